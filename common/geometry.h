@@ -1,0 +1,38 @@
+/* Geometry of sphero-polyhedra, in one place: closest points between features (vertex, edge,
+ * face), closest point on a body's surface, distance between two bodies. Used by the DEM
+ * contact detection, by the case loader (overlap at t = 0) and by the SPH-DEM coupling
+ * (virtual particle at the closest surface point, paper 000 eq. 12-14). */
+#ifndef LAHAR_GEOMETRY_H
+#define LAHAR_GEOMETRY_H
+#include "scene.h"
+#include "vec.h"
+
+/* Closest point c on segment [a, b] to p; returns |p - c|. */
+double geom_point_segment(vec3 p, vec3 a, vec3 b, vec3 *c);
+
+/* Closest points cp on [p0, p1] and cq on [q0, q1]; returns |cp - cq|. Robust for parallel and
+ * degenerate (zero-length) segments. */
+double geom_segment_segment(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 *cp, vec3 *cq);
+
+/* Closest point c on the planar convex polygon poly[0..n-1] (counter-clockwise about `normal`)
+ * to p; returns |p - c|. *inside = 1 when the projection of p falls inside the polygon. */
+double geom_point_polygon(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *c, int *inside);
+
+/* World-frame vertex i of a body at position x and orientation q. */
+vec3 geom_world_vertex(const lahar_shape *s, const double x[3], const double q[4], int i);
+
+/* Closest point `c` on the core (vertices, edges, faces) of a body placed at (x, q) to the world
+ * point p; returns the distance to the core (subtract shape->radius for the swept surface).
+ * *feature receives 0 vertex, 1 edge, 2 face. */
+double geom_point_body_core(const lahar_shape *s, const double x[3], const double q[4], vec3 p,
+                            vec3 *c, int *feature);
+
+/* Smallest distance between the cores of two placed bodies (all feature pairs); the swept
+ * surfaces overlap by (ra + rb) - distance when that is positive. */
+double geom_body_core_distance(const lahar_shape *a, const double xa[3], const double qa[4],
+                               const lahar_shape *b, const double xb[3], const double qb[4]);
+
+/* Outward unit normal of face f (body frame), from Newell's method. */
+vec3 geom_face_normal(const lahar_shape *s, int f);
+
+#endif

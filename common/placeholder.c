@@ -1,0 +1,1 @@
+/* placeholder */ typedef int lahar_placeholder_common;
