@@ -64,5 +64,34 @@ static inline vec3 q_rotate(quat q, vec3 v)
 }
 /* World frame -> body frame: q* v q. */
 static inline vec3 q_rotate_inv(quat q, vec3 v) { return q_rotate(q_conj(q), v); }
+/* Quaternion of a proper rotation matrix m (row-major, m v rotates v); Shepperd's method picks
+ * the largest of w, x, y, z to divide by, so it stays accurate for every angle. */
+static inline quat q_from_rotmat(const double m[3][3])
+{
+    double tr = m[0][0] + m[1][1] + m[2][2];
+    quat q;
+    if (tr > 0.0) {
+        double s = 2.0 * sqrt(1.0 + tr);
+        q.w = 0.25 * s; q.x = (m[2][1] - m[1][2]) / s; q.y = (m[0][2] - m[2][0]) / s; q.z = (m[1][0] - m[0][1]) / s;
+    } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
+        double s = 2.0 * sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]);
+        q.w = (m[2][1] - m[1][2]) / s; q.x = 0.25 * s; q.y = (m[0][1] + m[1][0]) / s; q.z = (m[0][2] + m[2][0]) / s;
+    } else if (m[1][1] > m[2][2]) {
+        double s = 2.0 * sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]);
+        q.w = (m[0][2] - m[2][0]) / s; q.x = (m[0][1] + m[1][0]) / s; q.y = 0.25 * s; q.z = (m[1][2] + m[2][1]) / s;
+    } else {
+        double s = 2.0 * sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]);
+        q.w = (m[1][0] - m[0][1]) / s; q.x = (m[0][2] + m[2][0]) / s; q.y = (m[1][2] + m[2][1]) / s; q.z = 0.25 * s;
+    }
+    if (q.w < 0.0) { q.w = -q.w; q.x = -q.x; q.y = -q.y; q.z = -q.z; } /* one canonical sign */
+    return q_normalize(q);
+}
+/* Rotation matrix (row-major) of a unit quaternion. */
+static inline void q_to_rotmat(quat q, double m[3][3])
+{
+    m[0][0] = 1 - 2 * (q.y * q.y + q.z * q.z); m[0][1] = 2 * (q.x * q.y - q.w * q.z); m[0][2] = 2 * (q.x * q.z + q.w * q.y);
+    m[1][0] = 2 * (q.x * q.y + q.w * q.z); m[1][1] = 1 - 2 * (q.x * q.x + q.z * q.z); m[1][2] = 2 * (q.y * q.z - q.w * q.x);
+    m[2][0] = 2 * (q.x * q.z - q.w * q.y); m[2][1] = 2 * (q.y * q.z + q.w * q.x); m[2][2] = 1 - 2 * (q.x * q.x + q.y * q.y);
+}
 
 #endif
