@@ -1,0 +1,87 @@
+/* Building sphero-polyhedra (lahar_shape, scene.h): primitive shapes, convex hulls, polyhedra
+ * from vertices + faces, STL import, convexity, and mass properties of the swept solid.
+ *
+ * Conventions:
+ * - 3D shapes carry vertices, edges and faces (faces counter-clockwise seen from outside).
+ * - 2D shapes (disc, 2D box, polygon, polyline, 2D segment) lie in the x-y plane (z = 0) and carry
+ *   vertices and edges only (nf = 0): contacts in 2D are vertex/edge features in the plane.
+ * - Every constructor returns 0 on success; on failure it returns -1, leaves *s empty (all
+ *   pointers NULL) and, where it takes `err`, writes a one-line reason without the file prefix.
+ * - A shape owns its arrays; release with lahar_shape_free (safe on an empty/zeroed shape). */
+#ifndef LAHAR_SHAPE_BUILD_H
+#define LAHAR_SHAPE_BUILD_H
+#include <stddef.h>
+#include "scene.h"
+
+/* Sphere (3D) or disc (2D): one vertex at the origin, swept by `radius`. */
+int lahar_shape_make_sphere(lahar_shape *s, double radius);
+/* Segment a-b swept by radius (a capsule in 3D, a stadium in 2D): 2 vertices, 1 edge. */
+int lahar_shape_make_segment(lahar_shape *s, const double a[3], const double b[3], double radius);
+/* Box centred at the origin whose CORE has half-extents `half` (the outer half-size of the swept
+ * box is half + radius): 8 vertices, 12 edges, 6 quad faces. The case file's `size` is the outer
+ * size; the loader passes half = size/2 - radius. */
+int lahar_shape_make_box(lahar_shape *s, const double half[3], double radius);
+/* 2D rectangle (core half-extents half[0], half[1]) in the x-y plane: 4 vertices, 4 edges. */
+int lahar_shape_make_box2d(lahar_shape *s, const double half[2], double radius);
+/* Finite one-sided rectangle: centre c, outward unit normal n, side lengths size[0] along the
+ * in-plane axis closest to world x (world y when n is along x) and size[1] along n x that axis.
+ * 4 vertices, 4 edges, 1 face. */
+int lahar_shape_make_plane(lahar_shape *s, const double c[3], const double n[3], const double size[2],
+                           double radius);
+/* 2D chain of n >= 2 points (z ignored, set to 0); closed adds the edge n-1 -> 0. */
+int lahar_shape_make_polyline(lahar_shape *s, const double (*p)[3], int n, int closed, double radius,
+                              char *err, size_t errlen);
+/* 2D convex hull of n points (x, y) as a counter-clockwise polygon. Fails if the points are all
+ * collinear (degenerate). */
+int lahar_shape_make_polygon_hull(lahar_shape *s, const double (*p)[3], int n, double radius, char *err,
+                                  size_t errlen);
+/* 3D convex hull of n >= 4 points; coplanar triangles are merged into polygonal faces and points
+ * inside the hull or on its faces/edges are dropped. Fails (degenerate) if all points are
+ * coplanar. Exact supporting-plane enumeration: meant for rocks of up to a few hundred points. */
+int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double radius, char *err, size_t errlen);
+/* Polyhedron from vertices and faces (face f = face_v[face_start[f] .. face_start[f+1])), which
+ * must be counter-clockwise seen from outside. Edges are built from the faces. Checks indices,
+ * faces with < 3 vertices and zero-area faces. Convexity is NOT required here (see is_convex). */
+int lahar_shape_make_polyhedron(lahar_shape *s, const double (*v)[3], int nv, const int *face_start,
+                                const int *face_v, int nf, double radius, char *err, size_t errlen);
+/* ASCII or binary STL (binary when the size is 84 + 50 n bytes). Vertices with identical
+ * coordinates are merged, triangles that collapse after merging are dropped, edges are built.
+ * The surface may be open and non-convex (fixed terrain, flumes). */
+int lahar_shape_read_stl(lahar_shape *s, const char *path, double radius, char *err, size_t errlen);
+
+int lahar_shape_copy(lahar_shape *dst, const lahar_shape *src);
+void lahar_shape_free(lahar_shape *s);
+
+/* 1 if every vertex lies on the inner side of every face plane (tolerance tol, metres); 2D
+ * shapes: of every edge line of a closed CCW polygon. Spheres, segments are convex. */
+int lahar_shape_is_convex(const lahar_shape *s, int dim, double tol);
+/* Signed volume of the core polyhedron (3D, faces closed and outward) - used to detect inverted
+ * face orientation. */
+double lahar_shape_core_volume(const lahar_shape *s);
+
+/* Apply x -> R (scale x) + t to every vertex (R row-major 3x3, may be NULL for identity). */
+void lahar_shape_transform(lahar_shape *s, const double R[3][3], const double t[3], double scale);
+
+/* Mass properties of the swept solid with unit density, computed EXACTLY (to rounding) by
+ * decomposing the Minkowski sum core + ball(R) into: the core polyhedron, one prism per face,
+ * one cylindrical wedge per edge (opening angle = angle between the adjacent face normals) and
+ * one spherical sector per vertex (its normal cone, solid angle = the vertex angle defect).
+ * 2D (per unit thickness): core polygon, one rectangle per edge, one circular sector per vertex.
+ * Valid for convex cores (and for the degenerate convex cores: point, segment, 2D polygons). */
+typedef struct {
+    double volume;        /* m^3 (area m^2 in 2D) */
+    double com[3];        /* centre of mass in the shape's frame */
+    double inertia[3];    /* principal moments per unit density about the axes below; 2D:
+                             [int y'^2, int x'^2, int (x'^2 + y'^2)] over the figure's area */
+    double axes[3][3];    /* columns = principal axes in the shape's frame, det = +1 */
+} lahar_mass_props;
+int lahar_shape_mass_properties(const lahar_shape *s, int dim, lahar_mass_props *mp, char *err, size_t errlen);
+/* Move a shape into its principal frame: v -> axes^T (v - com). */
+void lahar_shape_to_principal(lahar_shape *s, const lahar_mass_props *mp);
+
+/* Symmetric 3x3 eigen-decomposition by cyclic Jacobi rotations: a = V diag(d) V^T, V columns =
+ * eigenvectors, det V = +1 (a product of rotations). Not sorted: an already diagonal matrix gives
+ * V = identity, so symmetric shapes keep the axes the user wrote. Deterministic. */
+void lahar_sym3_eigen(const double a[3][3], double d[3], double V[3][3]);
+
+#endif
