@@ -97,6 +97,12 @@ typedef struct {
     double dem_dt_safety;  /* fraction of the contact period used as the DEM step, default 0.02 */
 
     lahar_check check;
+
+    /* output: section. output_fields: particle fields to write, bits in the order of the names
+     * velocity, density, pressure, phase, id (= LAHAR_PFIELD_* in output.h); default all.
+     * output_forces: 1 = write the per-body force stream (default), 0 = not. */
+    unsigned output_fields;
+    int output_forces;
 } lahar_case;
 
 /* Per-body state as exchanged with the other nodes (body_state_t). */

@@ -1,0 +1,33 @@
+/* Case files: YAML (documented key by key in cases/dem_drop_3d.yaml) -> lahar_case (scene.h).
+ *
+ * The loader checks everything it can before a run starts: YAML syntax, unknown keys (with the
+ * closest known key as a suggestion), types, ranges, references between sections, shapes
+ * (degenerate or non-convex polyhedra, unreadable STL files) and bodies overlapping at t = 0.
+ * It fills a default for every optional key, builds every shape, computes the mass properties of
+ * free and prescribed bodies and moves their shapes into the principal frame. */
+#ifndef LAHAR_CASE_H
+#define LAHAR_CASE_H
+#include "scene.h"
+#include "shape_build.h"
+
+/* Exit status of a program that rejects its input (lahar, lahar-case-check). */
+#define LAHAR_EXIT_BAD_INPUT 2
+
+/* Parse and validate a case file. On error prints ONE message to stderr of the form
+ *   cases/x.yaml:12: bodies[3].radius: must be > 0 (got -0.1); <what to do>
+ * and returns 2 (LAHAR_EXIT_BAD_INPUT); returns 0 on success. Nothing stays allocated on failure
+ * and *out is zeroed. */
+int lahar_case_load(const char *path, lahar_case *out);
+
+/* Same, but the message goes to `err` (without a trailing newline) instead of stderr. */
+int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen);
+
+/* Release everything a loaded (or scene-message-built) case owns; the case is zeroed. Safe on a
+ * zeroed case. */
+void lahar_case_free(lahar_case *c);
+
+/* Index of the body / material called `name`, or -1. */
+int lahar_case_find_body(const lahar_case *c, const char *name);
+int lahar_case_find_material(const lahar_case *c, const char *name);
+
+#endif
