@@ -1,0 +1,955 @@
+/* HDF5 output of bodies, forces and particles with XDMF sidecars (layout in output.h and
+ * tools/README.md). Everything a snapshot or a force row needs is allocated at open; the
+ * per-step path only copies into those buffers and calls HDF5. */
+#include "output.h"
+#include <errno.h>
+#include <hdf5.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include "vec.h"
+#include "xdmf.h"
+
+#define OUT_PATH_MAX 1200
+#define OUT_XML_CAP 16384
+#define FORCES_FLUSH_SECONDS 0.5
+#define FORCES_BUFFER_BYTES (256 * 1024)
+
+/* ---------------------------------------------------------------- small HDF5 helpers ---- */
+
+/* Files that are closed between snapshots are opened without HDF5's file lock so that a viewer
+ * holding the file open (ParaView) never makes the next snapshot fail. */
+static hid_t out_fapl_unlocked(void)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_file_locking(fapl, 0, 1);
+    return fapl;
+}
+
+static hid_t out_str_type(void)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    H5Tset_size(t, H5T_VARIABLE);
+    H5Tset_cset(t, H5T_CSET_UTF8);
+    return t;
+}
+
+static int out_attr(hid_t loc, const char *name, hid_t type, int n, const void *data)
+{
+    hsize_t d = (hsize_t)n;
+    hid_t sp = n == 0 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &d, NULL);
+    hid_t a = H5Acreate2(loc, name, type, sp, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = a < 0 ? -1 : H5Awrite(a, type, data);
+    if (a >= 0)
+        H5Aclose(a);
+    H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+static int out_attr_double(hid_t loc, const char *name, double v) { return out_attr(loc, name, H5T_NATIVE_DOUBLE, 0, &v); }
+static int out_attr_int64(hid_t loc, const char *name, int64_t v) { return out_attr(loc, name, H5T_NATIVE_INT64, 0, &v); }
+static int out_attr_string(hid_t loc, const char *name, const char *s)
+{
+    hid_t t = out_str_type();
+    int rc = out_attr(loc, name, t, 0, &s);
+    H5Tclose(t);
+    return rc;
+}
+
+/* Write a whole dataset (rank 1 or 2); file type = memory type except float32 display data. */
+static int out_dataset(hid_t loc, const char *name, hid_t memtype, hid_t filetype, int rank, hsize_t d0, hsize_t d1,
+                       const void *data)
+{
+    hsize_t dims[2] = {d0, d1};
+    hid_t sp = H5Screate_simple(rank, dims, NULL);
+    hid_t ds = H5Dcreate2(loc, name, filetype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = ds < 0 ? -1 : 0;
+    if (ds >= 0 && d0 * (rank == 2 ? d1 : 1) > 0)
+        rc = H5Dwrite(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    if (ds >= 0)
+        H5Dclose(ds);
+    H5Sclose(sp);
+    return rc < 0 ? -1 : 0;
+}
+
+static int out_strings(hid_t loc, const char *name, int n, const char *const *s)
+{
+    hid_t t = out_str_type();
+    int rc = out_dataset(loc, name, t, t, 1, (hsize_t)n, 0, s);
+    H5Tclose(t);
+    return rc;
+}
+
+static double out_wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---------------------------------------------------------------- bodies ---------------- */
+
+typedef struct {
+    hid_t file, t, step, force, torque, ncontacts;
+    int nbody;
+    int64_t rows;         /* rows on disk */
+    int cap, nbuf;        /* buffered rows */
+    double *bt, *bforce, *btorque;
+    int64_t *bstep;
+    int32_t *bncont;
+    double last_flush;
+    double interval;      /* s, 0 = every row */
+    int64_t next_slot;    /* next multiple of interval to record */
+} forces_stream;
+
+struct lahar_body_output {
+    char dir[OUT_PATH_MAX];
+    char h5path[OUT_PATH_MAX];
+    int dim, nbody;
+    lahar_display_mesh *mesh;  /* per body, body frame (fixed: world frame as given) */
+    int *moving;               /* per body: 1 if not fixed */
+    int64_t nmoving_vert, nmoving_cell, nfixed_vert, nfixed_cell;
+    double *state;             /* nbody * 13: x, q, v, w laid out as four blocks */
+    float *vert, *vvel;        /* moving display vertices and their velocities */
+    int64_t nsnap;
+    lahar_xdmf_file xmf;
+    char *xml;
+    forces_stream fs;
+};
+
+/* Flattened display geometry of the bodies with the given motion filter (moving = 1: free and
+ * prescribed bodies; 0: fixed ones), with world vertices from the case pose. */
+static int out_write_mesh_set(hid_t g, const lahar_body_output *o, const lahar_case *c, int moving)
+{
+    int64_t nv = moving ? o->nmoving_vert : o->nfixed_vert, nc = moving ? o->nmoving_cell : o->nfixed_cell;
+    int npc = o->dim == 2 ? 2 : 3;
+    float *v = malloc((size_t)(nv > 0 ? nv : 1) * 3 * sizeof *v);
+    int32_t *cell = malloc((size_t)(nc > 0 ? nc : 1) * (size_t)npc * sizeof *cell);
+    int32_t *bid = malloc((size_t)(nc > 0 ? nc : 1) * sizeof *bid);
+    int32_t *vbid = malloc((size_t)(nv > 0 ? nv : 1) * sizeof *vbid);
+    if (!v || !cell || !bid || !vbid) {
+        free(v), free(cell), free(bid), free(vbid);
+        return -1;
+    }
+    int64_t iv = 0, ic = 0;
+    for (int b = 0; b < o->nbody; b++) {
+        if (o->moving[b] != moving)
+            continue;
+        const lahar_display_mesh *m = &o->mesh[b];
+        quat q = q_load(c->bodies[b].q);
+        vec3 x = v3_load(c->bodies[b].x);
+        for (int k = 0; k < m->ncell; k++, ic++) {
+            for (int j = 0; j < npc; j++)
+                cell[ic * npc + j] = (int32_t)(iv + m->cell[k * npc + j]);
+            bid[ic] = b;
+        }
+        for (int i = 0; i < m->nvert; i++, iv++) {
+            vec3 p = v3_add(x, q_rotate(q, v3_load(m->v[i])));
+            v[iv * 3 + 0] = (float)p.x, v[iv * 3 + 1] = (float)p.y, v[iv * 3 + 2] = (float)p.z;
+            vbid[iv] = b;
+        }
+    }
+    int rc = 0;
+    if (!moving)
+        rc |= out_dataset(g, "vertices", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)nv, 3, v);
+    rc |= out_dataset(g, "cells", H5T_NATIVE_INT32, H5T_STD_I32LE, 2, (hsize_t)nc, (hsize_t)npc, cell);
+    rc |= out_dataset(g, "body_id", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nc, 0, bid);
+    rc |= out_dataset(g, "vertex_body_id", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nv, 0, vbid);
+    free(v), free(cell), free(bid), free(vbid);
+    return rc;
+}
+
+static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_case *c)
+{
+    int rc = 0, nb = c->nbody, nm = c->nmaterial;
+    hid_t h = H5Gcreate2(f, "header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (h < 0)
+        return -1;
+    rc |= out_attr_int64(h, "dimensions", c->dim);
+    rc |= out_attr_string(h, "units", "SI");
+    rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
+    rc |= out_attr_string(h, "case_path", c->path);
+    rc |= out_attr_int64(h, "nbody", nb);
+    rc |= out_attr(h, "gravity", H5T_NATIVE_DOUBLE, 3, c->gravity);
+    rc |= out_attr_double(h, "t_end", c->t_end);
+    rc |= out_attr_double(h, "output_interval", c->output_interval);
+    rc |= out_attr_double(h, "forces_interval", c->forces_interval);
+    rc |= out_attr_string(h, "motion_kinds", "0 free, 1 fixed, 2 prescribed");
+    rc |= out_attr_string(h, "frames", "geometry in body frame (fixed bodies: world frame); "
+                                       "quaternions (w,x,y,z) body->world; angular velocity in world frame");
+    size_t nalloc = (size_t)(nb > nm ? nb : nm) + 1;
+    const char **names = malloc(nalloc * sizeof *names);
+    int32_t *iv = malloc(nalloc * sizeof *iv);
+    double *dv = malloc(nalloc * 3 * sizeof *dv);
+    if (!names || !iv || !dv) {
+        free(names), free(iv), free(dv);
+        H5Gclose(h);
+        return -1;
+    }
+    for (int b = 0; b < nb; b++)
+        names[b] = c->bodies[b].name;
+    rc |= out_strings(h, "body_name", nb, names);
+    for (int b = 0; b < nb; b++)
+        iv[b] = b;
+    rc |= out_dataset(h, "body_id", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nb, 0, iv);
+    for (int b = 0; b < nb; b++)
+        iv[b] = c->bodies[b].material;
+    rc |= out_dataset(h, "material", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nb, 0, iv);
+    for (int b = 0; b < nb; b++) {
+        int m = c->bodies[b].material;
+        names[b] = (m >= 0 && m < nm) ? c->materials[m].name : "";
+    }
+    rc |= out_strings(h, "material_name", nb, names);
+    for (int b = 0; b < nb; b++)
+        iv[b] = (int32_t)c->bodies[b].motion;
+    rc |= out_dataset(h, "motion", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nb, 0, iv);
+    for (int b = 0; b < nb; b++)
+        dv[b] = c->bodies[b].mass;
+    rc |= out_dataset(h, "mass", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 1, (hsize_t)nb, 0, dv);
+    for (int b = 0; b < nb; b++)
+        dv[b] = c->bodies[b].shape.radius;
+    rc |= out_dataset(h, "sweep_radius", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 1, (hsize_t)nb, 0, dv);
+    for (int b = 0; b < nb; b++)
+        memcpy(dv + 3 * b, c->bodies[b].inertia, 3 * sizeof(double));
+    rc |= out_dataset(h, "inertia", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, dv);
+
+    /* material table: one dataset per property, indexed by /header/material */
+    hid_t mg = H5Gcreate2(h, "materials", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (mg < 0)
+        rc = -1;
+    else {
+        for (int m = 0; m < nm; m++)
+            names[m] = c->materials[m].name;
+        rc |= out_strings(mg, "name", nm, names);
+        static const struct {
+            const char *name;
+            size_t off;
+        } prop[] = {{"density", offsetof(lahar_material, density)},
+                    {"young", offsetof(lahar_material, young)},
+                    {"poisson", offsetof(lahar_material, poisson)},
+                    {"kn", offsetof(lahar_material, kn)},
+                    {"kt_ratio", offsetof(lahar_material, kt_ratio)},
+                    {"restitution", offsetof(lahar_material, restitution)},
+                    {"friction", offsetof(lahar_material, friction)}};
+        for (size_t p = 0; p < sizeof prop / sizeof prop[0]; p++) {
+            for (int m = 0; m < nm; m++)
+                memcpy(&dv[m], (const char *)&c->materials[m] + prop[p].off, sizeof(double));
+            rc |= out_dataset(mg, prop[p].name, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 1, (hsize_t)nm, 0, dv);
+        }
+        for (int m = 0; m < nm; m++)
+            iv[m] = (int32_t)c->materials[m].model;
+        rc |= out_dataset(mg, "model", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, (hsize_t)nm, 0, iv);
+        rc |= out_attr_string(mg, "model_kinds", "0 linear, 1 hertz");
+        H5Gclose(mg);
+    }
+    free(names), free(iv), free(dv);
+    (void)o;
+    H5Gclose(h);
+    return rc ? -1 : 0;
+}
+
+static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_case *c)
+{
+    int rc = 0;
+    hid_t g = H5Gcreate2(f, "geometry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0)
+        return -1;
+    rc |= out_attr_int64(g, "nodes_per_cell", o->dim == 2 ? 2 : 3);
+    rc |= out_attr_int64(g, "moving_vertices", o->nmoving_vert);
+    rc |= out_attr_int64(g, "moving_cells", o->nmoving_cell);
+    rc |= out_attr_int64(g, "fixed_vertices", o->nfixed_vert);
+    rc |= out_attr_int64(g, "fixed_cells", o->nfixed_cell);
+    hid_t bg = H5Gcreate2(g, "bodies", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    for (int b = 0; bg >= 0 && b < o->nbody; b++) {
+        char name[32];
+        snprintf(name, sizeof name, "%06d", b);
+        hid_t one = H5Gcreate2(bg, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        if (one < 0) {
+            rc = -1;
+            break;
+        }
+        const lahar_display_mesh *m = &o->mesh[b];
+        rc |= out_attr_string(one, "name", c->bodies[b].name);
+        rc |= out_attr_string(one, "frame", o->moving[b] ? "body" : "world");
+        rc |= out_dataset(one, "vertices", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)m->nvert, 3, m->v);
+        rc |= out_dataset(one, "cells", H5T_NATIVE_INT32, H5T_STD_I32LE, 2, (hsize_t)m->ncell,
+                          (hsize_t)m->nodes_per_cell, m->cell);
+        H5Gclose(one);
+    }
+    if (bg >= 0)
+        H5Gclose(bg);
+    else
+        rc = -1;
+    for (int moving = 0; moving < 2; moving++) {
+        hid_t s = H5Gcreate2(g, moving ? "moving" : "fixed", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        if (s < 0 || out_write_mesh_set(s, o, c, moving))
+            rc = -1;
+        if (s >= 0)
+            H5Gclose(s);
+    }
+    H5Gclose(g);
+    return rc ? -1 : 0;
+}
+
+static int forces_open(forces_stream *fs, const char *path, const lahar_case *c, char *err, size_t n)
+{
+    memset(fs, 0, sizeof *fs);
+    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = H5I_INVALID_HID;
+    int nb = c->nbody;
+    fs->nbody = nb;
+    fs->interval = c->forces_interval > 0.0 ? c->forces_interval : 0.0;
+    size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 52 + 16;
+    fs->cap = (int)(FORCES_BUFFER_BYTES / row_bytes);
+    if (fs->cap < 1)
+        fs->cap = 1;
+    if (fs->cap > 1024)
+        fs->cap = 1024;
+    size_t nrow = (size_t)fs->cap, nb3 = (size_t)(nb > 0 ? nb : 1) * 3;
+    fs->bt = malloc(nrow * sizeof *fs->bt);
+    fs->bstep = malloc(nrow * sizeof *fs->bstep);
+    fs->bforce = malloc(nrow * nb3 * sizeof *fs->bforce);
+    fs->btorque = malloc(nrow * nb3 * sizeof *fs->btorque);
+    fs->bncont = malloc(nrow * (size_t)(nb > 0 ? nb : 1) * sizeof *fs->bncont);
+    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont) {
+        snprintf(err, n, "out of memory for the force stream buffer");
+        return -1;
+    }
+    /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    fs->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (fs->file < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file", path);
+        return -1;
+    }
+    hsize_t chunk_rows = (hsize_t)fs->cap;
+    struct {
+        hid_t *id;
+        const char *name;
+        hid_t type;
+        int rank;
+        const char *units;
+    } ds[] = {{&fs->t, "t", H5T_IEEE_F64LE, 1, "s"},
+              {&fs->step, "step", H5T_STD_I64LE, 1, ""},
+              {&fs->force, "force", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N/m" : "N"},
+              {&fs->torque, "torque", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N m/m" : "N m"},
+              {&fs->ncontacts, "ncontacts", H5T_STD_I32LE, 2, ""}};
+    int rc = 0;
+    for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
+        hsize_t dims[3] = {0, (hsize_t)nb, 3}, maxd[3] = {H5S_UNLIMITED, (hsize_t)nb, 3};
+        hsize_t ch[3] = {chunk_rows, (hsize_t)(nb > 0 ? nb : 1), 3};
+        hid_t sp = H5Screate_simple(ds[k].rank, dims, maxd);
+        hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        H5Pset_chunk(dcpl, ds[k].rank, ch);
+        *ds[k].id = H5Dcreate2(fs->file, ds[k].name, ds[k].type, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+        H5Pclose(dcpl);
+        H5Sclose(sp);
+        if (*ds[k].id < 0 || (ds[k].units[0] && out_attr_string(*ds[k].id, "units", ds[k].units)))
+            rc = -1;
+    }
+    const char **names = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *names);
+    if (!names)
+        rc = -1;
+    else {
+        for (int b = 0; b < nb; b++)
+            names[b] = c->bodies[b].name;
+        hid_t st = out_str_type();
+        if (nb > 0)
+            rc |= out_attr(fs->file, "body_names", st, nb, names);
+        H5Tclose(st);
+        free(names);
+    }
+    rc |= out_attr_string(fs->file, "units", "SI");
+    rc |= out_attr_string(fs->file, "description",
+                          "contact + external force and torque (about the centre of mass) on each body, time "
+                          "average over the step; fixed bodies: the contact force they receive");
+    rc |= out_attr_string(fs->file, "lahar_version", LAHAR_VERSION);
+    if (rc || H5Fstart_swmr_write(fs->file) < 0) {
+        snprintf(err, n, "%s: cannot create the force datasets / start SWMR writing", path);
+        return -1;
+    }
+    fs->last_flush = out_wall_seconds();
+    return 0;
+}
+
+static int forces_flush(forces_stream *fs)
+{
+    if (fs->file < 0 || fs->nbuf == 0)
+        return 0;
+    hsize_t rows = (hsize_t)fs->nbuf, start = (hsize_t)fs->rows, nb = (hsize_t)fs->nbody;
+    struct {
+        hid_t id, mtype;
+        int rank;
+        const void *buf;
+    } ds[] = {{fs->t, H5T_NATIVE_DOUBLE, 1, fs->bt},
+              {fs->step, H5T_NATIVE_INT64, 1, fs->bstep},
+              {fs->force, H5T_NATIVE_DOUBLE, 3, fs->bforce},
+              {fs->torque, H5T_NATIVE_DOUBLE, 3, fs->btorque},
+              {fs->ncontacts, H5T_NATIVE_INT32, 2, fs->bncont}};
+    int rc = 0;
+    for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
+        hsize_t newd[3] = {start + rows, nb, 3}, off[3] = {start, 0, 0}, cnt[3] = {rows, nb, 3};
+        if (H5Dset_extent(ds[k].id, newd) < 0) {
+            rc = -1;
+            continue;
+        }
+        if (nb == 0 && ds[k].rank > 1)
+            continue;
+        hid_t fsp = H5Dget_space(ds[k].id);
+        hid_t msp = H5Screate_simple(ds[k].rank, cnt, NULL);
+        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, off, NULL, cnt, NULL);
+        if (H5Dwrite(ds[k].id, ds[k].mtype, msp, fsp, H5P_DEFAULT, ds[k].buf) < 0)
+            rc = -1;
+        H5Sclose(msp);
+        H5Sclose(fsp);
+    }
+    /* /t last: a SWMR reader that sees n rows in /t finds them in every other dataset */
+    for (size_t k = 1; k <= sizeof ds / sizeof ds[0]; k++)
+        if (H5Dflush(ds[k % (sizeof ds / sizeof ds[0])].id) < 0)
+            rc = -1;
+    fs->rows += fs->nbuf;
+    fs->nbuf = 0;
+    fs->last_flush = out_wall_seconds();
+    return rc;
+}
+
+static void forces_close(forces_stream *fs)
+{
+    forces_flush(fs);
+    hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts};
+    for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
+        if (ids[k] >= 0)
+            H5Dclose(ids[k]);
+    if (fs->file >= 0)
+        H5Fclose(fs->file);
+    free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont);
+    memset(fs, 0, sizeof *fs);
+    fs->file = H5I_INVALID_HID;
+}
+
+static void out_xdmf_bodies_info(const lahar_body_output *o, lahar_xdmf_bodies *x)
+{
+    x->h5name = "bodies.h5";
+    x->nbody = o->nbody;
+    x->nodes_per_cell = o->dim == 2 ? 2 : 3;
+    x->moving_vertices = o->nmoving_vert;
+    x->moving_cells = o->nmoving_cell;
+    x->fixed_vertices = o->nfixed_vert;
+    x->fixed_cells = o->nfixed_cell;
+}
+
+lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *c, char *err, size_t n)
+{
+    lahar_body_output *o = calloc(1, sizeof *o);
+    if (!o) {
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    o->xmf.fd = -1;
+    o->fs.file = H5I_INVALID_HID;
+    o->dim = c->dim;
+    o->nbody = c->nbody;
+    snprintf(o->dir, sizeof o->dir, "%s", outdir);
+    snprintf(o->h5path, sizeof o->h5path, "%s/bodies.h5", outdir);
+    size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
+    o->mesh = calloc(nb, sizeof *o->mesh);
+    o->moving = calloc(nb, sizeof *o->moving);
+    o->state = calloc(nb * 13, sizeof *o->state);
+    o->xml = malloc(OUT_XML_CAP);
+    if (!o->mesh || !o->moving || !o->state || !o->xml) {
+        snprintf(err, n, "out of memory");
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    for (int b = 0; b < c->nbody; b++) {
+        o->moving[b] = c->bodies[b].motion != LAHAR_MOTION_FIXED;
+        if (lahar_display_mesh_build(&c->bodies[b].shape, c->dim, c->bodies[b].convex, &o->mesh[b])) {
+            snprintf(err, n, "bodies[%d] (%s): cannot build its display mesh", b, c->bodies[b].name);
+            lahar_body_output_close(o);
+            return NULL;
+        }
+        if (o->moving[b])
+            o->nmoving_vert += o->mesh[b].nvert, o->nmoving_cell += o->mesh[b].ncell;
+        else
+            o->nfixed_vert += o->mesh[b].nvert, o->nfixed_cell += o->mesh[b].ncell;
+    }
+    size_t nmv = (size_t)(o->nmoving_vert > 0 ? o->nmoving_vert : 1);
+    o->vert = malloc(nmv * 3 * sizeof *o->vert);
+    o->vvel = malloc(nmv * 3 * sizeof *o->vvel);
+    if (!o->vert || !o->vvel) {
+        snprintf(err, n, "out of memory");
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = H5Fcreate(o->h5path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (f < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    int rc = out_write_header(f, o, c);
+    rc |= out_write_geometry(f, o, c);
+    hid_t sg = H5Gcreate2(f, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (sg < 0)
+        rc = -1;
+    else
+        H5Gclose(sg);
+    if (H5Fclose(f) < 0)
+        rc = -1;
+    if (rc) {
+        snprintf(err, n, "%s: writing header/geometry failed", o->h5path);
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    char path[OUT_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
+    if (lahar_xdmf_open(&o->xmf, path, err, n)) {
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    snprintf(path, sizeof path, "%s/forces.h5", outdir);
+    if (forces_open(&o->fs, path, c, err, n)) {
+        lahar_body_output_close(o);
+        return NULL;
+    }
+    return o;
+}
+
+int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, const lahar_body_state *s)
+{
+    int nb = o->nbody;
+    double *X = o->state, *Q = X + 3 * nb, *V = Q + 4 * nb, *W = V + 3 * nb;
+    int64_t iv = 0;
+    for (int b = 0; b < nb; b++) {
+        memcpy(X + 3 * b, s[b].x, sizeof s[b].x);
+        memcpy(Q + 4 * b, s[b].q, sizeof s[b].q);
+        memcpy(V + 3 * b, s[b].v, sizeof s[b].v);
+        memcpy(W + 3 * b, s[b].w, sizeof s[b].w);
+        if (!o->moving[b])
+            continue;
+        vec3 x = v3_load(s[b].x), v = v3_load(s[b].v), w = v3_load(s[b].w);
+        quat q = q_load(s[b].q);
+        const lahar_display_mesh *m = &o->mesh[b];
+        for (int i = 0; i < m->nvert; i++, iv++) {
+            vec3 r = q_rotate(q, v3_load(m->v[i]));
+            vec3 p = v3_add(x, r), u = v3_add(v, v3_cross(w, r)); /* rigid-body velocity of the point */
+            o->vert[3 * iv + 0] = (float)p.x, o->vert[3 * iv + 1] = (float)p.y, o->vert[3 * iv + 2] = (float)p.z;
+            o->vvel[3 * iv + 0] = (float)u.x, o->vvel[3 * iv + 1] = (float)u.y, o->vvel[3 * iv + 2] = (float)u.z;
+        }
+    }
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = H5Fopen(o->h5path, H5F_ACC_RDWR, fapl);
+    H5Pclose(fapl);
+    if (f < 0) {
+        fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
+        return -1;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
+    hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = g < 0 ? -1 : 0;
+    if (g >= 0) {
+        rc |= out_attr_double(g, "time", t);
+        rc |= out_attr_int64(g, "step", step);
+        rc |= out_dataset(g, "position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, X);
+        rc |= out_dataset(g, "quaternion", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 4, Q);
+        rc |= out_dataset(g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, V);
+        rc |= out_dataset(g, "angular_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, W);
+        rc |= out_dataset(g, "vertices", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3, o->vert);
+        rc |= out_dataset(g, "vertex_velocity", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3,
+                          o->vvel);
+        H5Gclose(g);
+    }
+    if (H5Fclose(f) < 0)
+        rc = -1;
+    if (rc) {
+        fprintf(stderr, "lahar: %s: writing snapshot %" PRId64 " (step %" PRId64 ") failed\n", o->h5path, o->nsnap,
+                step);
+        return -1;
+    }
+    lahar_xdmf_bodies xb;
+    out_xdmf_bodies_info(o, &xb);
+    size_t len = lahar_xdmf_step_begin(o->xml, OUT_XML_CAP, step, t);
+    if (len < OUT_XML_CAP)
+        len += lahar_xdmf_bodies_grids(o->xml + len, OUT_XML_CAP - len, &xb, o->nsnap);
+    if (len < OUT_XML_CAP)
+        len += lahar_xdmf_step_end(o->xml + len, OUT_XML_CAP - len);
+    o->nsnap++;
+    if (len >= OUT_XML_CAP || lahar_xdmf_append(&o->xmf, o->xml, len, OUT_XML_CAP)) {
+        fprintf(stderr, "lahar: %s/bodies.xmf: cannot append step %" PRId64 "\n", o->dir, step);
+        return -1;
+    }
+    return 0;
+}
+
+int lahar_body_output_forces(lahar_body_output *o, int64_t step, double t, const lahar_body_report *r)
+{
+    forces_stream *fs = &o->fs;
+    if (fs->file < 0)
+        return -1;
+    if (fs->interval > 0.0) {
+        /* record the first row at or after each multiple of the interval (slot counted in
+         * integers, relative tolerance for times that are multiples up to rounding) */
+        if (t < (double)fs->next_slot * fs->interval * (1.0 - 1e-12) - 1e-300)
+            return 0;
+        fs->next_slot = (int64_t)floor(t / fs->interval * (1.0 + 1e-12)) + 1;
+    }
+    int nb = fs->nbody, i = fs->nbuf;
+    fs->bt[i] = t;
+    fs->bstep[i] = step;
+    for (int b = 0; b < nb; b++) {
+        memcpy(fs->bforce + ((size_t)i * nb + b) * 3, r[b].force, 3 * sizeof(double));
+        memcpy(fs->btorque + ((size_t)i * nb + b) * 3, r[b].torque, 3 * sizeof(double));
+        fs->bncont[(size_t)i * nb + b] = r[b].ncontacts;
+    }
+    fs->nbuf++;
+    if (fs->nbuf == fs->cap || out_wall_seconds() - fs->last_flush >= FORCES_FLUSH_SECONDS)
+        return forces_flush(fs);
+    return 0;
+}
+
+void lahar_body_output_close(lahar_body_output *o)
+{
+    if (!o)
+        return;
+    forces_close(&o->fs);
+    lahar_xdmf_close(&o->xmf);
+    if (o->mesh)
+        for (int b = 0; b < o->nbody; b++)
+            lahar_display_mesh_free(&o->mesh[b]);
+    int had_snapshots = o->nsnap > 0;
+    char dir[OUT_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", o->dir);
+    free(o->mesh), free(o->moving), free(o->state), free(o->vert), free(o->vvel), free(o->xml);
+    free(o);
+    if (had_snapshots) {
+        char err[256];
+        if (lahar_output_xdmf_combine(dir, err, sizeof err))
+            fprintf(stderr, "lahar: %s\n", err);
+    }
+}
+
+/* ---------------------------------------------------------------- particles ------------- */
+
+struct lahar_particle_output {
+    char dir[OUT_PATH_MAX];
+    char h5path[OUT_PATH_MAX];
+    unsigned fields;
+    int64_t nsnap;
+    lahar_xdmf_file xmf;
+    char *xml;
+};
+
+lahar_particle_output *lahar_particle_output_open(const char *outdir, const lahar_case *c, unsigned fields,
+                                                  char *err, size_t n)
+{
+    lahar_particle_output *o = calloc(1, sizeof *o);
+    char *xml = malloc(OUT_XML_CAP);
+    if (!o || !xml) {
+        free(o), free(xml);
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    o->xml = xml;
+    o->xmf.fd = -1;
+    o->fields = fields & LAHAR_PFIELD_ALL;
+    snprintf(o->dir, sizeof o->dir, "%s", outdir);
+    snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = H5Fcreate(o->h5path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (f < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
+        lahar_particle_output_close(o);
+        return NULL;
+    }
+    int rc = 0;
+    hid_t h = H5Gcreate2(f, "header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (h < 0)
+        rc = -1;
+    else {
+        rc |= out_attr_int64(h, "dimensions", c->dim);
+        rc |= out_attr_string(h, "units", "SI");
+        rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
+        rc |= out_attr_string(h, "case_path", c->path);
+        rc |= out_attr_int64(h, "fields", o->fields);
+        rc |= out_attr_string(h, "field_bits", "1 velocity (vx,vy,vz), 2 density, 4 pressure, 8 phase, 16 id");
+        rc |= out_attr_double(h, "dx", c->sph_dx);
+        rc |= out_attr_double(h, "rest_density", c->sph_density);
+        H5Gclose(h);
+    }
+    hid_t sg = H5Gcreate2(f, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (sg < 0)
+        rc = -1;
+    else
+        H5Gclose(sg);
+    if (H5Fclose(f) < 0 || rc) {
+        snprintf(err, n, "%s: writing the header failed", o->h5path);
+        lahar_particle_output_close(o);
+        return NULL;
+    }
+    char path[OUT_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/particles.xmf", outdir);
+    if (lahar_xdmf_open(&o->xmf, path, err, n)) {
+        lahar_particle_output_close(o);
+        return NULL;
+    }
+    return o;
+}
+
+int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
+{
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = H5Fopen(o->h5path, H5F_ACC_RDWR, fapl);
+    H5Pclose(fapl);
+    if (f < 0) {
+        fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
+        return -1;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
+    hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    int rc = g < 0 ? -1 : 0;
+    hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
+    if (g >= 0) {
+        rc |= out_attr_double(g, "time", t);
+        rc |= out_attr_int64(g, "step", step);
+        rc |= out_attr_int64(g, "n", (int64_t)n);
+        const struct {
+            unsigned field;
+            const char *name;
+            hid_t mt, ft;
+            const void *data;
+        } col[] = {
+            {0, "x", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->x},
+            {0, "y", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->y},
+            {0, "z", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->z},
+            {LAHAR_PFIELD_VELOCITY, "vx", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vx},
+            {LAHAR_PFIELD_VELOCITY, "vy", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vy},
+            {LAHAR_PFIELD_VELOCITY, "vz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vz},
+            {LAHAR_PFIELD_DENSITY, "density", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->density},
+            {LAHAR_PFIELD_PRESSURE, "pressure", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->pressure},
+            {LAHAR_PFIELD_PHASE, "phase", H5T_NATIVE_INT32, H5T_STD_I32LE, p->phase},
+            {LAHAR_PFIELD_ID, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, p->id},
+        };
+        for (size_t k = 0; k < sizeof col / sizeof col[0] && !rc; k++) {
+            if (col[k].field && !(o->fields & col[k].field))
+                continue;
+            if (!col[k].data && n > 0) {
+                if (col[k].field == 0 && col[k].name[0] == 'z') {
+                    /* 2D: z is never written, the dataset's fill value (0) stands for it */
+                    hid_t sp = H5Screate_simple(1, &n, NULL);
+                    hid_t ds = H5Dcreate2(g, "z", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+                    if (ds < 0)
+                        rc = -1;
+                    else
+                        H5Dclose(ds);
+                    H5Sclose(sp);
+                    continue;
+                }
+                fprintf(stderr, "lahar: particle snapshot: field %s selected but not given\n", col[k].name);
+                rc = -1;
+                break;
+            }
+            rc |= out_dataset(g, col[k].name, col[k].mt, col[k].ft, 1, n, 0, col[k].data);
+        }
+        H5Gclose(g);
+    }
+    if (H5Fclose(f) < 0)
+        rc = -1;
+    if (rc) {
+        fprintf(stderr, "lahar: %s: writing snapshot %" PRId64 " failed\n", o->h5path, o->nsnap);
+        return -1;
+    }
+    lahar_xdmf_particles xp = {"particles.h5", o->fields};
+    size_t len = lahar_xdmf_step_begin(o->xml, OUT_XML_CAP, step, t);
+    if (len < OUT_XML_CAP)
+        len += lahar_xdmf_particles_grid(o->xml + len, OUT_XML_CAP - len, &xp, o->nsnap, (int64_t)n);
+    if (len < OUT_XML_CAP)
+        len += lahar_xdmf_step_end(o->xml + len, OUT_XML_CAP - len);
+    o->nsnap++;
+    if (len >= OUT_XML_CAP || lahar_xdmf_append(&o->xmf, o->xml, len, OUT_XML_CAP)) {
+        fprintf(stderr, "lahar: %s/particles.xmf: cannot append step %" PRId64 "\n", o->dir, step);
+        return -1;
+    }
+    return 0;
+}
+
+void lahar_particle_output_close(lahar_particle_output *o)
+{
+    if (!o)
+        return;
+    lahar_xdmf_close(&o->xmf);
+    int had_snapshots = o->nsnap > 0;
+    char dir[OUT_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", o->dir);
+    free(o->xml);
+    free(o);
+    if (had_snapshots) {
+        char err[256];
+        if (lahar_output_xdmf_combine(dir, err, sizeof err))
+            fprintf(stderr, "lahar: %s\n", err);
+    }
+}
+
+/* ---------------------------------------------------------------- combined XDMF --------- */
+
+typedef struct {
+    int64_t step, snap, n;
+    double t;
+} out_snap_entry;
+
+/* Read (step, time, n) of every snapshot group in OUT/<name>; returns the count or -1. A
+ * missing file gives 0. */
+static int64_t out_read_snapshot_list(const char *path, out_snap_entry **list)
+{
+    *list = NULL;
+    FILE *probe = fopen(path, "rb");
+    if (!probe)
+        return 0;
+    fclose(probe);
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
+    if (f < 0)
+        return -1;
+    hid_t g = H5Gopen2(f, "snapshots", H5P_DEFAULT);
+    H5G_info_t info;
+    if (g < 0 || H5Gget_info(g, &info) < 0) {
+        if (g >= 0)
+            H5Gclose(g);
+        H5Fclose(f);
+        return -1;
+    }
+    int64_t cnt = 0;
+    *list = malloc((size_t)(info.nlinks > 0 ? info.nlinks : 1) * sizeof **list);
+    for (hsize_t k = 0; *list && k < info.nlinks; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "%06" PRId64, (int64_t)k);
+        if (H5Lexists(g, name, H5P_DEFAULT) <= 0)
+            break;
+        hid_t s = H5Gopen2(g, name, H5P_DEFAULT);
+        out_snap_entry e = {0, (int64_t)k, 0, 0.0};
+        hid_t a = H5Aopen(s, "time", H5P_DEFAULT);
+        H5Aread(a, H5T_NATIVE_DOUBLE, &e.t);
+        H5Aclose(a);
+        a = H5Aopen(s, "step", H5P_DEFAULT);
+        H5Aread(a, H5T_NATIVE_INT64, &e.step);
+        H5Aclose(a);
+        if (H5Aexists(s, "n") > 0) {
+            a = H5Aopen(s, "n", H5P_DEFAULT);
+            H5Aread(a, H5T_NATIVE_INT64, &e.n);
+            H5Aclose(a);
+        }
+        H5Gclose(s);
+        (*list)[cnt++] = e;
+    }
+    H5Gclose(g);
+    H5Fclose(f);
+    return cnt;
+}
+
+static int out_read_attr_int64(hid_t loc, const char *obj, const char *name, int64_t *v)
+{
+    *v = 0;
+    if (H5Aexists_by_name(loc, obj, name, H5P_DEFAULT) <= 0)
+        return -1;
+    hid_t a = H5Aopen_by_name(loc, obj, name, H5P_DEFAULT, H5P_DEFAULT);
+    herr_t rc = H5Aread(a, H5T_NATIVE_INT64, v);
+    H5Aclose(a);
+    return rc < 0 ? -1 : 0;
+}
+
+int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n)
+{
+    char bpath[OUT_PATH_MAX + 16], ppath[OUT_PATH_MAX + 16], xpath[OUT_PATH_MAX + 16], tpath[OUT_PATH_MAX + 32];
+    snprintf(bpath, sizeof bpath, "%s/bodies.h5", outdir);
+    snprintf(ppath, sizeof ppath, "%s/particles.h5", outdir);
+    snprintf(xpath, sizeof xpath, "%s/lahar.xmf", outdir);
+    snprintf(tpath, sizeof tpath, "%s/.lahar.xmf.%d.tmp", outdir, (int)getpid());
+    out_snap_entry *bl = NULL, *pl = NULL;
+    int64_t nbs = out_read_snapshot_list(bpath, &bl), nps = out_read_snapshot_list(ppath, &pl);
+    if (nbs < 0 || nps < 0) {
+        free(bl), free(pl);
+        snprintf(err, n, "%s: cannot read the snapshot lists of bodies.h5/particles.h5", outdir);
+        return -1;
+    }
+    lahar_xdmf_bodies xb = {"bodies.h5", 0, 3, 0, 0, 0, 0};
+    lahar_xdmf_particles xp = {"particles.h5", 0};
+    if (nbs > 0) {
+        hid_t fapl = out_fapl_unlocked();
+        hid_t f = H5Fopen(bpath, H5F_ACC_RDONLY, fapl);
+        H5Pclose(fapl);
+        int64_t v[6] = {0};
+        if (f >= 0) {
+            out_read_attr_int64(f, "header", "nbody", &v[0]);
+            out_read_attr_int64(f, "geometry", "nodes_per_cell", &v[1]);
+            out_read_attr_int64(f, "geometry", "moving_vertices", &v[2]);
+            out_read_attr_int64(f, "geometry", "moving_cells", &v[3]);
+            out_read_attr_int64(f, "geometry", "fixed_vertices", &v[4]);
+            out_read_attr_int64(f, "geometry", "fixed_cells", &v[5]);
+            H5Fclose(f);
+        }
+        xb.nbody = (int)v[0], xb.nodes_per_cell = (int)v[1], xb.moving_vertices = v[2], xb.moving_cells = v[3];
+        xb.fixed_vertices = v[4], xb.fixed_cells = v[5];
+    }
+    if (nps > 0) {
+        hid_t fapl = out_fapl_unlocked();
+        hid_t f = H5Fopen(ppath, H5F_ACC_RDONLY, fapl);
+        H5Pclose(fapl);
+        int64_t v = 0;
+        if (f >= 0) {
+            out_read_attr_int64(f, "header", "fields", &v);
+            H5Fclose(f);
+        }
+        xp.fields = (unsigned)v;
+    }
+    FILE *fp = fopen(tpath, "w");
+    char *buf = malloc(OUT_XML_CAP);
+    if (!fp || !buf) {
+        if (fp)
+            fclose(fp);
+        free(buf), free(bl), free(pl);
+        snprintf(err, n, "%s: cannot write (%s)", tpath, strerror(errno));
+        return -1;
+    }
+    fputs("<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n <Domain>\n"
+          "  <Grid Name=\"lahar\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+          fp);
+    /* merge the two lists by step: a time step holds whatever was written at that step */
+    int64_t i = 0, j = 0;
+    while (i < nbs || j < nps) {
+        int take_b = i < nbs && (j >= nps || bl[i].step <= pl[j].step);
+        int take_p = j < nps && (i >= nbs || pl[j].step <= bl[i].step);
+        const out_snap_entry *e = take_b ? &bl[i] : &pl[j];
+        size_t len = lahar_xdmf_step_begin(buf, OUT_XML_CAP, e->step, e->t);
+        if (take_b && len < OUT_XML_CAP)
+            len += lahar_xdmf_bodies_grids(buf + len, OUT_XML_CAP - len, &xb, bl[i].snap);
+        if (take_p && len < OUT_XML_CAP)
+            len += lahar_xdmf_particles_grid(buf + len, OUT_XML_CAP - len, &xp, pl[j].snap, pl[j].n);
+        if (len < OUT_XML_CAP)
+            len += lahar_xdmf_step_end(buf + len, OUT_XML_CAP - len);
+        if (len < OUT_XML_CAP)
+            fwrite(buf, 1, len, fp);
+        i += take_b;
+        j += take_p;
+    }
+    fputs("  </Grid>\n </Domain>\n</Xdmf>\n", fp);
+    int rc = ferror(fp) ? -1 : 0;
+    if (fclose(fp))
+        rc = -1;
+    free(buf), free(bl), free(pl);
+    if (rc || rename(tpath, xpath)) {
+        remove(tpath);
+        snprintf(err, n, "%s: cannot write (%s)", xpath, strerror(errno));
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,86 @@
+/* Run output in HDF5 with XDMF sidecars for ParaView (layout documented in tools/README.md).
+ *
+ *   OUT/bodies.h5   /header (units, version, case, per-body names, materials, motion, mass,
+ *                   inertia), /geometry (display meshes written once), /snapshots/NNNNNN
+ *                   (time, step, per-body pose and velocities, world-frame display vertices of
+ *                   the moving bodies). Reopened and closed for every snapshot, so the file on
+ *                   disk is always complete and other programs can open it while a job runs.
+ *   OUT/bodies.xmf  XDMF temporal collection, rewritten in place after each snapshot.
+ *   OUT/forces.h5   per-body force stream (SWMR: readable while the run appends to it).
+ *   OUT/particles.h5 + OUT/particles.xmf   SPH particles (SoA datasets, fields selectable).
+ *   OUT/lahar.xmf   bodies and particles in one XDMF (lahar_output_xdmf_combine). */
+#ifndef LAHAR_OUTPUT_H
+#define LAHAR_OUTPUT_H
+#include <stddef.h>
+#include <stdint.h>
+#include "scene.h"
+
+typedef struct lahar_body_output lahar_body_output;
+
+/* Create OUT/bodies.h5 (header + geometry), OUT/bodies.xmf and OUT/forces.h5 for the bodies of
+ * case c (outdir must exist). Returns NULL and a message in err on failure. */
+lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *c, char *err, size_t n);
+/* Append snapshot (s has c->nbody entries) as /snapshots/NNNNNN and add it to bodies.xmf.
+ * Returns 0, or -1 on an HDF5/file error (message on stderr). */
+int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, const lahar_body_state *s);
+/* Offer one row of the force stream (r has c->nbody entries). Call it every step: rows are kept
+ * every step when c->forces_interval is 0, otherwise the first row at or after every multiple
+ * of forces_interval. Rows are buffered and flushed at least every 0.5 s of wall time and when
+ * the buffer is full. Returns 0, or -1 on error. */
+int lahar_body_output_forces(lahar_body_output *o, int64_t step, double t, const lahar_body_report *r);
+/* Flush and close everything (NULL is fine). Also refreshes OUT/lahar.xmf. */
+void lahar_body_output_close(lahar_body_output *o);
+
+/* Particle fields a writer stores besides the position (always stored). */
+enum {
+    LAHAR_PFIELD_VELOCITY = 1 << 0, /* vx, vy, vz */
+    LAHAR_PFIELD_DENSITY = 1 << 1,
+    LAHAR_PFIELD_PRESSURE = 1 << 2,
+    LAHAR_PFIELD_PHASE = 1 << 3,    /* int32 */
+    LAHAR_PFIELD_ID = 1 << 4,       /* int64 */
+    LAHAR_PFIELD_ALL = 0x1f
+};
+
+/* One snapshot of particles as structure-of-arrays. Arrays for fields not selected at open may
+ * be NULL; z may be NULL in 2D (written as zeros). */
+typedef struct {
+    int64_t n;
+    const double *x, *y, *z;
+    const double *vx, *vy, *vz;
+    const double *density, *pressure;
+    const int32_t *phase;
+    const int64_t *id;
+} lahar_particles_view;
+
+typedef struct lahar_particle_output lahar_particle_output;
+
+/* Create OUT/particles.h5 and OUT/particles.xmf; `fields` is a mask of LAHAR_PFIELD_*. */
+lahar_particle_output *lahar_particle_output_open(const char *outdir, const lahar_case *c, unsigned fields,
+                                                  char *err, size_t n);
+int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p);
+void lahar_particle_output_close(lahar_particle_output *o);
+
+/* Write OUT/lahar.xmf: one temporal collection whose time steps hold the body grids and the
+ * particle grid of the snapshots found in OUT/bodies.h5 and OUT/particles.h5 (either may be
+ * missing). Safe to call when no writer has the files open, e.g. by the coordinator at the end
+ * of a run; the writers also call it from their close. Returns 0, or -1 with a message. */
+int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n);
+
+/* Display mesh of a sphero-polyhedron for viewers (not used by the physics): a closed surface of
+ * triangles in 3D (spheres: icospheres; polyhedra: core faces offset by the sweep radius plus
+ * flat bevels along edges and fans at corners; rods: spheres + tubes), line segments in the
+ * x-y plane in 2D (convex bodies: the rounded outline; segments/polylines: thin quads).
+ * Coordinates in the shape's own frame; `convex` is the body's flag (2D outline choice). Built
+ * once at setup. */
+typedef struct {
+    int nvert;
+    double (*v)[3];
+    int ncell;
+    int nodes_per_cell; /* 3 (triangles, 3D) or 2 (line segments, 2D) */
+    int32_t *cell;      /* ncell * nodes_per_cell vertex indices */
+} lahar_display_mesh;
+
+int lahar_display_mesh_build(const lahar_shape *s, int dim, int convex, lahar_display_mesh *m);
+void lahar_display_mesh_free(lahar_display_mesh *m);
+
+#endif
