@@ -515,7 +515,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
         return NULL;
     }
     snprintf(path, sizeof path, "%s/forces.h5", outdir);
-    if (forces_open(&o->fs, path, c, err, n)) {
+    if (c->output_forces && forces_open(&o->fs, path, c, err, n)) {
         lahar_body_output_close(o);
         return NULL;
     }
@@ -593,7 +593,7 @@ int lahar_body_output_forces(lahar_body_output *o, int64_t step, double t, const
 {
     forces_stream *fs = &o->fs;
     if (fs->file < 0)
-        return -1;
+        return 0; /* the case turned the force stream off (output: forces) */
     if (fs->interval > 0.0) {
         /* record the first row at or after each multiple of the interval (slot counted in
          * integers, relative tolerance for times that are multiples up to rounding) */

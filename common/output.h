@@ -17,8 +17,8 @@
 
 typedef struct lahar_body_output lahar_body_output;
 
-/* Create OUT/bodies.h5 (header + geometry), OUT/bodies.xmf and OUT/forces.h5 for the bodies of
- * case c (outdir must exist). Returns NULL and a message in err on failure. */
+/* Create OUT/bodies.h5 (header + geometry), OUT/bodies.xmf and, when c->output_forces is set,
+ * OUT/forces.h5 for the bodies of case c (outdir must exist). Returns NULL and a message in err on failure. */
 lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *c, char *err, size_t n);
 /* Append snapshot (s has c->nbody entries) as /snapshots/NNNNNN and add it to bodies.xmf.
  * Returns 0, or -1 on an HDF5/file error (message on stderr). */
@@ -54,7 +54,8 @@ typedef struct {
 
 typedef struct lahar_particle_output lahar_particle_output;
 
-/* Create OUT/particles.h5 and OUT/particles.xmf; `fields` is a mask of LAHAR_PFIELD_*. */
+/* Create OUT/particles.h5 and OUT/particles.xmf; `fields` is a mask of LAHAR_PFIELD_* (pass
+ * c->output_fields, which the case loader fills from output: fields). */
 lahar_particle_output *lahar_particle_output_open(const char *outdir, const lahar_case *c, unsigned fields,
                                                   char *err, size_t n);
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p);

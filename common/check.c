@@ -1,0 +1,633 @@
+/* `lahar check` evaluation (see check.h): load the run's output, run the reference's evaluator,
+ * compare its values with the case's bounds, write OUT/check.json (cJSON) and the plot. */
+#include "check.h"
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <hdf5.h>
+#include <inttypes.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "geometry.h"
+#include "vec.h"
+
+extern char **environ;
+
+/* ---------------------------------------------------------------- loading --------------- */
+
+static int check_read(hid_t loc, const char *name, hid_t type, void *buf)
+{
+    hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT);
+    if (ds < 0)
+        return -1;
+    herr_t rc = H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    H5Dclose(ds);
+    return rc < 0 ? -1 : 0;
+}
+
+static int check_read_attr(hid_t loc, const char *name, hid_t type, void *buf)
+{
+    if (H5Aexists(loc, name) <= 0)
+        return -1;
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    herr_t rc = H5Aread(a, type, buf);
+    H5Aclose(a);
+    return rc < 0 ? -1 : 0;
+}
+
+static int check_load_forces(const char *outdir, lahar_check_data *d)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/forces.h5", outdir);
+    if (access(path, R_OK) != 0)
+        return 0;
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    int rc = -1;
+    hid_t ds = H5Dopen2(f, "t", H5P_DEFAULT);
+    if (ds >= 0) {
+        hid_t sp = H5Dget_space(ds);
+        hsize_t n = 0;
+        H5Sget_simple_extent_dims(sp, &n, NULL);
+        H5Sclose(sp);
+        H5Dclose(ds);
+        d->nrow = (int64_t)n;
+        d->ft = malloc((n ? n : 1) * sizeof *d->ft);
+        d->ncontacts = malloc((n ? n : 1) * (size_t)(d->nbody ? d->nbody : 1) * sizeof *d->ncontacts);
+        if (d->ft && d->ncontacts && (n == 0 || (!check_read(f, "t", H5T_NATIVE_DOUBLE, d->ft) &&
+                                                 (d->nbody == 0 || !check_read(f, "ncontacts", H5T_NATIVE_INT32,
+                                                                               d->ncontacts)))))
+            rc = 0;
+    }
+    H5Fclose(f);
+    return rc;
+}
+
+int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, size_t n)
+{
+    memset(d, 0, sizeof *d);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/bodies.h5", outdir);
+    if (access(path, R_OK) != 0) {
+        snprintf(err, n, "%s: missing (%s); did the run write output?", path, strerror(errno));
+        return -1;
+    }
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_file_locking(fapl, 0, 1);
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
+    if (f < 0) {
+        snprintf(err, n, "%s: not a readable HDF5 file", path);
+        return -1;
+    }
+    int64_t nbody = 0;
+    hid_t h = H5Gopen2(f, "header", H5P_DEFAULT);
+    hid_t g = H5Gopen2(f, "snapshots", H5P_DEFAULT);
+    H5G_info_t info = {0};
+    if (h < 0 || g < 0 || check_read_attr(h, "nbody", H5T_NATIVE_INT64, &nbody) || H5Gget_info(g, &info) < 0) {
+        snprintf(err, n, "%s: no /header or /snapshots (not written by lahar?)", path);
+        if (h >= 0)
+            H5Gclose(h);
+        if (g >= 0)
+            H5Gclose(g);
+        H5Fclose(f);
+        return -1;
+    }
+    H5Gclose(h);
+    d->nbody = (int)nbody;
+    size_t ns = info.nlinks ? info.nlinks : 1, nb3 = (size_t)(nbody ? nbody : 1) * 3;
+    d->t = malloc(ns * sizeof *d->t);
+    d->step = malloc(ns * sizeof *d->step);
+    d->x = malloc(ns * nb3 * sizeof *d->x);
+    d->v = malloc(ns * nb3 * sizeof *d->v);
+    d->w = malloc(ns * nb3 * sizeof *d->w);
+    int rc = (d->t && d->step && d->x && d->v && d->w) ? 0 : -1;
+    for (hsize_t k = 0; rc == 0 && k < info.nlinks; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "%06" PRId64, (int64_t)k);
+        if (H5Lexists(g, name, H5P_DEFAULT) <= 0)
+            break;
+        hid_t s = H5Gopen2(g, name, H5P_DEFAULT);
+        if (s < 0 || check_read_attr(s, "time", H5T_NATIVE_DOUBLE, &d->t[k]) ||
+            check_read_attr(s, "step", H5T_NATIVE_INT64, &d->step[k]) ||
+            (nbody > 0 && (check_read(s, "position", H5T_NATIVE_DOUBLE, d->x + k * nb3) ||
+                           check_read(s, "velocity", H5T_NATIVE_DOUBLE, d->v + k * nb3) ||
+                           check_read(s, "angular_velocity", H5T_NATIVE_DOUBLE, d->w + k * nb3))))
+            rc = -1;
+        if (s >= 0)
+            H5Gclose(s);
+        if (rc == 0)
+            d->nsnap = (int64_t)k + 1;
+    }
+    H5Gclose(g);
+    H5Fclose(f);
+    if (rc) {
+        snprintf(err, n, "%s: cannot read snapshot %" PRId64, path, d->nsnap);
+        lahar_check_data_free(d);
+        return -1;
+    }
+    if (check_load_forces(outdir, d)) {
+        snprintf(err, n, "%s/forces.h5: unreadable", outdir);
+        lahar_check_data_free(d);
+        return -1;
+    }
+    return 0;
+}
+
+void lahar_check_data_free(lahar_check_data *d)
+{
+    free(d->t), free(d->step), free(d->x), free(d->v), free(d->w), free(d->ft), free(d->ncontacts);
+    memset(d, 0, sizeof *d);
+}
+
+/* ---------------------------------------------------------------- evaluator helpers ----- */
+
+static void check_value(lahar_check_result *r, const char *name, double v)
+{
+    if (r->nvalue >= LAHAR_CHECK_MAX_VALUES)
+        return;
+    snprintf(r->value[r->nvalue].name, sizeof r->value[0].name, "%s", name);
+    r->value[r->nvalue].value = v;
+    r->nvalue++;
+}
+
+static vec3 check_vec(const lahar_check_data *d, const double *a, int64_t k, int b)
+{
+    return v3_load(a + ((size_t)k * (size_t)d->nbody + (size_t)b) * 3);
+}
+
+static int check_first_free_body(const lahar_case *c)
+{
+    for (int b = 0; b < c->nbody; b++)
+        if (c->bodies[b].motion == LAHAR_MOTION_FREE)
+            return b;
+    return -1;
+}
+
+static double check_material(const lahar_case *c, int body, size_t off)
+{
+    int m = c->bodies[body].material;
+    if (m < 0 || m >= c->nmaterial)
+        return NAN;
+    double v;
+    memcpy(&v, (const char *)&c->materials[m] + off, sizeof v);
+    return v;
+}
+
+/* Fixed bodies that ever touched something according to the force stream (all fixed bodies
+ * when there is no force stream). */
+static int check_fixed_touched(const lahar_case *c, const lahar_check_data *d, int j)
+{
+    if (c->bodies[j].motion != LAHAR_MOTION_FIXED)
+        return 0;
+    if (d->nrow == 0)
+        return 1;
+    for (int64_t k = 0; k < d->nrow; k++)
+        if (d->ncontacts[k * d->nbody + j] > 0)
+            return 1;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- restitution ----------- */
+
+/* A sphere dropped on a fixed floor (reference 06 §6.2/6.3/6.7). Between contacts the body is
+ * in free flight, so each snapshot fixes a parabola h(t) = h_k + u_k (t - t_k) - g (t - t_k)^2/2
+ * along -g. The impact instant of a bounce is where the parabola of the last snapshot before it
+ * meets the one of the first snapshot after it (their difference is linear in t; contact time
+ * neglected, an error of order g t_c / v); the speeds of both parabolas there give
+ * e = rebound / impact, independent of where the floor is and of the snapshot interval. */
+static int check_restitution(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    int b = check_first_free_body(c);
+    vec3 gv = v3_load(c->gravity);
+    double g = v3_norm(gv);
+    if (b < 0 || g <= 0.0 || d->nsnap < 3) {
+        snprintf(r->err, sizeof r->err, "restitution: needs a free body, gravity and >= 3 snapshots (have %" PRId64 ")",
+                 d->nsnap);
+        return -1;
+    }
+    vec3 gh = v3_scale(gv, 1.0 / g);
+    double e_ref = check_material(c, b, offsetof(lahar_material, restitution));
+    for (int j = 0; j < c->nbody; j++)
+        if (check_fixed_touched(c, d, j))
+            e_ref = fmin(e_ref, check_material(c, j, offsetof(lahar_material, restitution)));
+#define H(k) (-v3_dot(check_vec(d, d->x, (k), b), gh))
+#define U(k) (-v3_dot(check_vec(d, d->v, (k), b), gh))
+    /* u_k follows u_{k-1} - g dt in free flight (exact for leap-frog under constant gravity) */
+#define FREE(k0, k1) (fabs(U(k1) - (U(k0) - g * (d->t[k1] - d->t[k0]))) <= 1e-6 * (fabs(U(k0)) + g * (d->t[k1] - d->t[k0])) + 1e-12)
+    int nb = 0;
+    double e_first = NAN, err_max = 0.0, u_imp_first = 0.0, u_reb_first = 0.0, t_first = 0.0, h_contact = 0.0;
+    int64_t p_first = 0;
+    for (int64_t k = 0; k + 1 < d->nsnap; k++) {
+        if (!(U(k) < 0.0 && U(k + 1) > 0.0))
+            continue;
+        int64_t p = k, q = k + 1;
+        while (p >= 1 && !FREE(p - 1, p))
+            p--;
+        while (q + 1 < d->nsnap && !FREE(q, q + 1) && U(q + 1) > 0.0)
+            q++;
+        double tp = d->t[p], tq = d->t[q], up = U(p), uq = U(q), hp = H(p), hq = H(q);
+        double beta = up - uq - g * (tq - tp);
+        double alpha = hp - hq - up * tp + uq * tq + 0.5 * g * (tq - tp) * (tp + tq);
+        if (beta == 0.0)
+            continue;
+        double ti = -alpha / beta;
+        if (!(ti >= tp && ti <= tq))
+            continue;
+        double u_imp = -(up - g * (ti - tp)), u_reb = uq - g * (ti - tq);
+        if (u_imp <= 0.0 || u_reb <= 0.0)
+            continue;
+        double e = u_reb / u_imp, hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp);
+        if (nb == 0) {
+            e_first = e, u_imp_first = u_imp, u_reb_first = u_reb, t_first = ti, h_contact = hi, p_first = p;
+        }
+        /* later bounces count only while the flight after them spans >= 3 snapshots, so that no
+         * second bounce hides between two snapshots */
+        double dt_out = d->t[q] - d->t[q - 1];
+        if (nb == 0 || 2.0 * u_reb / g >= 3.0 * dt_out)
+            err_max = fmax(err_max, fabs(e - e_ref) / e_ref);
+        nb++;
+    }
+    if (nb == 0) {
+        snprintf(r->err, sizeof r->err,
+                 "restitution: no bounce of body %s found in %" PRId64 " snapshots (does it reach the floor before "
+                 "t_end?)",
+                 c->bodies[b].name, d->nsnap);
+        return -1;
+    }
+    check_value(r, "restitution_rel_error", fabs(e_first - e_ref) / e_ref);
+    check_value(r, "restitution_rel_error_max", err_max);
+    check_value(r, "e_measured", e_first);
+    check_value(r, "e_reference", e_ref);
+    check_value(r, "impact_speed", u_imp_first);
+    check_value(r, "rebound_speed", u_reb_first);
+    check_value(r, "impact_time", t_first);
+    check_value(r, "bounces", nb);
+    snprintf(r->note, sizeof r->note, "body %s; e_ref = min restitution of the body and the fixed bodies it touched",
+             c->bodies[b].name);
+    snprintf(r->title, sizeof r->title, "restitution: %s, e = %.4f (reference %.4f)", c->bodies[b].name, e_first, e_ref);
+    snprintf(r->xlabel, sizeof r->xlabel, "t [s]");
+    snprintf(r->ylabel, sizeof r->ylabel, "height along -g [m]");
+    /* reference: the measured pre-impact flight, then bounces at the impact height with e_ref */
+    double t0 = t_first, u0 = e_ref * u_imp_first;
+    double hp = H(p_first), up = U(p_first), tp = d->t[p_first];
+    for (int64_t k = 0; k < d->nsnap && r->nseries < LAHAR_CHECK_MAX_SERIES; k++) {
+        double t = d->t[k], href;
+        if (t <= t_first) {
+            href = hp + up * (t - tp) - 0.5 * g * (t - tp) * (t - tp);
+        } else {
+            while (u0 > 1e-9 && t > t0 + 2.0 * u0 / g) {
+                t0 += 2.0 * u0 / g;
+                u0 *= e_ref;
+            }
+            href = u0 > 1e-9 ? h_contact + u0 * (t - t0) - 0.5 * g * (t - t0) * (t - t0) : h_contact;
+        }
+        r->series_t[r->nseries] = t;
+        r->series_measured[r->nseries] = H(k);
+        r->series_reference[r->nseries] = href;
+        r->nseries++;
+    }
+#undef H
+#undef U
+#undef FREE
+    return 0;
+}
+
+/* ---------------------------------------------------------------- incline roll ---------- */
+
+/* Least-squares s = c0 + c1 tau + c2 tau^2 (normal equations, 3x3, Gaussian elimination). */
+static int check_fit_quadratic(const double *tau, const double *s, int n, double c[3])
+{
+    double A[3][4] = {{0}};
+    for (int i = 0; i < n; i++) {
+        double p[3] = {1.0, tau[i], tau[i] * tau[i]};
+        for (int r = 0; r < 3; r++) {
+            for (int k = 0; k < 3; k++)
+                A[r][k] += p[r] * p[k];
+            A[r][3] += p[r] * s[i];
+        }
+    }
+    for (int col = 0; col < 3; col++) {
+        int piv = col;
+        for (int r = col + 1; r < 3; r++)
+            if (fabs(A[r][col]) > fabs(A[piv][col]))
+                piv = r;
+        if (A[piv][col] == 0.0)
+            return -1;
+        for (int k = 0; k < 4; k++) {
+            double tmp = A[col][k];
+            A[col][k] = A[piv][k];
+            A[piv][k] = tmp;
+        }
+        for (int r = 0; r < 3; r++) {
+            if (r == col)
+                continue;
+            double f = A[r][col] / A[col][col];
+            for (int k = col; k < 4; k++)
+                A[r][k] -= f * A[col][k];
+        }
+    }
+    for (int r = 0; r < 3; r++)
+        c[r] = A[r][3] / A[r][r];
+    return 0;
+}
+
+/* Gap between the swept surfaces of the free body (a sphere/disc of radius R) at x and fixed
+ * body j; *normal is the outward normal of j at the closest point. */
+static double check_gap(const lahar_case *c, int j, vec3 x, double R, vec3 *normal)
+{
+    const lahar_body *f = &c->bodies[j];
+    vec3 cp;
+    int feature;
+    double dist = geom_point_body_core(&f->shape, f->x, f->q, x, &cp, &feature);
+    if (normal)
+        *normal = v3_normalize(v3_sub(x, cp));
+    return dist - f->shape.radius - R;
+}
+
+/* A sphere or disc on a fixed incline (reference 06 §6.4): acceleration along the slope is
+ * g sin(theta) / (1 + k), k = I/(m R^2) (sphere 5/7, disc 2/3), when it rolls, i.e. when
+ * mu >= k/(1+k) tan(theta); otherwise g (sin(theta) - mu cos(theta)). theta comes from the
+ * incline's geometry (normal at the closest point, geometry.h), the measured acceleration from a
+ * quadratic fit of the distance travelled along the slope while in contact. */
+static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    int b = check_first_free_body(c);
+    vec3 gv = v3_load(c->gravity);
+    double g = v3_norm(gv);
+    if (b < 0 || g <= 0.0 || d->nsnap < 5) {
+        snprintf(r->err, sizeof r->err, "incline_roll: needs a free body, gravity and >= 5 snapshots (have %" PRId64 ")",
+                 d->nsnap);
+        return -1;
+    }
+    const lahar_body *ball = &c->bodies[b];
+    double R = ball->shape.radius, m = ball->mass, I = c->dim == 2 ? ball->inertia[2] : ball->inertia[0];
+    if (ball->shape.nv != 1 || R <= 0.0 || m <= 0.0) {
+        snprintf(r->err, sizeof r->err, "incline_roll: body %s must be a sphere or disc (one vertex, radius > 0)",
+                 ball->name);
+        return -1;
+    }
+    vec3 gh = v3_scale(gv, 1.0 / g);
+    /* the incline: the fixed body closest to the ball at the first snapshot */
+    int inc = -1;
+    double best = INFINITY;
+    vec3 x0 = check_vec(d, d->x, 0, b), n;
+    for (int j = 0; j < c->nbody; j++) {
+        if (c->bodies[j].motion != LAHAR_MOTION_FIXED)
+            continue;
+        double gap = check_gap(c, j, x0, R, NULL);
+        if (gap < best)
+            best = gap, inc = j;
+    }
+    if (inc < 0) {
+        snprintf(r->err, sizeof r->err, "incline_roll: no fixed body (the incline) in the case");
+        return -1;
+    }
+    /* contact snapshots: from the first one touching the incline, while touching */
+    double tol = 0.02 * R;
+    int64_t i0 = -1, i1 = -1;
+    for (int64_t k = 0; k < d->nsnap; k++) {
+        int touching = check_gap(c, inc, check_vec(d, d->x, k, b), R, NULL) <= tol;
+        if (touching && i0 < 0)
+            i0 = k;
+        if (i0 >= 0) {
+            if (!touching)
+                break;
+            i1 = k;
+        }
+    }
+    if (i0 < 0) {
+        snprintf(r->err, sizeof r->err, "incline_roll: body %s never touches %s", ball->name, c->bodies[inc].name);
+        return -1;
+    }
+    check_gap(c, inc, check_vec(d, d->x, i0, b), R, &n);
+    double cos_t = fmin(1.0, fmax(-1.0, -v3_dot(n, gh))), sin_t = sqrt(fmax(0.0, 1.0 - cos_t * cos_t));
+    vec3 down = v3_normalize(v3_sub(gh, v3_scale(n, v3_dot(gh, n))));
+    double k_i = I / (m * R * R);
+    double mu = fmin(check_material(c, b, offsetof(lahar_material, friction)),
+                     check_material(c, inc, offsetof(lahar_material, friction)));
+    int rolling = mu * cos_t >= k_i / (1.0 + k_i) * sin_t;
+    double a_ref = rolling ? g * sin_t / (1.0 + k_i) : g * (sin_t - mu * cos_t);
+    /* skip the start transient: the first tenth of the contact window, at least one snapshot */
+    int64_t start = i0 + ((i1 - i0 + 1) / 10 > 1 ? (i1 - i0 + 1) / 10 : 1);
+    int np = (int)(i1 - start + 1);
+    if (np < 4) {
+        snprintf(r->err, sizeof r->err,
+                 "incline_roll: only %d snapshots in contact after the start; lower time.output_interval", np);
+        return -1;
+    }
+    double *tau = malloc((size_t)np * sizeof *tau), *s = malloc((size_t)np * sizeof *s), cf[3];
+    if (!tau || !s) {
+        free(tau), free(s);
+        snprintf(r->err, sizeof r->err, "out of memory");
+        return -1;
+    }
+    vec3 xs = check_vec(d, d->x, start, b);
+    for (int i = 0; i < np; i++) {
+        tau[i] = d->t[start + i] - d->t[start];
+        s[i] = v3_dot(v3_sub(check_vec(d, d->x, start + i, b), xs), down);
+    }
+    int fit = check_fit_quadratic(tau, s, np, cf);
+    if (fit) {
+        free(tau), free(s);
+        snprintf(r->err, sizeof r->err, "incline_roll: degenerate fit");
+        return -1;
+    }
+    double a = 2.0 * cf[2];
+    check_value(r, "accel_rel_error", fabs(a - a_ref) / a_ref);
+    check_value(r, "accel_measured", a);
+    check_value(r, "accel_reference", a_ref);
+    check_value(r, "theta_deg", atan2(sin_t, cos_t) * 180.0 / M_PI);
+    check_value(r, "mu", mu);
+    check_value(r, "inertia_ratio", k_i);
+    check_value(r, "rolling", rolling);
+    check_value(r, "fit_points", np);
+    snprintf(r->note, sizeof r->note, "body %s on %s: %s (mu %s k/(1+k) tan(theta))", ball->name, c->bodies[inc].name,
+             rolling ? "rolling without slip" : "sliding", rolling ? ">=" : "<");
+    snprintf(r->title, sizeof r->title, "incline: %s %s, a = %.5g (reference %.5g) m/s^2", ball->name,
+             rolling ? "rolling" : "sliding", a, a_ref);
+    snprintf(r->xlabel, sizeof r->xlabel, "t [s]");
+    snprintf(r->ylabel, sizeof r->ylabel, "distance down the slope [m]");
+    for (int i = 0; i < np && r->nseries < LAHAR_CHECK_MAX_SERIES; i++) {
+        r->series_t[r->nseries] = d->t[start + i];
+        r->series_measured[r->nseries] = s[i];
+        r->series_reference[r->nseries] = cf[0] + cf[1] * tau[i] + 0.5 * a_ref * tau[i] * tau[i];
+        r->nseries++;
+    }
+    free(tau), free(s);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- table + driver -------- */
+
+static const lahar_check_reference check_references[] = {
+    {"restitution", "sphere dropped on a fixed floor: rebound/impact speed vs the material's e",
+     "restitution_rel_error", 0.01, check_restitution},
+    {"incline_roll", "sphere/disc on a fixed incline: fitted acceleration vs rolling or sliding theory",
+     "accel_rel_error", 0.01, check_incline_roll},
+};
+#define CHECK_NREF (sizeof check_references / sizeof check_references[0])
+
+const lahar_check_reference *lahar_check_find(const char *name)
+{
+    for (size_t k = 0; k < CHECK_NREF; k++)
+        if (strcmp(check_references[k].name, name) == 0)
+            return &check_references[k];
+    return NULL;
+}
+
+const char *lahar_check_names(void) { return "restitution, incline_roll"; }
+
+static int check_write_json(const char *path, cJSON *root)
+{
+    char *text = cJSON_Print(root);
+    if (!text)
+        return -1;
+    FILE *f = fopen(path, "w");
+    int rc = -1;
+    if (f) {
+        rc = fputs(text, f) < 0 ? -1 : 0;
+        fputc('\n', f);
+        if (fclose(f))
+            rc = -1;
+    }
+    cJSON_free(text);
+    return rc;
+}
+
+static int check_fail(const char *outdir, const char *reference, const char *msg)
+{
+    fprintf(stderr, "lahar check: %s\n", msg);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/check.json", outdir);
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddBoolToObject(root, "pass", 0);
+    cJSON_AddStringToObject(root, "reference", reference);
+    cJSON_AddStringToObject(root, "error", msg);
+    cJSON_AddObjectToObject(root, "metrics");
+    struct stat st;
+    if (stat(outdir, &st) == 0 && S_ISDIR(st.st_mode))
+        check_write_json(path, root);
+    cJSON_Delete(root);
+    return 2;
+}
+
+/* python3 tools/plot_check.py OUT; a missing python3/matplotlib only costs the plot. */
+static void check_plot(const char *outdir)
+{
+    const char *py = getenv("LAHAR_PYTHON");
+    if (!py || !*py)
+        py = "python3";
+    char script[1200];
+    snprintf(script, sizeof script, "%s/plot_check.py", LAHAR_TOOLS_DIR);
+    char *argv[] = {(char *)py, script, (char *)outdir, NULL};
+    pid_t pid;
+    int status = 0;
+    if (posix_spawnp(&pid, py, NULL, NULL, argv, environ) != 0) {
+        fprintf(stderr, "lahar check: no plot: cannot run %s (install python3, python3-matplotlib, python3-h5py); "
+                        "check.json is written\n",
+                py);
+        return;
+    }
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fprintf(stderr, "lahar check: no plot (%s %s failed, see above); check.json is written\n", py, script);
+}
+
+int lahar_check_evaluate(const lahar_case *c, const char *outdir)
+{
+    char msg[2048];
+    if (!c->check.enabled)
+        return check_fail(outdir, "", "the case has no check: section (add check: {reference: ..., metrics: ...})");
+    const lahar_check_reference *ref = lahar_check_find(c->check.reference);
+    if (!ref) {
+        snprintf(msg, sizeof msg, "%s: check.reference '%s' is unknown; known references: %s", c->path,
+                 c->check.reference, lahar_check_names());
+        return check_fail(outdir, c->check.reference, msg);
+    }
+    lahar_check_data d;
+    if (lahar_check_data_load(outdir, &d, msg, sizeof msg))
+        return check_fail(outdir, ref->name, msg);
+    lahar_check_result *r = calloc(1, sizeof *r);
+    double *series = malloc(3 * LAHAR_CHECK_MAX_SERIES * sizeof *series);
+    if (!r || !series) {
+        free(r), free(series);
+        lahar_check_data_free(&d);
+        return check_fail(outdir, ref->name, "out of memory");
+    }
+    r->series_t = series, r->series_measured = series + LAHAR_CHECK_MAX_SERIES;
+    r->series_reference = series + 2 * LAHAR_CHECK_MAX_SERIES;
+    int rc = ref->evaluate(c, &d, r);
+    lahar_check_data_free(&d);
+    if (rc) {
+        snprintf(msg, sizeof msg, "%s", r->err);
+        free(r), free(series);
+        return check_fail(outdir, ref->name, msg);
+    }
+    /* the case's metrics (or the reference's default) against the computed values */
+    int nmetric = c->check.nmetric > 0 ? c->check.nmetric : 1;
+    cJSON *root = cJSON_CreateObject(), *metrics = cJSON_CreateObject(), *info = cJSON_CreateObject();
+    int all_pass = 1, used[LAHAR_CHECK_MAX_VALUES] = {0};
+    for (int k = 0; k < nmetric; k++) {
+        const char *name = c->check.nmetric > 0 ? c->check.metric[k].name : ref->default_metric;
+        double bound = c->check.nmetric > 0 ? c->check.metric[k].bound : ref->default_bound;
+        int found = -1;
+        for (int i = 0; i < r->nvalue; i++)
+            if (strcmp(r->value[i].name, name) == 0)
+                found = i;
+        if (found < 0) {
+            size_t pos = (size_t)snprintf(msg, sizeof msg, "%s: check.metrics.%s is not a metric of reference %s; it has:",
+                                          c->path, name, ref->name);
+            for (int i = 0; i < r->nvalue && pos < sizeof msg; i++)
+                pos += (size_t)snprintf(msg + pos, sizeof msg - pos, " %s", r->value[i].name);
+            cJSON_Delete(root), cJSON_Delete(metrics), cJSON_Delete(info);
+            free(r), free(series);
+            return check_fail(outdir, ref->name, msg);
+        }
+        used[found] = 1;
+        double v = r->value[found].value;
+        int pass = v <= bound; /* NaN fails */
+        all_pass &= pass;
+        cJSON *m = cJSON_AddObjectToObject(metrics, name);
+        cJSON_AddNumberToObject(m, "value", v);
+        cJSON_AddNumberToObject(m, "bound", bound);
+        cJSON_AddBoolToObject(m, "pass", pass);
+        printf("lahar check %s: %s = %.6g (bound %.6g) %s\n", ref->name, name, v, bound, pass ? "pass" : "FAIL");
+    }
+    for (int i = 0; i < r->nvalue; i++)
+        if (!used[i])
+            cJSON_AddNumberToObject(info, r->value[i].name, r->value[i].value);
+    cJSON_AddStringToObject(info, "note", r->note);
+    cJSON_AddBoolToObject(root, "pass", all_pass);
+    cJSON_AddStringToObject(root, "reference", ref->name);
+    cJSON_AddStringToObject(root, "case", c->path);
+    cJSON_AddItemToObject(root, "metrics", metrics);
+    cJSON_AddItemToObject(root, "info", info);
+    cJSON *plot = cJSON_AddObjectToObject(root, "plot");
+    cJSON_AddStringToObject(plot, "title", r->title);
+    cJSON_AddStringToObject(plot, "xlabel", r->xlabel);
+    cJSON_AddStringToObject(plot, "ylabel", r->ylabel);
+    cJSON_AddItemToObject(plot, "t", cJSON_CreateDoubleArray(r->series_t, r->nseries));
+    cJSON_AddItemToObject(plot, "measured", cJSON_CreateDoubleArray(r->series_measured, r->nseries));
+    cJSON_AddItemToObject(plot, "reference", cJSON_CreateDoubleArray(r->series_reference, r->nseries));
+    char path[1200];
+    snprintf(path, sizeof path, "%s/check.json", outdir);
+    int wrc = check_write_json(path, root);
+    cJSON_Delete(root);
+    free(r), free(series);
+    if (wrc) {
+        fprintf(stderr, "lahar check: %s: cannot write\n", path);
+        return 2;
+    }
+    printf("lahar check %s: %s; details in %s\n", ref->name, all_pass ? "PASS" : "FAIL", path);
+    fflush(stdout);
+    check_plot(outdir);
+    return all_pass ? 0 : 1;
+}

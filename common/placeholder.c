@@ -1,1 +1,0 @@
-/* placeholder */ typedef int lahar_placeholder_common;
