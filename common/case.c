@@ -1,0 +1,1355 @@
+/* Case file loader (see case.h; every key is documented in cases/dem_drop_3d.yaml).
+ *
+ * libyaml builds the document (yaml_parser_load: aliases resolve to shared nodes, every node
+ * carries its line); a small typed-accessor layer below reads numbers, vectors, strings and
+ * enums with defaults and reports the first problem as `file:line: key.path: what; what to do`. */
+#include "case.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+#include "geometry.h"
+#include "vec.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define KEY_MAX 192
+
+/* --- reader: the document, the first error, and the typed accessors ------------------------- */
+
+typedef struct {
+    const char *path;
+    char dir[1024]; /* directory of the case file: relative STL paths start here */
+    yaml_document_t *doc;
+    int failed;
+    char *err;
+    size_t errlen;
+    int dim;
+} reader;
+
+static void rd_fail(reader *r, const yaml_node_t *n, const char *key, const char *fmt, ...)
+{
+    if (r->failed)
+        return;
+    r->failed = 1;
+    int line = n ? (int)n->start_mark.line + 1 : 1;
+    int k = snprintf(r->err, r->errlen, "%s:%d: %s%s", r->path, line, key ? key : "", key && *key ? ": " : "");
+    if (k < 0 || (size_t)k >= r->errlen)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->err + k, r->errlen - (size_t)k, fmt, ap);
+    va_end(ap);
+}
+
+static yaml_node_t *rd_node(reader *r, int id) { return yaml_document_get_node(r->doc, id); }
+
+static const char *node_kind(const yaml_node_t *n)
+{
+    switch (n->type) {
+    case YAML_SCALAR_NODE: return "a scalar";
+    case YAML_SEQUENCE_NODE: return "a list";
+    case YAML_MAPPING_NODE: return "a mapping";
+    default: return "nothing";
+    }
+}
+
+static const char *scalar(const yaml_node_t *n) { return (const char *)n->data.scalar.value; }
+
+static int seq_len(const yaml_node_t *n)
+{
+    return (int)(n->data.sequence.items.top - n->data.sequence.items.start);
+}
+
+static yaml_node_t *seq_item(reader *r, const yaml_node_t *n, int i)
+{
+    return rd_node(r, n->data.sequence.items.start[i]);
+}
+
+/* Edit distance for "did you mean" (keys are short). */
+static int edit_distance(const char *a, const char *b)
+{
+    int la = (int)strlen(a), lb = (int)strlen(b);
+    if (la > 63 || lb > 63)
+        return 99;
+    int d[64][64];
+    for (int i = 0; i <= la; i++)
+        d[i][0] = i;
+    for (int j = 0; j <= lb; j++)
+        d[0][j] = j;
+    for (int i = 1; i <= la; i++)
+        for (int j = 1; j <= lb; j++) {
+            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < c)
+                c = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < c)
+                c = d[i][j - 1] + 1;
+            d[i][j] = c;
+        }
+    return d[la][lb];
+}
+
+/* Closest of names[] (NULL-terminated) to s, or NULL when nothing is close. */
+static const char *closest_name(const char *s, const char *const *names)
+{
+    const char *best = NULL;
+    int bd = 1 << 30;
+    for (int i = 0; names[i]; i++) {
+        int d = edit_distance(s, names[i]);
+        if (d < bd) {
+            bd = d;
+            best = names[i];
+        }
+    }
+    int len = (int)strlen(s);
+    return bd <= (len > 6 ? 3 : 2) ? best : NULL;
+}
+
+static void join_names(const char *const *names, char *out, size_t n)
+{
+    size_t k = 0;
+    out[0] = '\0';
+    for (int i = 0; names[i] && k < n; i++) {
+        int w = snprintf(out + k, n - k, "%s%s", i ? ", " : "", names[i]);
+        if (w < 0)
+            break;
+        k += (size_t)w;
+    }
+}
+
+/* A mapping being read: its node and the key path prefix for messages ("bodies[3]"). */
+typedef struct {
+    reader *r;
+    yaml_node_t *node;
+    char prefix[KEY_MAX];
+} rmap;
+
+static void key_join(const char *prefix, const char *key, char out[KEY_MAX])
+{
+    if (prefix[0])
+        snprintf(out, KEY_MAX, "%.*s.%s", KEY_MAX / 2, prefix, key);
+    else
+        snprintf(out, KEY_MAX, "%s", key);
+}
+
+static int rmap_open(reader *r, yaml_node_t *n, const char *prefix, rmap *m)
+{
+    m->r = r;
+    m->node = n;
+    snprintf(m->prefix, sizeof m->prefix, "%s", prefix);
+    if (r->failed)
+        return -1;
+    if (!n || n->type != YAML_MAPPING_NODE) {
+        rd_fail(r, n, prefix, "expected a mapping of keys to values, got %s; write it as {key: value, ...} "
+                "or as indented key: value lines", n ? node_kind(n) : "nothing");
+        return -1;
+    }
+    return 0;
+}
+
+static yaml_node_t *rmap_get(const rmap *m, const char *key)
+{
+    if (m->r->failed || !m->node)
+        return NULL;
+    for (yaml_node_pair_t *p = m->node->data.mapping.pairs.start; p < m->node->data.mapping.pairs.top; p++) {
+        yaml_node_t *k = rd_node(m->r, p->key);
+        if (k && k->type == YAML_SCALAR_NODE && strcmp(scalar(k), key) == 0)
+            return rd_node(m->r, p->value);
+    }
+    return NULL;
+}
+
+/* Report the first key that is not in known[] (with a suggestion) or appears twice. */
+static void rmap_check_keys(rmap *m, const char *const *known)
+{
+    reader *r = m->r;
+    if (r->failed)
+        return;
+    for (yaml_node_pair_t *p = m->node->data.mapping.pairs.start; p < m->node->data.mapping.pairs.top; p++) {
+        yaml_node_t *k = rd_node(r, p->key);
+        char key[KEY_MAX];
+        if (!k || k->type != YAML_SCALAR_NODE) {
+            rd_fail(r, k, m->prefix, "a key must be a plain name, got %s", k ? node_kind(k) : "nothing");
+            return;
+        }
+        key_join(m->prefix, scalar(k), key);
+        int ok = 0;
+        for (int i = 0; known[i] && !ok; i++)
+            ok = strcmp(known[i], scalar(k)) == 0;
+        if (!ok) {
+            char list[512];
+            join_names(known, list, sizeof list);
+            const char *near = closest_name(scalar(k), known);
+            if (near)
+                rd_fail(r, k, key, "unknown key; did you mean '%s'? (known keys here: %s)", near, list);
+            else
+                rd_fail(r, k, key, "unknown key; known keys here: %s", list);
+            return;
+        }
+        for (yaml_node_pair_t *q = m->node->data.mapping.pairs.start; q < p; q++) {
+            yaml_node_t *k2 = rd_node(r, q->key);
+            if (k2 && k2->type == YAML_SCALAR_NODE && strcmp(scalar(k2), scalar(k)) == 0) {
+                rd_fail(r, k, key, "duplicate key (first given on line %d); keep only one",
+                        (int)k2->start_mark.line + 1);
+                return;
+            }
+        }
+    }
+}
+
+static void rmap_missing(rmap *m, const char *key, const char *example)
+{
+    char full[KEY_MAX];
+    key_join(m->prefix, key, full);
+    rd_fail(m->r, m->node, full, "missing required key; add e.g. `%s: %s`", key, example);
+}
+
+/* Fail on the value of `key` (or on the mapping when the key is absent). */
+static void rmap_fail(rmap *m, const char *key, const char *fmt, ...)
+{
+    if (m->r->failed)
+        return;
+    char full[KEY_MAX], msg[512];
+    key_join(m->prefix, key, full);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    yaml_node_t *n = rmap_get(m, key);
+    rd_fail(m->r, n ? n : m->node, full, "%s", msg);
+}
+
+static int node_number(reader *r, yaml_node_t *n, const char *key, double *out)
+{
+    if (r->failed)
+        return -1;
+    if (n->type != YAML_SCALAR_NODE) {
+        rd_fail(r, n, key, "expected a number, got %s", node_kind(n));
+        return -1;
+    }
+    const char *s = scalar(n);
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(s, &end);
+    while (end && (*end == ' ' || *end == '\t'))
+        end++;
+    if (end == s || !end || *end != '\0' || errno == ERANGE || !isfinite(v)) {
+        rd_fail(r, n, key, "expected a finite number, got '%s'", s);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+static double rmap_num(rmap *m, const char *key, int required, double def, const char *example)
+{
+    yaml_node_t *n = rmap_get(m, key);
+    if (!n) {
+        if (required && !m->r->failed)
+            rmap_missing(m, key, example);
+        return def;
+    }
+    char full[KEY_MAX];
+    key_join(m->prefix, key, full);
+    double v = def;
+    node_number(m->r, n, full, &v);
+    return v;
+}
+
+/* A list of exactly n numbers into out (left untouched when absent). Returns 1 if present. */
+static int node_vec(reader *r, yaml_node_t *n, const char *key, int count, double *out)
+{
+    if (r->failed)
+        return 0;
+    if (n->type != YAML_SEQUENCE_NODE || seq_len(n) != count) {
+        if (n->type == YAML_SEQUENCE_NODE)
+            rd_fail(r, n, key, "expected a list of %d numbers, got %d%s", count, seq_len(n),
+                    count == 2 ? " (2D cases give [x, y])" : (count == 3 ? " (3D cases give [x, y, z])" : ""));
+        else
+            rd_fail(r, n, key, "expected a list of %d numbers like [%s], got %s", count,
+                    count == 2 ? "x, y" : (count == 3 ? "x, y, z" : "a, b, ..."), node_kind(n));
+        return 0;
+    }
+    double tmp[16];
+    for (int i = 0; i < count && i < 16; i++) {
+        char ik[KEY_MAX];
+        snprintf(ik, sizeof ik, "%.*s[%d]", KEY_MAX - 16, key, i);
+        if (node_number(r, seq_item(r, n, i), ik, &tmp[i]) != 0)
+            return 0;
+    }
+    memcpy(out, tmp, (size_t)count * sizeof *out);
+    return 1;
+}
+
+static int rmap_vec(rmap *m, const char *key, int count, double *out, int required, const char *example)
+{
+    yaml_node_t *n = rmap_get(m, key);
+    if (!n) {
+        if (required && !m->r->failed)
+            rmap_missing(m, key, example);
+        return 0;
+    }
+    char full[KEY_MAX];
+    key_join(m->prefix, key, full);
+    return node_vec(m->r, n, full, count, out);
+}
+
+static const char *rmap_str(rmap *m, const char *key, int required, const char *def, const char *example)
+{
+    yaml_node_t *n = rmap_get(m, key);
+    if (!n) {
+        if (required && !m->r->failed)
+            rmap_missing(m, key, example);
+        return def;
+    }
+    if (n->type != YAML_SCALAR_NODE || scalar(n)[0] == '\0') {
+        rmap_fail(m, key, "expected a non-empty name/text, got %s", n->type == YAML_SCALAR_NODE ? "an empty value" : node_kind(n));
+        return def;
+    }
+    return scalar(n);
+}
+
+/* A name shorter than LAHAR_NAME_MAX. */
+static void rmap_name(rmap *m, const char *key, int required, const char *def, char out[LAHAR_NAME_MAX])
+{
+    const char *s = rmap_str(m, key, required, def, "name");
+    if (m->r->failed)
+        return;
+    if (strlen(s) >= LAHAR_NAME_MAX) {
+        rmap_fail(m, key, "name '%.20s...' is longer than %d characters; shorten it", s, LAHAR_NAME_MAX - 1);
+        return;
+    }
+    snprintf(out, LAHAR_NAME_MAX, "%s", s);
+}
+
+static int rmap_enum(rmap *m, const char *key, const char *const *names, int required, int def)
+{
+    const char *s = rmap_str(m, key, required, NULL, names[0]);
+    if (!s || m->r->failed)
+        return def;
+    for (int i = 0; names[i]; i++)
+        if (strcmp(s, names[i]) == 0)
+            return i;
+    char list[256];
+    join_names(names, list, sizeof list);
+    const char *near = closest_name(s, names);
+    if (near)
+        rmap_fail(m, key, "unknown value '%s'; did you mean '%s'? (one of: %s)", s, near, list);
+    else
+        rmap_fail(m, key, "unknown value '%s'; use one of: %s", s, list);
+    return def;
+}
+
+static int rmap_bool(rmap *m, const char *key, int def)
+{
+    static const char *const names[] = {"false", "true", "no", "yes", NULL};
+    int v = rmap_enum(m, key, names, 0, def ? 1 : 0);
+    return v == 1 || v == 3;
+}
+
+/* --- case sections ------------------------------------------------------------------------------- */
+
+static void read_time(reader *r, yaml_node_t *root, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"end", "dt_max", "dt_min", "output_interval", "forces_interval", NULL};
+    rmap m;
+    if (!n) {
+        rd_fail(r, root, "time",
+                "missing required section; add e.g. `time: {end: 1.0, dt_max: 1e-3}`");
+        return;
+    }
+    if (rmap_open(r, n, "time", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    c->t_end = rmap_num(&m, "end", 1, 0.0, "1.0");
+    c->dt_max = rmap_num(&m, "dt_max", 0, 1e-3, "1e-3");
+    c->dt_min = rmap_num(&m, "dt_min", 0, 1e-9, "1e-9");
+    c->output_interval = rmap_num(&m, "output_interval", 0, c->t_end / 100.0, "0.01");
+    c->forces_interval = rmap_num(&m, "forces_interval", 0, 0.0, "0");
+    if (r->failed)
+        return;
+    if (!(c->t_end > 0))
+        rmap_fail(&m, "end", "must be > 0 s (got %g); give the simulated duration in seconds", c->t_end);
+    else if (!(c->dt_max > 0))
+        rmap_fail(&m, "dt_max", "must be > 0 s (got %g); it bounds the coordinator step, e.g. 1e-3", c->dt_max);
+    else if (!(c->dt_min > 0) || c->dt_min > c->dt_max)
+        rmap_fail(&m, "dt_min", "must be > 0 and <= dt_max = %g (got %g); it is the step below which a run stops",
+                  c->dt_max, c->dt_min);
+    else if (!(c->output_interval > 0))
+        rmap_fail(&m, "output_interval", "must be > 0 s (got %g)", c->output_interval);
+    else if (c->output_interval > c->t_end)
+        rmap_fail(&m, "output_interval", "is larger than the end time (%g > %g s), so nothing after t = 0 would be "
+                  "written; make it <= end", c->output_interval, c->t_end);
+    else if (c->forces_interval < 0)
+        rmap_fail(&m, "forces_interval", "must be >= 0 s (got %g); 0 records every step", c->forces_interval);
+}
+
+static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"density", "model", "young", "poisson", "kn", "kt_ratio", "restitution",
+                                       "friction", NULL};
+    static const char *const models[] = {"linear", "hertz", NULL};
+    rmap top;
+    if (rmap_open(r, n, "materials", &top) != 0)
+        return;
+    int nm = (int)(n->data.mapping.pairs.top - n->data.mapping.pairs.start);
+    if (nm == 0) {
+        rd_fail(r, n, "materials", "no material defined; add e.g. `rock: {density: 2650, young: 1e8, "
+                "restitution: 0.5, friction: 0.5}`");
+        return;
+    }
+    c->materials = calloc((size_t)nm, sizeof *c->materials);
+    if (!c->materials) {
+        rd_fail(r, n, "materials", "out of memory");
+        return;
+    }
+    for (int i = 0; i < nm && !r->failed; i++) {
+        yaml_node_pair_t *p = n->data.mapping.pairs.start + i;
+        yaml_node_t *kn = rd_node(r, p->key);
+        lahar_material *mat = &c->materials[i];
+        if (kn->type != YAML_SCALAR_NODE) {
+            rd_fail(r, kn, "materials", "a material name must be a plain name");
+            return;
+        }
+        for (int j = 0; j < i; j++)
+            if (strcmp(c->materials[j].name, scalar(kn)) == 0) {
+                rd_fail(r, kn, "materials", "material '%s' is defined twice; keep one", scalar(kn));
+                return;
+            }
+        if (strlen(scalar(kn)) >= LAHAR_NAME_MAX) {
+            rd_fail(r, kn, "materials", "material name longer than %d characters", LAHAR_NAME_MAX - 1);
+            return;
+        }
+        snprintf(mat->name, sizeof mat->name, "%s", scalar(kn));
+        char prefix[KEY_MAX];
+        snprintf(prefix, sizeof prefix, "materials.%s", mat->name);
+        rmap m;
+        if (rmap_open(r, rd_node(r, p->value), prefix, &m) != 0)
+            return;
+        c->nmaterial = i + 1;
+        rmap_check_keys(&m, keys);
+        mat->density = rmap_num(&m, "density", 1, 0.0, "2650");
+        mat->model = (lahar_contact_model)rmap_enum(&m, "model", models, 0, LAHAR_CONTACT_HERTZ);
+        if (r->failed)
+            return;
+        if (mat->model == LAHAR_CONTACT_HERTZ) {
+            if (rmap_get(&m, "kn"))
+                rmap_fail(&m, "kn", "is the stiffness of model: linear, but this material uses model: hertz; "
+                          "remove kn or set model: linear");
+            mat->young = rmap_num(&m, "young", 1, 0.0, "1e8");
+            mat->poisson = rmap_num(&m, "poisson", 0, 0.25, "0.25");
+        } else {
+            if (rmap_get(&m, "young"))
+                rmap_fail(&m, "young", "is used by model: hertz, but this material uses model: linear; "
+                          "remove young or set model: hertz");
+            mat->kn = rmap_num(&m, "kn", 1, 0.0, "1e6");
+            mat->poisson = rmap_num(&m, "poisson", 0, 0.25, "0.25");
+        }
+        mat->kt_ratio = rmap_num(&m, "kt_ratio", 0, 2.0 / 7.0, "0.2857");
+        mat->restitution = rmap_num(&m, "restitution", 1, 0.0, "0.5");
+        mat->friction = rmap_num(&m, "friction", 1, 0.0, "0.5");
+        if (r->failed)
+            return;
+        if (!(mat->density > 0))
+            rmap_fail(&m, "density", "must be > 0 kg/m^3 (got %g)", mat->density);
+        else if (mat->model == LAHAR_CONTACT_HERTZ && !(mat->young > 0))
+            rmap_fail(&m, "young", "must be > 0 Pa (got %g); Young's modulus, e.g. 1e8", mat->young);
+        else if (!(mat->poisson >= 0 && mat->poisson < 0.5))
+            rmap_fail(&m, "poisson", "must be in [0, 0.5) (got %g)", mat->poisson);
+        else if (mat->model == LAHAR_CONTACT_LINEAR && !(mat->kn > 0))
+            rmap_fail(&m, "kn", "must be > 0 N/m (got %g)", mat->kn);
+        else if (!(mat->kt_ratio > 0))
+            rmap_fail(&m, "kt_ratio", "must be > 0 (got %g); 2/7 is the usual choice", mat->kt_ratio);
+        else if (!(mat->restitution > 0 && mat->restitution <= 1))
+            rmap_fail(&m, "restitution", "must be in (0, 1] (got %g); 1 is elastic, small values are very "
+                      "dissipative", mat->restitution);
+        else if (!(mat->friction >= 0))
+            rmap_fail(&m, "friction", "must be >= 0 (got %g); 0 is frictionless", mat->friction);
+    }
+}
+
+static void read_dem(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"engine", "dt_safety", NULL};
+    snprintf(c->dem_engine, sizeof c->dem_engine, "spheropoly");
+    c->dem_dt_safety = 0.02;
+    if (!n)
+        return;
+    rmap m;
+    if (rmap_open(r, n, "dem", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    rmap_name(&m, "engine", 0, "spheropoly", c->dem_engine);
+    c->dem_dt_safety = rmap_num(&m, "dt_safety", 0, 0.02, "0.02");
+    if (!r->failed && !(c->dem_dt_safety > 0 && c->dem_dt_safety <= 1))
+        rmap_fail(&m, "dt_safety", "must be in (0, 1] (got %g); it is the fraction of the contact period used as "
+                  "the DEM step, 0.02 is safe", c->dem_dt_safety);
+}
+
+/* --- bodies -------------------------------------------------------------------------------------- */
+
+enum { SH_SPHERE, SH_DISC, SH_BOX, SH_SEGMENT, SH_POLYLINE, SH_POLYGON, SH_POLYHEDRON, SH_PLANE, SH_STL, SH_N };
+static const char *const shape_names[] = {"sphere", "disc", "box", "segment", "polyline", "polygon",
+                                          "polyhedron", "plane", "stl", NULL};
+/* 2: 2D only, 3: 3D only, 0: both */
+static const int shape_dim[SH_N] = {3, 2, 0, 0, 2, 2, 3, 3, 3};
+static const int shape_fixed_only[SH_N] = {0, 0, 0, 0, 1, 0, 0, 1, 1};
+static const char *const motion_names[] = {"free", "fixed", "prescribed", NULL};
+
+/* Read a list of points (each `dim` numbers) into a new array of 3-vectors (z = 0 in 2D). */
+static double (*read_points(reader *r, yaml_node_t *n, const char *key, int dim, int *np))[3]
+{
+    if (r->failed)
+        return NULL;
+    if (n->type != YAML_SEQUENCE_NODE || seq_len(n) == 0) {
+        rd_fail(r, n, key, "expected a non-empty list of points like [[x, y%s], ...], got %s", dim == 3 ? ", z" : "",
+                n->type == YAML_SEQUENCE_NODE ? "an empty list" : node_kind(n));
+        return NULL;
+    }
+    int cnt = seq_len(n);
+    double (*p)[3] = calloc((size_t)cnt, sizeof *p);
+    if (!p) {
+        rd_fail(r, n, key, "out of memory");
+        return NULL;
+    }
+    for (int i = 0; i < cnt; i++) {
+        char ik[KEY_MAX];
+        snprintf(ik, sizeof ik, "%.*s[%d]", KEY_MAX - 16, key, i);
+        if (!node_vec(r, seq_item(r, n, i), ik, dim, p[i])) {
+            free(p);
+            return NULL;
+        }
+    }
+    *np = cnt;
+    return p;
+}
+
+/* Faces: a list of lists of vertex indices -> face_start (nf + 1) and face_v. */
+static int read_faces(reader *r, yaml_node_t *n, const char *key, int **fs, int **fv, int *nf)
+{
+    if (n->type != YAML_SEQUENCE_NODE || seq_len(n) == 0) {
+        rd_fail(r, n, key, "expected a non-empty list of faces like [[0, 1, 2], ...], got %s",
+                n->type == YAML_SEQUENCE_NODE ? "an empty list" : node_kind(n));
+        return -1;
+    }
+    int cnt = seq_len(n), total = 0;
+    for (int f = 0; f < cnt; f++) {
+        yaml_node_t *fn = seq_item(r, n, f);
+        if (fn->type != YAML_SEQUENCE_NODE) {
+            char ik[KEY_MAX];
+            snprintf(ik, sizeof ik, "%.*s[%d]", KEY_MAX - 16, key, f);
+            rd_fail(r, fn, ik, "expected a list of vertex indices like [0, 1, 2], got %s", node_kind(fn));
+            return -1;
+        }
+        total += seq_len(fn);
+    }
+    *fs = calloc((size_t)cnt + 1, sizeof **fs);
+    *fv = calloc((size_t)(total ? total : 1), sizeof **fv);
+    if (!*fs || !*fv) {
+        free(*fs);
+        free(*fv);
+        rd_fail(r, n, key, "out of memory");
+        return -1;
+    }
+    int k = 0;
+    for (int f = 0; f < cnt; f++) {
+        yaml_node_t *fn = seq_item(r, n, f);
+        (*fs)[f] = k;
+        for (int i = 0; i < seq_len(fn); i++) {
+            char ik[KEY_MAX];
+            snprintf(ik, sizeof ik, "%.*s[%d][%d]", KEY_MAX - 24, key, f, i);
+            double v;
+            if (node_number(r, seq_item(r, fn, i), ik, &v) != 0 || v != floor(v) || v < 0 || v > INT_MAX) {
+                rd_fail(r, seq_item(r, fn, i), ik, "expected a vertex index (an integer >= 0)");
+                free(*fs);
+                free(*fv);
+                return -1;
+            }
+            (*fv)[k++] = (int)v;
+        }
+    }
+    (*fs)[cnt] = k;
+    *nf = cnt;
+    return 0;
+}
+
+/* Mass properties per identical local shape: thousands of copies of one rock cost one computation. */
+typedef struct {
+    uint64_t hash;
+    int dim;
+    lahar_shape local;      /* as built, before the principal transform (the lookup key) */
+    lahar_shape principal;  /* moved to the principal frame */
+    lahar_mass_props mp;    /* unit density */
+} mass_cache_entry;
+
+typedef struct {
+    int n, cap;
+    mass_cache_entry *e;
+} mass_cache;
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static uint64_t shape_hash(const lahar_shape *s, int dim)
+{
+    uint64_t h = 1469598103934665603ull;
+    h = fnv1a(h, &dim, sizeof dim);
+    h = fnv1a(h, &s->radius, sizeof s->radius);
+    h = fnv1a(h, &s->nv, sizeof s->nv);
+    h = fnv1a(h, &s->nf, sizeof s->nf);
+    h = fnv1a(h, s->v, (size_t)s->nv * sizeof *s->v);
+    if (s->nf)
+        h = fnv1a(h, s->face_v, (size_t)s->face_start[s->nf] * sizeof *s->face_v);
+    return h;
+}
+
+static int shape_equal(const lahar_shape *a, const lahar_shape *b)
+{
+    if (a->nv != b->nv || a->ne != b->ne || a->nf != b->nf || a->radius != b->radius)
+        return 0;
+    if (memcmp(a->v, b->v, (size_t)a->nv * sizeof *a->v) != 0 || memcmp(a->e, b->e, (size_t)a->ne * sizeof *a->e) != 0)
+        return 0;
+    if (a->nf && (memcmp(a->face_start, b->face_start, ((size_t)a->nf + 1) * sizeof *a->face_start) != 0 ||
+                  memcmp(a->face_v, b->face_v, (size_t)a->face_start[a->nf] * sizeof *a->face_v) != 0))
+        return 0;
+    return 1;
+}
+
+static void mass_cache_free(mass_cache *mc)
+{
+    for (int i = 0; i < mc->n; i++) {
+        lahar_shape_free(&mc->e[i].local);
+        lahar_shape_free(&mc->e[i].principal);
+    }
+    free(mc->e);
+    memset(mc, 0, sizeof *mc);
+}
+
+/* Replace *s (local frame) by its principal-frame version and give its unit-density properties. */
+static int mass_cache_apply(mass_cache *mc, lahar_shape *s, int dim, lahar_mass_props *mp, char *err, size_t errlen)
+{
+    uint64_t h = shape_hash(s, dim);
+    for (int i = 0; i < mc->n; i++)
+        if (mc->e[i].hash == h && mc->e[i].dim == dim && shape_equal(&mc->e[i].local, s)) {
+            lahar_shape_free(s);
+            *mp = mc->e[i].mp;
+            return lahar_shape_copy(s, &mc->e[i].principal);
+        }
+    if (lahar_shape_mass_properties(s, dim, mp, err, errlen) != 0)
+        return -1;
+    if (mc->n == mc->cap) {
+        int cap = mc->cap ? 2 * mc->cap : 16;
+        mass_cache_entry *t = realloc(mc->e, (size_t)cap * sizeof *t);
+        if (!t)
+            return -1;
+        mc->e = t;
+        mc->cap = cap;
+    }
+    mass_cache_entry *e = &mc->e[mc->n];
+    memset(e, 0, sizeof *e);
+    if (lahar_shape_copy(&e->local, s) != 0)
+        return -1;
+    lahar_shape_to_principal(s, mp);
+    if (lahar_shape_copy(&e->principal, s) != 0) {
+        lahar_shape_free(&e->local);
+        return -1;
+    }
+    e->hash = h;
+    e->dim = dim;
+    e->mp = *mp;
+    mc->n++;
+    return 0;
+}
+
+/* Build the body's shape in its local frame (coordinates relative to `position`, before the
+ * orientation). Returns 0 or -1 (message already reported). */
+static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
+{
+    const int dim = r->dim;
+    char key[KEY_MAX], err[512] = "";
+    double radius = rmap_num(m, "radius", 1, 0.0, kind == SH_SPHERE || kind == SH_DISC ? "0.05" : "0.005");
+    if (r->failed)
+        return -1;
+    if (!(radius > 0)) {
+        rmap_fail(m, "radius", "must be > 0 m (got %g); %s", radius,
+                  kind == SH_SPHERE || kind == SH_DISC ? "it is the sphere/disc radius"
+                                                       : "it is the sweep (rounding) radius of the shape, small "
+                                                         "compared with the body (e.g. 1-5 % of its size)");
+        return -1;
+    }
+    int rc = -1;
+    switch (kind) {
+    case SH_SPHERE:
+    case SH_DISC:
+        rc = lahar_shape_make_sphere(s, radius);
+        break;
+    case SH_BOX: {
+        double size[3] = {0, 0, 0}, half[3] = {0, 0, 0};
+        rmap_vec(m, "size", dim, size, 1, dim == 3 ? "[0.2, 0.1, 0.1]" : "[0.2, 0.1]");
+        if (r->failed)
+            return -1;
+        for (int k = 0; k < dim; k++) {
+            if (!(size[k] > 2.0 * radius)) {
+                rmap_fail(m, "size", "every side must be > 2 radius = %g m (got %g); size is the OUTER size, the "
+                          "core is size - 2 radius", 2.0 * radius, size[k]);
+                return -1;
+            }
+            half[k] = 0.5 * size[k] - radius;
+        }
+        rc = dim == 3 ? lahar_shape_make_box(s, half, radius) : lahar_shape_make_box2d(s, half, radius);
+        break;
+    }
+    case SH_PLANE: {
+        double size[2] = {0, 0}, nrm[3] = {0, 0, 0}, zero[3] = {0, 0, 0};
+        rmap_vec(m, "normal", 3, nrm, 1, "[0, 0, 1]");
+        rmap_vec(m, "size", 2, size, 1, "[1.0, 1.0]");
+        if (r->failed)
+            return -1;
+        if (!(v3_norm(v3_load(nrm)) > 0)) {
+            rmap_fail(m, "normal", "must not be the zero vector; it is the outward normal of the rectangle");
+            return -1;
+        }
+        if (!(size[0] > 0 && size[1] > 0)) {
+            rmap_fail(m, "size", "both sides must be > 0 m (got [%g, %g])", size[0], size[1]);
+            return -1;
+        }
+        rc = lahar_shape_make_plane(s, zero, nrm, size, radius);
+        break;
+    }
+    case SH_SEGMENT:
+    case SH_POLYLINE:
+    case SH_POLYGON:
+    case SH_POLYHEDRON: {
+        yaml_node_t *vn = rmap_get(m, "vertices");
+        if (!vn) {
+            rmap_missing(m, "vertices", dim == 3 ? "[[0, 0, 0], [1, 0, 0], ...]" : "[[0, 0], [1, 0], ...]");
+            return -1;
+        }
+        key_join(m->prefix, "vertices", key);
+        int np = 0;
+        double (*p)[3] = read_points(r, vn, key, dim, &np);
+        if (!p)
+            return -1;
+        if (kind == SH_SEGMENT) {
+            if (np != 2)
+                rd_fail(r, vn, key, "a segment has exactly 2 vertices (got %d)", np);
+            else if (v3_norm(v3_sub(v3_load(p[0]), v3_load(p[1]))) == 0.0)
+                rd_fail(r, vn, key, "the two vertices coincide; use shape: %s for a single point",
+                        dim == 3 ? "sphere" : "disc");
+            else
+                rc = lahar_shape_make_segment(s, p[0], p[1], radius);
+        } else if (kind == SH_POLYLINE) {
+            int closed = rmap_bool(m, "closed", 0);
+            if (!r->failed) {
+                rc = lahar_shape_make_polyline(s, (const double(*)[3])p, np, closed, radius, err, sizeof err);
+                if (rc != 0)
+                    rd_fail(r, vn, key, "%s; fix the points", err);
+            }
+        } else if (kind == SH_POLYGON) {
+            rc = lahar_shape_make_polygon_hull(s, (const double(*)[3])p, np, radius, err, sizeof err);
+            if (rc != 0)
+                rd_fail(r, vn, key, "%s; a polygon needs 3 or more points not on one line", err);
+        } else {
+            yaml_node_t *fn = rmap_get(m, "faces");
+            if (!fn) {
+                rc = lahar_shape_make_hull(s, (const double(*)[3])p, np, radius, err, sizeof err);
+                if (rc != 0)
+                    rd_fail(r, vn, key, "%s; a polyhedron needs 4 or more points not all in one plane", err);
+            } else {
+                int *fs = NULL, *fv = NULL, nf = 0;
+                char fkey[KEY_MAX];
+                key_join(m->prefix, "faces", fkey);
+                if (read_faces(r, fn, fkey, &fs, &fv, &nf) == 0) {
+                    rc = lahar_shape_make_polyhedron(s, (const double(*)[3])p, np, fs, fv, nf, radius, err, sizeof err);
+                    if (rc != 0)
+                        rd_fail(r, fn, fkey, "%s (degenerate polyhedron); fix the faces or drop `faces:` to use the "
+                                "convex hull of the vertices", err);
+                    else if (lahar_shape_core_volume(s) <= 0) {
+                        rd_fail(r, fn, fkey, "the faces are clockwise seen from outside (the core volume is %g); "
+                                "list every face's vertices counter-clockwise seen from outside",
+                                lahar_shape_core_volume(s));
+                        lahar_shape_free(s);
+                        rc = -1;
+                    } else if (motion != LAHAR_MOTION_FIXED) {
+                        double L = 0;
+                        for (int i = 0; i < np; i++)
+                            L = fmax(L, v3_norm(v3_load(p[i])));
+                        if (!lahar_shape_is_convex(s, 3, 1e-9 * (L > 0 ? L : 1))) {
+                            rd_fail(r, fn, fkey, "the polyhedron is not convex, but moving bodies must be convex; "
+                                    "drop `faces:` to use the convex hull, or split the body");
+                            lahar_shape_free(s);
+                            rc = -1;
+                        }
+                    }
+                    free(fs);
+                    free(fv);
+                }
+            }
+        }
+        free(p);
+        break;
+    }
+    case SH_STL: {
+        const char *file = rmap_str(m, "file", 1, NULL, "terrain.stl");
+        double scale = rmap_num(m, "scale", 0, 1.0, "0.001");
+        if (r->failed)
+            return -1;
+        if (!(scale > 0)) {
+            rmap_fail(m, "scale", "must be > 0 (got %g); it multiplies the STL coordinates, e.g. 0.001 for mm", scale);
+            return -1;
+        }
+        char full[2048];
+        if (file[0] == '/')
+            snprintf(full, sizeof full, "%s", file);
+        else
+            snprintf(full, sizeof full, "%s%s", r->dir, file);
+        rc = lahar_shape_read_stl(s, full, radius, err, sizeof err);
+        if (rc != 0)
+            rmap_fail(m, "file", "%s; STL paths are relative to the case file's directory", err);
+        else
+            lahar_shape_transform(s, NULL, NULL, scale);
+        break;
+    }
+    default:
+        break;
+    }
+    if (rc != 0 && !r->failed)
+        rd_fail(r, m->node, m->prefix, "out of memory building the shape");
+    return r->failed ? -1 : 0;
+}
+
+static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cache *mc)
+{
+    static const char *const common_keys[] = {"name", "shape", "material", "motion", "position", "orientation",
+                                              "velocity", "angular_velocity", "radius"};
+    static const char *const extra[SH_N][3] = {
+        [SH_SPHERE] = {NULL},
+        [SH_DISC] = {NULL},
+        [SH_BOX] = {"size", NULL},
+        [SH_SEGMENT] = {"vertices", NULL},
+        [SH_POLYLINE] = {"vertices", "closed", NULL},
+        [SH_POLYGON] = {"vertices", NULL},
+        [SH_POLYHEDRON] = {"vertices", "faces", NULL},
+        [SH_PLANE] = {"normal", "size", NULL},
+        [SH_STL] = {"file", "scale", NULL},
+    };
+    const int dim = r->dim;
+    char prefix[KEY_MAX];
+    snprintf(prefix, sizeof prefix, "bodies[%d]", i);
+    rmap m;
+    if (rmap_open(r, n, prefix, &m) != 0)
+        return;
+    lahar_body *b = &c->bodies[i];
+    int kind = rmap_enum(&m, "shape", shape_names, 1, SH_SPHERE);
+    if (r->failed)
+        return;
+    const char *keys[16];
+    int nk = 0;
+    for (size_t k = 0; k < sizeof common_keys / sizeof *common_keys; k++)
+        keys[nk++] = common_keys[k];
+    for (int k = 0; extra[kind][k]; k++)
+        keys[nk++] = extra[kind][k];
+    keys[nk] = NULL;
+    rmap_check_keys(&m, keys);
+
+    char defname[LAHAR_NAME_MAX];
+    snprintf(defname, sizeof defname, "body%d", i);
+    rmap_name(&m, "name", 0, defname, b->name);
+    for (int j = 0; j < i && !r->failed; j++)
+        if (strcmp(c->bodies[j].name, b->name) == 0)
+            rmap_fail(&m, "name", "'%s' is already the name of bodies[%d]; body names must be unique", b->name, j);
+    if (r->failed)
+        return;
+    if (shape_dim[kind] && shape_dim[kind] != dim) {
+        static const char *const alt[SH_N] = {"disc", "sphere", "", "", "segment or stl", "box or polyhedron",
+                                              "polygon", "polyline", "polyline"};
+        rmap_fail(&m, "shape", "'%s' is a %dD shape but the case has dimensions: %d; use %s", shape_names[kind],
+                  shape_dim[kind], dim, alt[kind]);
+        return;
+    }
+    b->motion = (lahar_motion)rmap_enum(&m, "motion", motion_names, 0, LAHAR_MOTION_FREE);
+    const char *mat = rmap_str(&m, "material", 1, NULL, c->nmaterial ? c->materials[0].name : "rock");
+    if (r->failed)
+        return;
+    if (shape_fixed_only[kind] && b->motion != LAHAR_MOTION_FIXED) {
+        rmap_fail(&m, "shape", "'%s' bodies can only be walls: add `motion: fixed`%s", shape_names[kind],
+                  kind == SH_STL ? " (STL surfaces may be open and non-convex)" : "");
+        return;
+    }
+    b->material = lahar_case_find_material(c, mat);
+    if (b->material < 0) {
+        const char *names[64];
+        int nn = 0;
+        for (int k = 0; k < c->nmaterial && nn < 63; k++)
+            names[nn++] = c->materials[k].name;
+        names[nn] = NULL;
+        char list[512];
+        join_names(names, list, sizeof list);
+        const char *near = closest_name(mat, names);
+        if (nn == 0)
+            rmap_fail(&m, "material", "unknown material '%s'; define it in the materials: section", mat);
+        else if (near)
+            rmap_fail(&m, "material", "unknown material '%s'; did you mean '%s'? (materials: %s)", mat, near, list);
+        else
+            rmap_fail(&m, "material", "unknown material '%s'; define it in materials: (defined: %s)", mat, list);
+        return;
+    }
+
+    double pos[3] = {0, 0, 0}, vel[3] = {0, 0, 0}, omega[3] = {0, 0, 0};
+    rmap_vec(&m, "position", dim, pos, 0, "");
+    quat qu = q_identity();
+    yaml_node_t *on = rmap_get(&m, "orientation");
+    if (on && !r->failed) {
+        static const char *const okeys3[] = {"axis", "angle_deg", NULL};
+        static const char *const okeys2[] = {"angle_deg", NULL};
+        char ok[KEY_MAX];
+        key_join(prefix, "orientation", ok);
+        rmap om;
+        if (rmap_open(r, on, ok, &om) == 0) {
+            rmap_check_keys(&om, dim == 3 ? okeys3 : okeys2);
+            double axis[3] = {0, 0, 1};
+            if (dim == 3)
+                rmap_vec(&om, "axis", 3, axis, 0, "");
+            double ang = rmap_num(&om, "angle_deg", 1, 0.0, "30");
+            if (!r->failed && !(v3_norm(v3_load(axis)) > 0))
+                rmap_fail(&om, "axis", "must not be the zero vector");
+            qu = q_axis_angle(v3_normalize(v3_load(axis)), ang * M_PI / 180.0);
+        }
+    }
+    int has_v = rmap_vec(&m, "velocity", dim, vel, 0, "");
+    int has_w = 0;
+    if (dim == 3)
+        has_w = rmap_vec(&m, "angular_velocity", 3, omega, 0, "");
+    else if (rmap_get(&m, "angular_velocity")) {
+        omega[2] = rmap_num(&m, "angular_velocity", 0, 0.0, "");
+        has_w = 1;
+    }
+    if (r->failed)
+        return;
+    if (b->motion == LAHAR_MOTION_FIXED && (has_v || has_w)) {
+        rmap_fail(&m, has_v ? "velocity" : "angular_velocity", "a fixed body does not move; remove it, or use "
+                  "`motion: prescribed` for a wall that moves at a given velocity");
+        return;
+    }
+
+    lahar_shape *s = &b->shape;
+    if (build_shape(r, &m, kind, b->motion, s) != 0)
+        return;
+    double R[3][3];
+    q_to_rotmat(qu, R);
+    if (b->motion == LAHAR_MOTION_FIXED) {
+        /* walls keep world-frame geometry with identity orientation, mass 0 marks "immovable" */
+        lahar_shape_transform(s, (const double(*)[3])R, pos, 1.0);
+        b->q[0] = 1.0;
+        b->convex = lahar_shape_is_convex(s, dim, 1e-9 * (s->radius + 1.0));
+        return;
+    }
+    char err[256] = "";
+    lahar_mass_props mp;
+    if (mass_cache_apply(mc, s, dim, &mp, err, sizeof err) != 0) {
+        rd_fail(r, n, prefix, "cannot compute mass properties: %s", err[0] ? err : "out of memory");
+        return;
+    }
+    double rho = c->materials[b->material].density;
+    b->convex = 1;
+    b->mass = rho * mp.volume;
+    for (int k = 0; k < 3; k++)
+        b->inertia[k] = rho * mp.inertia[k];
+    vec3 com = q_rotate(qu, v3_load(mp.com));
+    v3_store(v3_add(v3_load(pos), com), b->x);
+    quat qb = q_normalize(q_mul(qu, q_from_rotmat((const double(*)[3])mp.axes)));
+    q_store(qb, b->q);
+    memcpy(b->v, vel, sizeof vel);
+    memcpy(b->w, omega, sizeof omega);
+}
+
+static void read_bodies(reader *r, yaml_node_t *n, lahar_case *c, mass_cache *mc, int *line)
+{
+    if (n->type != YAML_SEQUENCE_NODE) {
+        rd_fail(r, n, "bodies", "expected a list of bodies (lines starting with `- `), got %s", node_kind(n));
+        return;
+    }
+    int nb = seq_len(n);
+    c->bodies = calloc((size_t)(nb ? nb : 1), sizeof *c->bodies);
+    if (!c->bodies) {
+        rd_fail(r, n, "bodies", "out of memory");
+        return;
+    }
+    for (int i = 0; i < nb && !r->failed; i++) {
+        c->nbody = i + 1;
+        yaml_node_t *bn = seq_item(r, n, i);
+        line[i] = (int)bn->start_mark.line + 1;
+        read_body(r, bn, i, c, mc);
+    }
+}
+
+/* Bodies must not interpenetrate at t = 0 (walls may meet each other). */
+static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
+{
+    int n = c->nbody;
+    double (*ctr)[4] = malloc((size_t)(n ? n : 1) * sizeof *ctr); /* bounding sphere centre, radius */
+    if (!ctr) {
+        rd_fail(r, bodies, "bodies", "out of memory");
+        return;
+    }
+    for (int i = 0; i < n; i++) {
+        const lahar_body *b = &c->bodies[i];
+        const lahar_shape *s = &b->shape;
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            lo[k] = INFINITY;
+            hi[k] = -INFINITY;
+        }
+        for (int v = 0; v < s->nv; v++) {
+            vec3 w = geom_world_vertex(s, b->x, b->q, v);
+            for (int k = 0; k < 3; k++) {
+                lo[k] = fmin(lo[k], v3_get(w, k));
+                hi[k] = fmax(hi[k], v3_get(w, k));
+            }
+        }
+        for (int k = 0; k < 3; k++)
+            ctr[i][k] = 0.5 * (lo[k] + hi[k]);
+        ctr[i][3] = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                               (hi[2] - lo[2]) * (hi[2] - lo[2])) + s->radius;
+    }
+    for (int j = 0; j < n && !r->failed; j++)
+        for (int i = 0; i < j && !r->failed; i++) {
+            const lahar_body *a = &c->bodies[i], *b = &c->bodies[j];
+            if (a->motion != LAHAR_MOTION_FREE && b->motion != LAHAR_MOTION_FREE)
+                continue;
+            double dx = ctr[i][0] - ctr[j][0], dy = ctr[i][1] - ctr[j][1], dz = ctr[i][2] - ctr[j][2];
+            if (sqrt(dx * dx + dy * dy + dz * dz) > ctr[i][3] + ctr[j][3])
+                continue;
+            double d = geom_body_core_distance(&a->shape, a->x, a->q, &b->shape, b->x, b->q);
+            double halo = a->shape.radius + b->shape.radius;
+            if (d < halo * (1.0 - 1e-9)) {
+                char key[KEY_MAX];
+                snprintf(key, sizeof key, "bodies[%d]", j);
+                rd_fail(r, seq_item(r, bodies, j), key, "'%s' overlaps '%s' (bodies[%d]) by %.3g m at t = 0 (core "
+                        "distance %.3g m < sum of radii %.3g m); move the bodies apart", b->name, a->name, i,
+                        halo - d, d, halo);
+            }
+        }
+    free(ctr);
+}
+
+static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"dx", "density", "blocks", NULL};
+    static const char *const bkeys[] = {"name", "box", "velocity", NULL};
+    static const char *const boxkeys[] = {"lo", "hi", NULL};
+    c->sph_density = 1000.0;
+    if (!n)
+        return;
+    const int dim = r->dim;
+    rmap m;
+    if (rmap_open(r, n, "sph", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    c->sph_dx = rmap_num(&m, "dx", 1, 0.0, "0.01");
+    c->sph_density = rmap_num(&m, "density", 0, 1000.0, "1000");
+    if (r->failed)
+        return;
+    if (!(c->sph_dx > 0)) {
+        rmap_fail(&m, "dx", "must be > 0 m (got %g); it is the particle spacing", c->sph_dx);
+        return;
+    }
+    if (!(c->sph_density > 0)) {
+        rmap_fail(&m, "density", "must be > 0 kg/m^3 (got %g)", c->sph_density);
+        return;
+    }
+    yaml_node_t *bl = rmap_get(&m, "blocks");
+    if (!bl) {
+        rmap_missing(&m, "blocks", "[{name: water, box: {lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}}]");
+        return;
+    }
+    if (bl->type != YAML_SEQUENCE_NODE || seq_len(bl) == 0) {
+        rd_fail(r, bl, "sph.blocks", "expected a non-empty list of particle blocks");
+        return;
+    }
+    int nb = seq_len(bl);
+    c->blocks = calloc((size_t)nb, sizeof *c->blocks);
+    if (!c->blocks) {
+        rd_fail(r, bl, "sph.blocks", "out of memory");
+        return;
+    }
+    for (int i = 0; i < nb && !r->failed; i++) {
+        lahar_particle_block *pb = &c->blocks[i];
+        c->nblock = i + 1;
+        char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+        snprintf(prefix, sizeof prefix, "sph.blocks[%d]", i);
+        snprintf(def, sizeof def, "block%d", i);
+        rmap bm, xm;
+        if (rmap_open(r, seq_item(r, bl, i), prefix, &bm) != 0)
+            return;
+        rmap_check_keys(&bm, bkeys);
+        rmap_name(&bm, "name", 0, def, pb->name);
+        rmap_vec(&bm, "velocity", dim, pb->v, 0, "");
+        yaml_node_t *bx = rmap_get(&bm, "box");
+        if (!bx) {
+            rmap_missing(&bm, "box", "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}");
+            return;
+        }
+        char bp[KEY_MAX];
+        key_join(prefix, "box", bp);
+        if (rmap_open(r, bx, bp, &xm) != 0)
+            return;
+        rmap_check_keys(&xm, boxkeys);
+        rmap_vec(&xm, "lo", dim, pb->lo, 1, dim == 3 ? "[0, 0, 0]" : "[0, 0]");
+        rmap_vec(&xm, "hi", dim, pb->hi, 1, dim == 3 ? "[0.1, 0.1, 0.1]" : "[0.1, 0.1]");
+        for (int k = 0; k < dim && !r->failed; k++)
+            if (!(pb->hi[k] > pb->lo[k]))
+                rmap_fail(&xm, "hi", "must be > lo in every component (component %d: %g <= %g)", k, pb->hi[k], pb->lo[k]);
+    }
+}
+
+static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"fields", "forces", NULL};
+    /* bit i = field_names[i], matching LAHAR_PFIELD_* in output.h */
+    static const char *const field_names[] = {"velocity", "density", "pressure", "phase", "id", NULL};
+    static const char *const forces_names[] = {"none", "all", NULL};
+    c->output_fields = 0x1f;
+    c->output_forces = 1;
+    if (!n)
+        return;
+    rmap m;
+    if (rmap_open(r, n, "output", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    c->output_forces = rmap_enum(&m, "forces", forces_names, 0, 1);
+    yaml_node_t *f = rmap_get(&m, "fields");
+    if (!f || r->failed)
+        return;
+    if (f->type != YAML_SEQUENCE_NODE) {
+        rd_fail(r, f, "output.fields", "expected a list of field names like [velocity, pressure], got %s", node_kind(f));
+        return;
+    }
+    c->output_fields = 0;
+    for (int i = 0; i < seq_len(f) && !r->failed; i++) {
+        yaml_node_t *it = seq_item(r, f, i);
+        char key[KEY_MAX];
+        snprintf(key, sizeof key, "output.fields[%d]", i);
+        int found = -1;
+        if (it->type == YAML_SCALAR_NODE)
+            for (int k = 0; field_names[k]; k++)
+                if (strcmp(scalar(it), field_names[k]) == 0)
+                    found = k;
+        if (found < 0) {
+            char list[128];
+            join_names(field_names, list, sizeof list);
+            const char *near = it->type == YAML_SCALAR_NODE ? closest_name(scalar(it), field_names) : NULL;
+            rd_fail(r, it, key, "unknown field%s%s%s; fields are: %s", near ? "; did you mean '" : "",
+                    near ? near : "", near ? "'?" : "", list);
+            return;
+        }
+        c->output_fields |= 1u << found;
+    }
+}
+
+static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"reference", "metrics", NULL};
+    if (!n)
+        return;
+    rmap m, mm;
+    if (rmap_open(r, n, "check", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    const char *ref = rmap_str(&m, "reference", 1, "", "restitution");
+    if (r->failed)
+        return;
+    if (strlen(ref) >= sizeof c->check.reference) {
+        rmap_fail(&m, "reference", "longer than %d characters", (int)sizeof c->check.reference - 1);
+        return;
+    }
+    snprintf(c->check.reference, sizeof c->check.reference, "%s", ref);
+    yaml_node_t *mn = rmap_get(&m, "metrics");
+    if (!mn) {
+        rmap_missing(&m, "metrics", "{restitution_rel_error: 0.01}");
+        return;
+    }
+    if (rmap_open(r, mn, "check.metrics", &mm) != 0)
+        return;
+    int nm = (int)(mn->data.mapping.pairs.top - mn->data.mapping.pairs.start);
+    if (nm == 0 || nm > 16) {
+        rd_fail(r, mn, "check.metrics", "give 1 to 16 metrics as `name: bound` (got %d)", nm);
+        return;
+    }
+    for (int i = 0; i < nm && !r->failed; i++) {
+        yaml_node_pair_t *p = mn->data.mapping.pairs.start + i;
+        yaml_node_t *k = rd_node(r, p->key);
+        if (k->type != YAML_SCALAR_NODE || strlen(scalar(k)) >= LAHAR_NAME_MAX) {
+            rd_fail(r, k, "check.metrics", "a metric name must be a plain name shorter than %d characters",
+                    LAHAR_NAME_MAX);
+            return;
+        }
+        snprintf(c->check.metric[i].name, LAHAR_NAME_MAX, "%s", scalar(k));
+        char key[KEY_MAX];
+        snprintf(key, sizeof key, "check.metrics.%s", scalar(k));
+        double v = 0;
+        if (node_number(r, rd_node(r, p->value), key, &v) != 0)
+            return;
+        if (!(v >= 0)) {
+            rd_fail(r, rd_node(r, p->value), key, "a bound must be >= 0 (got %g); the metric passes when its value "
+                    "is <= the bound", v);
+            return;
+        }
+        c->check.metric[i].bound = v;
+        c->check.nmetric = i + 1;
+    }
+    c->check.enabled = 1;
+}
+
+/* --- entry points ------------------------------------------------------------------------------- */
+
+static void read_case(reader *r, lahar_case *c)
+{
+    static const char *const keys[] = {"dimensions", "gravity", "time", "materials", "dem", "bodies", "output",
+                                       "check", "sph", NULL};
+    yaml_node_t *root = yaml_document_get_root_node(r->doc);
+    if (!root) {
+        rd_fail(r, NULL, "", "the case file is empty; a case needs at least dimensions, time and bodies or sph");
+        return;
+    }
+    rmap m;
+    if (rmap_open(r, root, "", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    double d = rmap_num(&m, "dimensions", 1, 3.0, "3");
+    if (r->failed)
+        return;
+    if (d != 2.0 && d != 3.0) {
+        rmap_fail(&m, "dimensions", "must be 2 or 3 (got %g); 2D scenes live in the x-y plane", d);
+        return;
+    }
+    c->dim = r->dim = (int)d;
+    c->gravity[c->dim - 1] = -9.81;
+    rmap_vec(&m, "gravity", c->dim, c->gravity, 0, "");
+    read_time(r, root, rmap_get(&m, "time"), c);
+    yaml_node_t *mat = rmap_get(&m, "materials"), *bodies = rmap_get(&m, "bodies"), *sph = rmap_get(&m, "sph");
+    if (!r->failed && bodies && !mat)
+        rmap_missing(&m, "materials", "{rock: {density: 2650, young: 1e8, restitution: 0.5, friction: 0.5}}");
+    if (!r->failed && !bodies && !sph)
+        rd_fail(r, root, "bodies", "the case has neither bodies nor an sph section; add at least one");
+    if (mat)
+        read_materials(r, mat, c);
+    read_dem(r, rmap_get(&m, "dem"), c);
+    if (bodies && !r->failed) {
+        int nb = bodies->type == YAML_SEQUENCE_NODE ? seq_len(bodies) : 0;
+        int *line = calloc((size_t)(nb ? nb : 1), sizeof *line);
+        mass_cache mc = {0, 0, NULL};
+        if (!line)
+            rd_fail(r, bodies, "bodies", "out of memory");
+        else
+            read_bodies(r, bodies, c, &mc, line);
+        mass_cache_free(&mc);
+        free(line);
+        if (!r->failed)
+            check_overlaps(r, bodies, c);
+    }
+    read_sph(r, sph, c);
+    read_output(r, rmap_get(&m, "output"), c);
+    read_check(r, rmap_get(&m, "check"), c);
+}
+
+int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (errlen)
+        err[0] = '\0';
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    reader r;
+    memset(&r, 0, sizeof r);
+    r.path = path;
+    r.err = err;
+    r.errlen = errlen;
+    const char *slash = strrchr(path, '/');
+    if (slash)
+        snprintf(r.dir, sizeof r.dir, "%.*s/", (int)(slash - path), path);
+    yaml_parser_t parser;
+    yaml_document_t doc;
+    if (!yaml_parser_initialize(&parser)) {
+        fclose(fp);
+        snprintf(err, errlen, "%s: cannot initialise the YAML parser", path);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    yaml_parser_set_input_file(&parser, fp);
+    if (!yaml_parser_load(&parser, &doc)) {
+        snprintf(err, errlen, "%s:%d: YAML syntax error: %s%s%s (column %d); fix the YAML syntax", path,
+                 (int)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown problem",
+                 parser.context ? " " : "", parser.context ? parser.context : "", (int)parser.problem_mark.column + 1);
+        yaml_parser_delete(&parser);
+        fclose(fp);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    r.doc = &doc;
+    snprintf(out->path, sizeof out->path, "%s", path);
+    read_case(&r, out);
+    yaml_document_delete(&doc);
+    yaml_parser_delete(&parser);
+    fclose(fp);
+    if (r.failed) {
+        lahar_case_free(out);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    return 0;
+}
+
+int lahar_case_load(const char *path, lahar_case *out)
+{
+    char err[2048];
+    int rc = lahar_case_load_err(path, out, err, sizeof err);
+    if (rc != 0)
+        fprintf(stderr, "%s\n", err);
+    return rc;
+}
+
+void lahar_case_free(lahar_case *c)
+{
+    if (!c)
+        return;
+    if (c->bodies)
+        for (int i = 0; i < c->nbody; i++)
+            lahar_shape_free(&c->bodies[i].shape);
+    free(c->bodies);
+    free(c->materials);
+    free(c->blocks);
+    memset(c, 0, sizeof *c);
+}
+
+int lahar_case_find_body(const lahar_case *c, const char *name)
+{
+    for (int i = 0; i < c->nbody; i++)
+        if (strcmp(c->bodies[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
+int lahar_case_find_material(const lahar_case *c, const char *name)
+{
+    for (int i = 0; i < c->nmaterial; i++)
+        if (strcmp(c->materials[i].name, name) == 0)
+            return i;
+    return -1;
+}
