@@ -14,6 +14,14 @@ double geom_point_segment(vec3 p, vec3 a, vec3 b, vec3 *c);
  * degenerate (zero-length) segments. */
 double geom_segment_segment(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 *cp, vec3 *cq);
 
+/* As geom_point_segment, also returning the parameter t in [0, 1] of c = a + t (b - a). */
+double geom_point_segment_param(vec3 p, vec3 a, vec3 b, vec3 *c, double *t);
+
+/* As geom_segment_segment, also returning the parameters s, t in [0, 1] of cp = p0 + s (p1 - p0)
+ * and cq = q0 + t (q1 - q0) (the DEM uses them to keep edge-edge contacts interior to both). */
+double geom_segment_segment_param(vec3 p0, vec3 p1, vec3 q0, vec3 q1, double *s, double *t,
+                                  vec3 *cp, vec3 *cq);
+
 /* Closest point c on the planar convex polygon poly[0..n-1] (counter-clockwise about `normal`)
  * to p; returns |p - c|. *inside = 1 when the projection of p falls inside the polygon. */
 double geom_point_polygon(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *c, int *inside);

@@ -1,0 +1,49 @@
+/* Contact laws of the sphero-polyhedra DEM engine: how two materials combine into a pair law,
+ * the normal (linear or Hertz) and tangential (spring with Coulomb limit) forces, and the damping
+ * calibrated from the coefficient of restitution. Formulas and conventions: dem_node/README.md. */
+#ifndef LAHAR_DEM_CONTACT_H
+#define LAHAR_DEM_CONTACT_H
+#include <stddef.h>
+#include "scene.h"
+#include "vec.h"
+
+typedef struct {
+    lahar_contact_model model;
+    double kn;       /* linear: normal stiffness (harmonic mean of the two materials) */
+    double estar;    /* Hertz: effective modulus E*, 1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b */
+    double kt_ratio; /* tangential / normal (secant) stiffness */
+    double e;        /* restitution, min of the two */
+    double mu;       /* Coulomb friction, min of the two */
+    double damp;     /* linear: damping ratio zeta; Hertz: alpha (Tsuji form), both calibrated for
+                        the clipped force so that a binary impact rebounds with exactly e */
+} dem_pair_law;
+
+/* Combine two materials. Returns 0, or -1 with a message (e.g. Hertz without Young's modulus). */
+int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair_law *out,
+                      char *err, size_t errlen);
+
+/* Restitution of a binary impact under `model` with damping parameter `damp` (zeta or alpha) and
+ * the normal force clipped at zero, from the scaled equation of motion (m* = k = v0 = 1). */
+double dem_restitution_clipped(lahar_contact_model model, double damp);
+
+/* Damping parameter (zeta for linear, alpha for Hertz) whose clipped impact rebounds with e. */
+double dem_damping_for_restitution(lahar_contact_model model, double e);
+
+/* Normal force magnitude (>= 0, clipped) for overlap delta > 0 and overlap rate delta_dot
+ * (> 0 approaching); also the current normal stiffness (secant for Hertz) and damping coefficient
+ * used to build the tangential ones. */
+double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
+                        double rstar, double *k_secant, double *c_normal);
+
+/* Elastic contact period of the pair: linear 2 pi sqrt(m* / kn), twice the contact duration; Hertz: the elastic
+ * Hertz duration 2.868266 (m*^2/(R* E*^2 v))^(1/5) (reference 06 sec. 6.1) at impact speed v. */
+double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, double v_impact);
+
+/* Tangential force (world vector) from the spring xi (already rotated onto the tangent plane and
+ * advanced by the tangential displacement of this step), the tangential relative velocity vt, the
+ * normal force fn and the normal stiffness/damping. When the trial force exceeds mu fn the spring is
+ * truncated so that it alone carries the Coulomb force (sliding). */
+vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn, double k_secant,
+                          double c_normal);
+
+#endif

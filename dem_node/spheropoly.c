@@ -1,0 +1,1091 @@
+/* The "spheropoly" DEM engine: rigid sphero-polyhedra (Galindo-Torres 2009-2013 as used in paper
+ * 000 sec. 3) with linear or Hertz normal contacts, a tangential spring with Coulomb limit, a
+ * hashed uniform grid broad phase, per-body feature grids for big surfaces, kick-drift-kick
+ * leap-frog for translation and an exactly rotating splitting (NO_SQUISH / Dullweber-Leimkuhler-
+ * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
+#include "spheropoly.h"
+#include <float.h>
+#include <math.h>
+#include <omp.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "dem_contact.h"
+#include "dem_feature_grid.h"
+#include "geometry.h"
+
+/* Contact types: which features of body a (lower index) and b meet. */
+enum { SP_VF = 0, SP_FV, SP_EE, SP_VE, SP_EV, SP_VV };
+
+/* Bodies with more features than this get a feature grid. */
+enum { SP_GRID_MIN_FEATURES = 64 };
+
+typedef struct {
+    int a, b, type, fa, fb;
+    vec3 xi;     /* tangential spring (world), kept across steps while the contact lasts */
+    vec3 f;      /* force on b (a gets -f), world */
+    vec3 cp;     /* contact point, world */
+    double delta;
+} sp_contact;
+
+typedef struct {
+    int nv, ne, nf;
+    int v0;      /* first vertex in vb/vw/vadj_start pools (vadj_start has nv+1 per body at va0) */
+    int va0;
+    int e0;      /* first edge in the edge pools */
+    int f0;      /* first face in fstart (nf+1 entries at fs0) and face normal pools */
+    int fs0;
+    double radius, bound; /* sweep radius; bounding radius about the centre of mass */
+    int grid;    /* index into e->grids or -1 */
+    int material;
+    lahar_motion motion;
+    double mass, inertia[3];
+    vec3 aabb_lo, aabb_hi; /* world box of non-free bodies (vertices +- radius) */
+} sp_geo;
+
+typedef struct {
+    vec3 x, v, L, w; /* position, velocity, angular momentum and velocity (world) */
+    quat q;
+    vec3 fc, tc;     /* contact force / torque of the last evaluation */
+} sp_state;
+
+typedef struct {
+    sp_contact *c;
+    int n, cap;
+    dem_feature_query fq;
+    int oom;
+} sp_thread;
+
+struct lahar_dem_engine {
+    int dim, nbody, nmat;
+    vec3 g;
+    double dt_stable;
+    long step;                /* substeps taken since creation */
+    sp_geo *geo;
+    sp_state *st;
+    char (*names)[LAHAR_NAME_MAX];
+    dem_pair_law *laws;       /* nmat x nmat */
+    /* geometry pools */
+    vec3 *vb, *vw;            /* body-frame and world vertices */
+    int *vadj_start, *vadj;   /* vertex neighbours (local vertex ids) */
+    int (*edge)[2];           /* local vertex ids */
+    int (*edge_face)[2];      /* local face ids adjacent to each edge, -1 if none */
+    int *fstart;              /* per body nf+1 offsets into fv/fw (global) */
+    int *fv;                  /* local vertex ids */
+    vec3 *fw;                 /* world copy of the face polygons */
+    vec3 *nb, *nw;            /* face normals body / world */
+    dem_feature_grid *grids;
+    int ngrid;
+    /* broad phase */
+    int nfree, *free_ids, nlarge, *large_ids;
+    double cell;
+    long long (*cellc)[3];
+    int *bucket_start, *bucket_items, nbucket;
+    int (*pairs)[2];
+    int npair, pair_cap;
+    /* contacts: previous evaluation (history) and hash over it */
+    sp_contact *prev, *cur;
+    int nprev, contact_cap;
+    int *hash, hash_cap;
+    sp_thread *thr;
+    int nthr;
+    /* report accumulators over the substeps of one advance */
+    vec3 *rep_f, *rep_t;
+    int rep_n;
+    int *ncontact_body;
+};
+
+/* ---------------------------------------------------------------------------------------------- */
+
+static void *xcalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
+
+static int grow(void **p, int *cap, int need, size_t size)
+{
+    if (need <= *cap) return 0;
+    int c = *cap > 0 ? *cap : 64;
+    while (c < need) c *= 2;
+    void *q = realloc(*p, (size_t)c * size);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+static double mstar_of(const lahar_dem_engine *e, int a, int b)
+{
+    const sp_geo *ga = &e->geo[a], *gb = &e->geo[b];
+    int fa = ga->motion == LAHAR_MOTION_FREE, fb = gb->motion == LAHAR_MOTION_FREE;
+    if (fa && fb) return ga->mass * gb->mass / (ga->mass + gb->mass);
+    return fa ? ga->mass : gb->mass; /* fixed / prescribed partner: infinite mass */
+}
+
+/* Update world vertices, face polygons/normals and (non-free) boxes of body i. */
+static void body_update_world(lahar_dem_engine *e, int i)
+{
+    sp_geo *g = &e->geo[i];
+    sp_state *s = &e->st[i];
+    vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
+    for (int k = 0; k < g->nv; k++) {
+        vec3 w = v3_add(s->x, q_rotate(s->q, e->vb[g->v0 + k]));
+        e->vw[g->v0 + k] = w;
+        lo = v3(fmin(lo.x, w.x), fmin(lo.y, w.y), fmin(lo.z, w.z));
+        hi = v3(fmax(hi.x, w.x), fmax(hi.y, w.y), fmax(hi.z, w.z));
+    }
+    for (int f = 0; f < g->nf; f++) {
+        e->nw[g->f0 + f] = q_rotate(s->q, e->nb[g->f0 + f]);
+        for (int k = e->fstart[g->fs0 + f]; k < e->fstart[g->fs0 + f + 1]; k++) e->fw[k] = e->vw[g->v0 + e->fv[k]];
+    }
+    vec3 r = v3(g->radius, g->radius, g->radius);
+    g->aabb_lo = v3_sub(lo, r);
+    g->aabb_hi = v3_add(hi, r);
+}
+
+/* World angular velocity from the angular momentum: w = R I^-1 R^T L (2D: about z only). */
+static void body_update_omega(lahar_dem_engine *e, int i)
+{
+    sp_geo *g = &e->geo[i];
+    sp_state *s = &e->st[i];
+    if (e->dim == 2) {
+        s->w = v3(0.0, 0.0, s->L.z / g->inertia[2]);
+        return;
+    }
+    vec3 pb = q_rotate_inv(s->q, s->L);
+    vec3 wb = v3(pb.x / g->inertia[0], pb.y / g->inertia[1], pb.z / g->inertia[2]);
+    s->w = q_rotate(s->q, wb);
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Narrow phase                                                                                    */
+
+typedef struct {
+    const lahar_dem_engine *e;
+    int a, b;
+    const dem_pair_law *law;
+    double mstar, h;
+    sp_thread *t;
+} sp_pair_ctx;
+
+static uint64_t contact_key_hash(int a, int b, int type, int fa, int fb)
+{
+    uint64_t k = (uint64_t)(uint32_t)a * 0x9E3779B97F4A7C15ull;
+    k ^= (uint64_t)(uint32_t)b + 0x7F4A7C159E3779B9ull + (k << 6) + (k >> 2);
+    k ^= (uint64_t)(uint32_t)type * 0xBF58476D1CE4E5B9ull + (k << 6) + (k >> 2);
+    k ^= (uint64_t)(uint32_t)fa * 0x94D049BB133111EBull + (k << 6) + (k >> 2);
+    k ^= (uint64_t)(uint32_t)fb + 0x2545F4914F6CDD1Dull + (k << 6) + (k >> 2);
+    k ^= k >> 31;
+    return k;
+}
+
+static const sp_contact *history_find(const lahar_dem_engine *e, int a, int b, int type, int fa, int fb)
+{
+    if (e->nprev == 0) return NULL;
+    uint64_t m = (uint64_t)e->hash_cap - 1;
+    for (uint64_t h = contact_key_hash(a, b, type, fa, fb) & m;; h = (h + 1) & m) {
+        int i = e->hash[h];
+        if (i < 0) return NULL;
+        const sp_contact *c = &e->prev[i];
+        if (c->a == a && c->b == b && c->type == type && c->fa == fa && c->fb == fb) return c;
+    }
+}
+
+static int history_rebuild(lahar_dem_engine *e)
+{
+    int need = 16;
+    while (need < 2 * e->nprev) need *= 2;
+    if (need > e->hash_cap) {
+        int *h = realloc(e->hash, sizeof(int) * (size_t)need);
+        if (!h) return -1;
+        e->hash = h;
+        e->hash_cap = need;
+    }
+    memset(e->hash, 0xff, sizeof(int) * (size_t)e->hash_cap);
+    uint64_t m = (uint64_t)e->hash_cap - 1;
+    for (int i = 0; i < e->nprev; i++) {
+        const sp_contact *c = &e->prev[i];
+        uint64_t h = contact_key_hash(c->a, c->b, c->type, c->fa, c->fb) & m;
+        while (e->hash[h] >= 0) h = (h + 1) & m;
+        e->hash[h] = i;
+    }
+    return 0;
+}
+
+/* A feature pair whose cores are at pa (on a) and pb (on b): a contact when the swept surfaces
+ * overlap. ra_curv / rb_curv: curvature radius of each feature for Hertz (0 = flat face). */
+static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3 pb, int a_flat, int b_flat,
+                         vec3 fallback_n)
+{
+    const lahar_dem_engine *e = x->e;
+    const sp_geo *ga = &e->geo[x->a], *gb = &e->geo[x->b];
+    double rsum = ga->radius + gb->radius;
+    vec3 dvec = v3_sub(pb, pa);
+    double d2 = v3_norm2(dvec);
+    if (d2 >= rsum * rsum) return;
+    double d = sqrt(d2);
+    vec3 n = d > 1e-12 * rsum ? v3_scale(dvec, 1.0 / d) : fallback_n;
+    double delta = rsum - d;
+    /* contact point in the middle of the overlap */
+    vec3 cp = v3_scale(v3_add(v3_axpy(ga->radius, n, pa), v3_axpy(-gb->radius, n, pb)), 0.5);
+    const sp_state *sa = &e->st[x->a], *sb = &e->st[x->b];
+    vec3 va = v3_add(sa->v, v3_cross(sa->w, v3_sub(cp, sa->x)));
+    vec3 vb = v3_add(sb->v, v3_cross(sb->w, v3_sub(cp, sb->x)));
+    vec3 vr = v3_sub(vb, va);
+    double vn = v3_dot(vr, n);
+    vec3 vt = v3_axpy(-vn, n, vr);
+    /* R*: sweep radius for a vertex or edge, infinite for a face (paper 003 eq. 16) */
+    double rstar = a_flat ? gb->radius : (b_flat ? ga->radius : ga->radius * gb->radius / rsum);
+    double k, c;
+    double fn = dem_normal_force(x->law, delta, -vn, x->mstar, rstar, &k, &c);
+    /* tangential spring from the last step, rotated onto the current tangent plane (magnitude kept) */
+    vec3 xi = v3(0.0, 0.0, 0.0);
+    const sp_contact *old = history_find(e, x->a, x->b, type, fa, fb);
+    if (old) {
+        double m0 = v3_norm(old->xi);
+        xi = v3_axpy(-v3_dot(old->xi, n), n, old->xi);
+        double m1 = v3_norm(xi);
+        if (m1 > 0.0) xi = v3_scale(xi, m0 / m1);
+    }
+    xi = v3_axpy(x->h, vt, xi);
+    vec3 ft = dem_tangential_force(x->law, &xi, vt, fn, k, c);
+    sp_thread *t = x->t;
+    if (t->n == t->cap && grow((void **)&t->c, &t->cap, t->n + 1, sizeof(sp_contact))) {
+        t->oom = 1;
+        return;
+    }
+    sp_contact *o = &t->c[t->n++];
+    o->a = x->a;
+    o->b = x->b;
+    o->type = type;
+    o->fa = fa;
+    o->fb = fb;
+    o->xi = xi;
+    o->f = v3_axpy(fn, n, ft);
+    o->cp = cp;
+    o->delta = delta;
+}
+
+/* Features of one side of a pair: all of them, or the candidates from its feature grid. */
+typedef struct {
+    int body, nv, ne, nf;
+    const int *v, *e, *f; /* NULL = 0..n-1 */
+} sp_side;
+
+static inline int side_id(const int *list, int k) { return list ? list[k] : k; }
+
+/* Is world point p in the Voronoi region of vertex i of body g (all its edges point away)? */
+static int vertex_region(const lahar_dem_engine *e, const sp_geo *g, int i, vec3 p)
+{
+    vec3 vi = e->vw[g->v0 + i];
+    vec3 dp = v3_sub(p, vi);
+    for (int k = e->vadj_start[g->va0 + i]; k < e->vadj_start[g->va0 + i + 1]; k++)
+        if (v3_dot(dp, v3_sub(e->vw[g->v0 + e->vadj[k]], vi)) > 0.0) return 0;
+    return 1;
+}
+
+/* Does p project inside one of the faces adjacent to edge j of body g? (then vertex-face owns it) */
+static int edge_face_owns(const lahar_dem_engine *e, const sp_geo *g, int j, vec3 p)
+{
+    if (e->dim == 2) return 0;
+    for (int s = 0; s < 2; s++) {
+        int f = e->edge_face[g->e0 + j][s];
+        if (f < 0) continue;
+        int b = e->fstart[g->fs0 + f], m = e->fstart[g->fs0 + f + 1] - b;
+        int in;
+        geom_point_polygon(p, e->fw + b, m, e->nw[g->f0 + f], NULL, &in);
+        if (in) return 1;
+    }
+    return 0;
+}
+
+/* vertex i of body gv (side index sv: 0 = a, 1 = b) against face f of body gf */
+static void test_vertex_face(sp_pair_ctx *x, const sp_geo *gv, int i, const sp_geo *gf, int f, int v_is_a)
+{
+    const lahar_dem_engine *e = x->e;
+    vec3 p = e->vw[gv->v0 + i];
+    vec3 nrm = e->nw[gf->f0 + f];
+    double rsum = gv->radius + gf->radius;
+    double dplane = v3_dot(v3_sub(p, e->fw[e->fstart[gf->fs0 + f]]), nrm);
+    if (fabs(dplane) >= rsum) return;
+    int b = e->fstart[gf->fs0 + f], m = e->fstart[gf->fs0 + f + 1] - b;
+    vec3 c;
+    int in;
+    geom_point_polygon(p, e->fw + b, m, nrm, &c, &in);
+    if (!in) return; /* outside the face: an edge or vertex contact owns it */
+    vec3 side = dplane >= 0.0 ? nrm : v3_neg(nrm); /* from the face towards the vertex */
+    if (v_is_a) contact_emit(x, SP_VF, i, f, p, c, 0, 1, v3_neg(side));
+    else contact_emit(x, SP_FV, f, i, c, p, 1, 0, side);
+}
+
+static void test_vertex_edge(sp_pair_ctx *x, const sp_geo *gv, int i, const sp_geo *ge, int j, int v_is_a)
+{
+    const lahar_dem_engine *e = x->e;
+    vec3 p = e->vw[gv->v0 + i];
+    vec3 q0 = e->vw[ge->v0 + e->edge[ge->e0 + j][0]], q1 = e->vw[ge->v0 + e->edge[ge->e0 + j][1]];
+    vec3 c;
+    double t;
+    double rsum = gv->radius + ge->radius;
+    double d = geom_point_segment_param(p, q0, q1, &c, &t);
+    if (d >= rsum || t <= 0.0 || t >= 1.0) return; /* ends belong to vertex-vertex */
+    if (edge_face_owns(e, ge, j, p)) return;
+    vec3 dir = v3_normalize(v3_sub(e->st[x->b].x, e->st[x->a].x));
+    if (v_is_a) contact_emit(x, SP_VE, i, j, p, c, 0, 0, dir);
+    else contact_emit(x, SP_EV, j, i, c, p, 0, 0, dir);
+}
+
+static void pair_narrow(sp_pair_ctx *x, const sp_side *A, const sp_side *B)
+{
+    const lahar_dem_engine *e = x->e;
+    const sp_geo *ga = &e->geo[A->body], *gb = &e->geo[B->body];
+    double rsum = ga->radius + gb->radius;
+    int three_d = e->dim == 3;
+    vec3 dir_ab = v3_normalize(v3_sub(e->st[B->body].x, e->st[A->body].x));
+    if (three_d) {
+        for (int k = 0; k < A->nv; k++)
+            for (int l = 0; l < B->nf; l++) test_vertex_face(x, ga, side_id(A->v, k), gb, side_id(B->f, l), 1);
+        for (int l = 0; l < B->nv; l++)
+            for (int k = 0; k < A->nf; k++) test_vertex_face(x, gb, side_id(B->v, l), ga, side_id(A->f, k), 0);
+        /* edge-edge only when the closest points are interior to both edges and the edges are not
+         * parallel (then vertex-edge contacts at the ends carry the load) */
+        for (int k = 0; k < A->ne; k++) {
+            int i = side_id(A->e, k);
+            vec3 p0 = e->vw[ga->v0 + e->edge[ga->e0 + i][0]], p1 = e->vw[ga->v0 + e->edge[ga->e0 + i][1]];
+            vec3 da = v3_sub(p1, p0);
+            for (int l = 0; l < B->ne; l++) {
+                int j = side_id(B->e, l);
+                vec3 q0 = e->vw[gb->v0 + e->edge[gb->e0 + j][0]], q1 = e->vw[gb->v0 + e->edge[gb->e0 + j][1]];
+                vec3 db = v3_sub(q1, q0);
+                vec3 cr = v3_cross(da, db);
+                if (v3_norm2(cr) <= 1e-6 * v3_norm2(da) * v3_norm2(db)) continue; /* within ~0.06 deg */
+                vec3 cp, cq;
+                double s, t;
+                double d = geom_segment_segment_param(p0, p1, q0, q1, &s, &t, &cp, &cq);
+                if (d >= rsum || s <= 0.0 || s >= 1.0 || t <= 0.0 || t >= 1.0) continue;
+                vec3 fbn = v3_normalize(cr);
+                if (v3_dot(fbn, dir_ab) < 0.0) fbn = v3_neg(fbn);
+                contact_emit(x, SP_EE, i, j, cp, cq, 0, 0, fbn);
+            }
+        }
+    }
+    for (int k = 0; k < A->nv; k++)
+        for (int l = 0; l < B->ne; l++) test_vertex_edge(x, ga, side_id(A->v, k), gb, side_id(B->e, l), 1);
+    for (int l = 0; l < B->nv; l++)
+        for (int k = 0; k < A->ne; k++) test_vertex_edge(x, gb, side_id(B->v, l), ga, side_id(A->e, k), 0);
+    for (int k = 0; k < A->nv; k++) {
+        int i = side_id(A->v, k);
+        vec3 p = e->vw[ga->v0 + i];
+        for (int l = 0; l < B->nv; l++) {
+            int j = side_id(B->v, l);
+            vec3 q = e->vw[gb->v0 + j];
+            if (v3_norm2(v3_sub(p, q)) >= rsum * rsum) continue;
+            if (!vertex_region(e, gb, j, p) || !vertex_region(e, ga, i, q)) continue;
+            contact_emit(x, SP_VV, i, j, p, q, 0, 0, dir_ab);
+        }
+    }
+}
+
+/* All contacts of broad-phase pair (a, b), a < b, into the thread buffer. */
+static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread *t)
+{
+    const sp_geo *ga = &e->geo[a], *gb = &e->geo[b];
+    sp_pair_ctx x = {e, a, b, &e->laws[ga->material * e->nmat + gb->material], mstar_of(e, a, b), h, t};
+    sp_side A = {a, ga->nv, ga->ne, e->dim == 3 ? ga->nf : 0, NULL, NULL, NULL};
+    sp_side B = {b, gb->nv, gb->ne, e->dim == 3 ? gb->nf : 0, NULL, NULL, NULL};
+    /* a big body (feature grid) is reduced to the features near the other's bounding ball */
+    sp_side *big = NULL;
+    const sp_geo *gbig = NULL, *gsmall = NULL;
+    int ibig = -1, ismall = -1;
+    if (ga->grid >= 0 && (gb->grid < 0 || ga->nv + ga->ne + ga->nf >= gb->nv + gb->ne + gb->nf)) {
+        big = &A; gbig = ga; gsmall = gb; ibig = a; ismall = b;
+    } else if (gb->grid >= 0) {
+        big = &B; gbig = gb; gsmall = ga; ibig = b; ismall = a;
+    }
+    if (big) {
+        vec3 c = q_rotate_inv(e->st[ibig].q, v3_sub(e->st[ismall].x, e->st[ibig].x));
+        dem_feature_grid_query(&e->grids[gbig->grid], c, gsmall->bound, &t->fq);
+        big->nv = t->fq.nout[DEM_FEATURE_VERTEX];
+        big->ne = t->fq.nout[DEM_FEATURE_EDGE];
+        big->nf = e->dim == 3 ? t->fq.nout[DEM_FEATURE_FACE] : 0;
+        big->v = t->fq.out[DEM_FEATURE_VERTEX];
+        big->e = t->fq.out[DEM_FEATURE_EDGE];
+        big->f = t->fq.out[DEM_FEATURE_FACE];
+    }
+    pair_narrow(&x, &A, &B);
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Broad phase: free bodies binned by centre in a hashed uniform grid of cell >= the largest
+ * bounding diameter (so neighbours are within the 27 surrounding cells); fixed and prescribed
+ * bodies (few, possibly huge) are tested against every free body by box. O(N) per step. */
+
+static uint32_t cell_hash(long long x, long long y, long long z)
+{
+    uint64_t h = (uint64_t)x * 73856093ull ^ (uint64_t)y * 19349663ull ^ (uint64_t)z * 83492791ull;
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 32;
+    return (uint32_t)h;
+}
+
+static int add_pair(lahar_dem_engine *e, int a, int b)
+{
+    if (e->npair == e->pair_cap && grow((void **)&e->pairs, &e->pair_cap, e->npair + 1, sizeof(int[2]))) return -1;
+    e->pairs[e->npair][0] = a < b ? a : b;
+    e->pairs[e->npair][1] = a < b ? b : a;
+    e->npair++;
+    return 0;
+}
+
+static int broad_phase(lahar_dem_engine *e)
+{
+    e->npair = 0;
+    int nb = e->nbucket;
+    if (e->nfree > 0) {
+        double inv = 1.0 / e->cell;
+        memset(e->bucket_start, 0, sizeof(int) * (size_t)(nb + 1));
+        for (int k = 0; k < e->nfree; k++) {
+            const sp_state *s = &e->st[e->free_ids[k]];
+            e->cellc[k][0] = (long long)floor(s->x.x * inv);
+            e->cellc[k][1] = (long long)floor(s->x.y * inv);
+            e->cellc[k][2] = e->dim == 3 ? (long long)floor(s->x.z * inv) : 0;
+            e->bucket_start[(cell_hash(e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]) & (uint32_t)(nb - 1)) + 1]++;
+        }
+        for (int i = 0; i < nb; i++) e->bucket_start[i + 1] += e->bucket_start[i];
+        for (int k = 0; k < e->nfree; k++) {
+            uint32_t h = cell_hash(e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]) & (uint32_t)(nb - 1);
+            e->bucket_items[e->bucket_start[h]++] = k;
+        }
+        for (int i = nb; i > 0; i--) e->bucket_start[i] = e->bucket_start[i - 1];
+        e->bucket_start[0] = 0;
+        int zr = e->dim == 3 ? 1 : 0;
+        for (int k = 0; k < e->nfree; k++) {
+            int i = e->free_ids[k];
+            const sp_state *si = &e->st[i];
+            for (int dz = -zr; dz <= zr; dz++)
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        long long cx = e->cellc[k][0] + dx, cy = e->cellc[k][1] + dy, cz = e->cellc[k][2] + dz;
+                        uint32_t h = cell_hash(cx, cy, cz) & (uint32_t)(nb - 1);
+                        for (int m = e->bucket_start[h]; m < e->bucket_start[h + 1]; m++) {
+                            int l = e->bucket_items[m];
+                            int j = e->free_ids[l];
+                            if (j <= i || e->cellc[l][0] != cx || e->cellc[l][1] != cy || e->cellc[l][2] != cz) continue;
+                            double r = e->geo[i].bound + e->geo[j].bound;
+                            if (v3_norm2(v3_sub(e->st[j].x, si->x)) < r * r && add_pair(e, i, j)) return -1;
+                        }
+                    }
+        }
+    }
+    for (int k = 0; k < e->nfree; k++) {
+        int i = e->free_ids[k];
+        vec3 c = e->st[i].x;
+        double r = e->geo[i].bound;
+        for (int l = 0; l < e->nlarge; l++) {
+            const sp_geo *gl = &e->geo[e->large_ids[l]];
+            if (c.x + r < gl->aabb_lo.x || c.x - r > gl->aabb_hi.x || c.y + r < gl->aabb_lo.y ||
+                c.y - r > gl->aabb_hi.y || c.z + r < gl->aabb_lo.z || c.z - r > gl->aabb_hi.z)
+                continue;
+            if (add_pair(e, i, e->large_ids[l])) return -1;
+        }
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Forces                                                                                          */
+
+/* Contacts and contact forces at the current positions; h is the time since the last evaluation
+ * (advances the tangential springs). Returns 0, or -1 with err set. */
+static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
+{
+    if (broad_phase(e)) {
+        snprintf(err, errlen, "spheropoly: out of memory in the broad phase");
+        return -1;
+    }
+    int oom = 0;
+#pragma omp parallel num_threads(e->nthr) reduction(| : oom)
+    {
+        sp_thread *t = &e->thr[omp_get_thread_num()];
+        t->n = 0;
+        t->oom = 0;
+        /* static schedule: each thread takes one contiguous block of pairs in order, so
+         * concatenating the thread buffers in thread order gives the contacts in pair order */
+#pragma omp for schedule(static)
+        for (int p = 0; p < e->npair; p++) pair_contacts(e, e->pairs[p][0], e->pairs[p][1], h, t);
+        oom |= t->oom;
+    }
+    int total = 0;
+    for (int t = 0; t < e->nthr; t++) total += e->thr[t].n;
+    if (oom || total > e->contact_cap) {
+        int cap = e->contact_cap, cap2 = e->contact_cap;
+        if (oom || grow((void **)&e->cur, &cap, total, sizeof(sp_contact)) ||
+            grow((void **)&e->prev, &cap2, total, sizeof(sp_contact))) {
+            snprintf(err, errlen, "spheropoly: out of memory for %d contacts", total);
+            return -1;
+        }
+        e->contact_cap = cap < cap2 ? cap : cap2;
+    }
+    int n = 0;
+    for (int t = 0; t < e->nthr; t++) {
+        if (e->thr[t].n) memcpy(e->cur + n, e->thr[t].c, sizeof(sp_contact) * (size_t)e->thr[t].n);
+        n += e->thr[t].n;
+    }
+    /* the new contacts become the history of the next evaluation */
+    sp_contact *tmp = e->prev;
+    e->prev = e->cur;
+    e->cur = tmp;
+    e->nprev = n;
+    if (history_rebuild(e)) {
+        snprintf(err, errlen, "spheropoly: out of memory for the contact history");
+        return -1;
+    }
+    /* serial accumulation in contact order: bitwise deterministic for any thread count */
+    for (int i = 0; i < e->nbody; i++) {
+        e->st[i].fc = v3(0.0, 0.0, 0.0);
+        e->st[i].tc = v3(0.0, 0.0, 0.0);
+        e->ncontact_body[i] = 0;
+    }
+    for (int k = 0; k < n; k++) {
+        const sp_contact *c = &e->prev[k];
+        sp_state *sa = &e->st[c->a], *sb = &e->st[c->b];
+        sa->fc = v3_sub(sa->fc, c->f);
+        sb->fc = v3_add(sb->fc, c->f);
+        sa->tc = v3_sub(sa->tc, v3_cross(v3_sub(c->cp, sa->x), c->f));
+        sb->tc = v3_add(sb->tc, v3_cross(v3_sub(c->cp, sb->x), c->f));
+        e->ncontact_body[c->a]++;
+        e->ncontact_body[c->b]++;
+        double rmin = fmin(e->geo[c->a].radius, e->geo[c->b].radius);
+        if (c->delta > 0.5 * rmin) {
+            snprintf(err, errlen,
+                     "spheropoly: overlap %.3g m between bodies %d '%s' and %d '%s' exceeds half the smaller "
+                     "sweep radius %.3g m at substep %ld (time step too large or bodies interpenetrating)",
+                     c->delta, c->a, e->names[c->a], c->b, e->names[c->b], rmin, e->step);
+            return -1;
+        }
+    }
+    if (e->dim == 2)
+        for (int i = 0; i < e->nbody; i++) {
+            e->st[i].fc.z = 0.0;
+            e->st[i].tc.x = e->st[i].tc.y = 0.0;
+        }
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Integration                                                                                     */
+
+/* Exact free rotation about body axis k for time tau: the flow of H_k = Pi_k^2 / (2 I_k). */
+static void rotate_about_axis(quat *q, vec3 *pi, const double inertia[3], int k, double tau)
+{
+    if (!(inertia[k] > 0.0)) return;
+    double pk = v3_get(*pi, k);
+    double th = tau * pk / inertia[k];
+    vec3 axis = v3(k == 0, k == 1, k == 2);
+    *q = q_mul(*q, q_axis_angle(axis, th));
+    /* Pi is the body-frame angular momentum: the body turns by +th, Pi turns by -th */
+    double c = cos(th), s = sin(th);
+    if (k == 0) *pi = v3(pi->x, c * pi->y + s * pi->z, -s * pi->y + c * pi->z);
+    else if (k == 1) *pi = v3(c * pi->x - s * pi->z, pi->y, s * pi->x + c * pi->z);
+    else *pi = v3(c * pi->x + s * pi->y, -s * pi->x + c * pi->y, pi->z);
+}
+
+static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
+{
+    for (int k = 0; k < e->nfree; k++) {
+        int i = e->free_ids[k];
+        sp_state *s = &e->st[i];
+        double m = e->geo[i].mass;
+        vec3 f = v3_axpy(m, e->g, s->fc), t = s->tc;
+        if (loads) {
+            f = v3_add(f, v3_load(loads[i].force));
+            t = v3_add(t, v3_load(loads[i].torque));
+        }
+        if (e->dim == 2) {
+            f.z = 0.0;
+            t.x = t.y = 0.0;
+        }
+        s->v = v3_axpy(half / m, f, s->v);
+        s->L = v3_axpy(half, t, s->L);
+        body_update_omega(e, i);
+    }
+}
+
+static void drift(lahar_dem_engine *e, double h)
+{
+    for (int i = 0; i < e->nbody; i++) {
+        sp_geo *g = &e->geo[i];
+        sp_state *s = &e->st[i];
+        if (g->motion == LAHAR_MOTION_FIXED) continue;
+        s->x = v3_axpy(h, s->v, s->x);
+        if (g->motion == LAHAR_MOTION_PRESCRIBED) {
+            double wn = v3_norm(s->w);
+            if (wn > 0.0) s->q = q_normalize(q_mul(q_axis_angle(v3_scale(s->w, 1.0 / wn), wn * h), s->q));
+        } else if (e->dim == 2) {
+            s->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * s->L.z / g->inertia[2]), s->q));
+        } else {
+            /* symmetric splitting X(h/2) Y(h/2) Z(h) Y(h/2) X(h/2) of the free rigid body, each an
+             * exact rotation: Dullweber, Leimkuhler & McLachlan, J. Chem. Phys. 107 (1997) 5840 */
+            vec3 pi = q_rotate_inv(s->q, s->L);
+            rotate_about_axis(&s->q, &pi, g->inertia, 0, 0.5 * h);
+            rotate_about_axis(&s->q, &pi, g->inertia, 1, 0.5 * h);
+            rotate_about_axis(&s->q, &pi, g->inertia, 2, h);
+            rotate_about_axis(&s->q, &pi, g->inertia, 1, 0.5 * h);
+            rotate_about_axis(&s->q, &pi, g->inertia, 0, 0.5 * h);
+            s->q = q_normalize(s->q);
+        }
+        if (g->motion == LAHAR_MOTION_FREE) body_update_omega(e, i);
+        body_update_world(e, i);
+    }
+}
+
+static int check_finite(const lahar_dem_engine *e, char *err, size_t errlen)
+{
+    for (int k = 0; k < e->nfree; k++) {
+        int i = e->free_ids[k];
+        const sp_state *s = &e->st[i];
+        double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
+        if (!isfinite(sum)) {
+            snprintf(err, errlen, "spheropoly: body %d '%s' has a non-finite state at substep %ld", i,
+                     e->names[i], e->step);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loads, char *err, size_t errlen)
+{
+    if (!(dt > 0.0)) {
+        snprintf(err, errlen, "spheropoly: step %g must be positive", dt);
+        return -1;
+    }
+    double r = dt / e->dt_stable;
+    int n = r <= 1.0 ? 1 : (int)ceil(r);
+    double h = dt / n;
+    for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
+    for (int k = 0; k < n; k++) {
+        kick(e, 0.5 * h, loads);
+        drift(e, h);
+        e->step++;
+        if (compute_forces(e, h, err, errlen)) return -1;
+        kick(e, 0.5 * h, loads);
+        if (check_finite(e, err, errlen)) return -1;
+        for (int i = 0; i < e->nbody; i++) {
+            vec3 f = e->st[i].fc, t = e->st[i].tc;
+            if (loads) {
+                f = v3_add(f, v3_load(loads[i].force));
+                t = v3_add(t, v3_load(loads[i].torque));
+            }
+            e->rep_f[i] = v3_add(e->rep_f[i], f);
+            e->rep_t[i] = v3_add(e->rep_t[i], t);
+        }
+    }
+    for (int i = 0; i < e->nbody; i++) {
+        e->rep_f[i] = v3_scale(e->rep_f[i], 1.0 / n);
+        e->rep_t[i] = v3_scale(e->rep_t[i], 1.0 / n);
+    }
+    e->rep_n = n;
+    return n;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Setup                                                                                           */
+
+static void sp_destroy(lahar_dem_engine *e)
+{
+    if (!e) return;
+    for (int i = 0; i < e->ngrid; i++) dem_feature_grid_free(&e->grids[i]);
+    if (e->thr)
+        for (int t = 0; t < e->nthr; t++) {
+            free(e->thr[t].c);
+            dem_feature_query_free(&e->thr[t].fq);
+        }
+    free(e->thr);
+    free(e->grids);
+    free(e->geo);
+    free(e->st);
+    free(e->names);
+    free(e->laws);
+    free(e->vb);
+    free(e->vw);
+    free(e->vadj_start);
+    free(e->vadj);
+    free(e->edge);
+    free(e->edge_face);
+    free(e->fstart);
+    free(e->fv);
+    free(e->fw);
+    free(e->nb);
+    free(e->nw);
+    free(e->free_ids);
+    free(e->large_ids);
+    free(e->cellc);
+    free(e->bucket_start);
+    free(e->bucket_items);
+    free(e->pairs);
+    free(e->prev);
+    free(e->cur);
+    free(e->hash);
+    free(e->rep_f);
+    free(e->rep_t);
+    free(e->ncontact_body);
+    free(e);
+}
+
+/* Engine-wide stable step: dem_dt_safety x the shortest contact period over the free bodies and
+ * every material they may touch (see README: m* = m/2 against other free bodies, m against fixed
+ * ones; Hertz at the impact speed of a fall across the whole scene). */
+static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c)
+{
+    double safety = c->dem_dt_safety > 0.0 ? c->dem_dt_safety : 0.02;
+    vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
+    double vmax = 0.0, rmax = 0.0;
+    for (int i = 0; i < e->nbody; i++) {
+        const sp_geo *g = &e->geo[i];
+        for (int k = 0; k < g->nv; k++) {
+            vec3 w = e->vw[g->v0 + k];
+            lo = v3(fmin(lo.x, w.x), fmin(lo.y, w.y), fmin(lo.z, w.z));
+            hi = v3(fmax(hi.x, w.x), fmax(hi.y, w.y), fmax(hi.z, w.z));
+        }
+        double v = v3_norm(e->st[i].v) + v3_norm(e->st[i].w) * g->bound;
+        if (v > vmax) vmax = v;
+        if (g->radius > rmax) rmax = g->radius;
+    }
+    double extent = e->nbody > 0 ? v3_norm(v3_sub(hi, lo)) : 0.0;
+    double vimpact = vmax + sqrt(2.0 * v3_norm(e->g) * extent) + 1.0;
+    double period = DBL_MAX;
+    int nfree_all = e->nfree;
+    for (int k = 0; k < e->nfree; k++) {
+        const sp_geo *g = &e->geo[e->free_ids[k]];
+        for (int j = 0; j < e->nbody; j++) {
+            const sp_geo *o = &e->geo[j];
+            if (o->motion == LAHAR_MOTION_FREE && nfree_all < 2) continue;
+            double mstar = o->motion == LAHAR_MOTION_FREE ? 0.5 * g->mass : g->mass;
+            const dem_pair_law *law = &e->laws[g->material * e->nmat + o->material];
+            double rstar = fmax(g->radius, o->radius); /* largest R* gives the shortest Hertz contact */
+            double p = dem_contact_period(law, mstar, rstar, vimpact);
+            if (p < period) period = p;
+        }
+    }
+    (void)rmax;
+    if (period == DBL_MAX) period = c->dt_max > 0.0 ? c->dt_max / safety : 1.0;
+    return safety * period;
+}
+
+static int build_topology(lahar_dem_engine *e, int i, const lahar_shape *s, char *err, size_t errlen)
+{
+    sp_geo *g = &e->geo[i];
+    /* vertex neighbours through edges (CSR) */
+    int *deg = e->vadj_start + g->va0;
+    for (int k = 0; k <= s->nv; k++) deg[k] = 0;
+    for (int k = 0; k < s->ne; k++) {
+        int a = s->e[k][0], b = s->e[k][1];
+        if (a < 0 || a >= s->nv || b < 0 || b >= s->nv) {
+            snprintf(err, errlen, "spheropoly: body %d '%s': edge %d uses a missing vertex", i, e->names[i], k);
+            return -1;
+        }
+        deg[a + 1]++;
+        deg[b + 1]++;
+    }
+    for (int k = 0; k < s->nv; k++) deg[k + 1] += deg[k];
+    int base = 2 * g->e0; /* each body owns 2 ne adjacency slots from 2 e0 */
+    for (int k = 0; k <= s->nv; k++) deg[k] += base;
+    int *fill = malloc(sizeof(int) * (size_t)(s->nv + 1));
+    if (!fill) return -1;
+    memcpy(fill, deg, sizeof(int) * (size_t)(s->nv + 1));
+    for (int k = 0; k < s->ne; k++) {
+        int a = s->e[k][0], b = s->e[k][1];
+        e->vadj[fill[a]++] = b;
+        e->vadj[fill[b]++] = a;
+    }
+    free(fill);
+    /* faces adjacent to each edge: the faces using both its vertices consecutively */
+    for (int k = 0; k < s->ne; k++) e->edge_face[g->e0 + k][0] = e->edge_face[g->e0 + k][1] = -1;
+    for (int f = 0; f < s->nf; f++) {
+        int b0 = s->face_start[f], m = s->face_start[f + 1] - b0;
+        for (int j = 0; j < m; j++) {
+            int va = s->face_v[b0 + j], vb = s->face_v[b0 + (j + 1) % m];
+            for (int k = 0; k < s->ne; k++) {
+                if (!((s->e[k][0] == va && s->e[k][1] == vb) || (s->e[k][0] == vb && s->e[k][1] == va))) continue;
+                int *ef = e->edge_face[g->e0 + k];
+                if (ef[0] < 0) ef[0] = f;
+                else if (ef[1] < 0 && ef[0] != f) ef[1] = f;
+            }
+        }
+    }
+    return 0;
+}
+
+static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen)
+{
+    lahar_dem_engine *e = calloc(1, sizeof *e);
+    if (!e) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        return NULL;
+    }
+    e->dim = c->dim == 2 ? 2 : 3;
+    e->nbody = c->nbody;
+    e->nmat = c->nmaterial;
+    e->g = v3_load(c->gravity);
+    if (e->dim == 2) e->g.z = 0.0;
+    int nb = c->nbody > 0 ? c->nbody : 0;
+    if (e->nmat <= 0 && nb > 0) {
+        snprintf(err, errlen, "spheropoly: the case has bodies but no materials");
+        goto fail;
+    }
+    int nv = 0, ne = 0, nf = 0, nfv = 0;
+    for (int i = 0; i < nb; i++) {
+        const lahar_body *b = &c->bodies[i];
+        const lahar_shape *s = &b->shape;
+        if (b->material < 0 || b->material >= c->nmaterial) {
+            snprintf(err, errlen, "spheropoly: body %d '%s': material index %d out of range", i, b->name, b->material);
+            goto fail;
+        }
+        if (s->nv < 1 || !(s->radius > 0.0)) {
+            snprintf(err, errlen, "spheropoly: body %d '%s': needs at least one vertex and a sweep radius > 0", i, b->name);
+            goto fail;
+        }
+        if (b->motion == LAHAR_MOTION_FREE) {
+            int bad = !(b->mass > 0.0) || !(b->inertia[2] > 0.0);
+            if (e->dim == 3) bad |= !(b->inertia[0] > 0.0) || !(b->inertia[1] > 0.0);
+            if (bad) {
+                snprintf(err, errlen, "spheropoly: free body %d '%s' needs positive mass and principal inertia", i, b->name);
+                goto fail;
+            }
+        }
+        nv += s->nv;
+        ne += s->ne;
+        nf += s->nf;
+        nfv += s->nf > 0 ? s->face_start[s->nf] : 0;
+    }
+    e->geo = xcalloc((size_t)nb, sizeof *e->geo);
+    e->st = xcalloc((size_t)nb, sizeof *e->st);
+    e->names = xcalloc((size_t)nb, sizeof *e->names);
+    e->laws = xcalloc((size_t)(e->nmat * e->nmat), sizeof *e->laws);
+    e->vb = xcalloc((size_t)nv, sizeof(vec3));
+    e->vw = xcalloc((size_t)nv, sizeof(vec3));
+    e->vadj_start = xcalloc((size_t)(nv + nb), sizeof(int));
+    e->vadj = xcalloc((size_t)(2 * ne), sizeof(int));
+    e->edge = xcalloc((size_t)ne, sizeof(int[2]));
+    e->edge_face = xcalloc((size_t)ne, sizeof(int[2]));
+    e->fstart = xcalloc((size_t)(nf + nb), sizeof(int));
+    e->fv = xcalloc((size_t)nfv, sizeof(int));
+    e->fw = xcalloc((size_t)nfv, sizeof(vec3));
+    e->nb = xcalloc((size_t)nf, sizeof(vec3));
+    e->nw = xcalloc((size_t)nf, sizeof(vec3));
+    e->free_ids = xcalloc((size_t)nb, sizeof(int));
+    e->large_ids = xcalloc((size_t)nb, sizeof(int));
+    e->cellc = xcalloc((size_t)nb, sizeof(long long[3]));
+    e->grids = xcalloc((size_t)nb, sizeof(dem_feature_grid));
+    e->rep_f = xcalloc((size_t)nb, sizeof(vec3));
+    e->rep_t = xcalloc((size_t)nb, sizeof(vec3));
+    e->ncontact_body = xcalloc((size_t)nb, sizeof(int));
+    if (!e->geo || !e->st || !e->names || !e->laws || !e->vb || !e->vw || !e->vadj_start || !e->vadj || !e->edge ||
+        !e->edge_face || !e->fstart || !e->fv || !e->fw || !e->nb || !e->nw || !e->free_ids || !e->large_ids ||
+        !e->cellc || !e->grids || !e->rep_f || !e->rep_t || !e->ncontact_body) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        goto fail;
+    }
+    for (int a = 0; a < e->nmat; a++)
+        for (int b = 0; b < e->nmat; b++)
+            if (dem_pair_law_make(&c->materials[a], &c->materials[b], &e->laws[a * e->nmat + b], err, errlen)) goto fail;
+    int ov = 0, oe = 0, of = 0, ofv = 0, maxv = 0, maxe = 0, maxf = 0;
+    for (int i = 0; i < nb; i++) {
+        const lahar_body *b = &c->bodies[i];
+        const lahar_shape *s = &b->shape;
+        sp_geo *g = &e->geo[i];
+        snprintf(e->names[i], LAHAR_NAME_MAX, "%s", b->name);
+        g->nv = s->nv;
+        g->ne = s->ne;
+        g->nf = s->nf;
+        g->v0 = ov;
+        g->va0 = ov + i;
+        g->e0 = oe;
+        g->f0 = of;
+        g->fs0 = of + i;
+        g->radius = s->radius;
+        g->material = b->material;
+        g->motion = b->motion;
+        g->mass = b->mass;
+        memcpy(g->inertia, b->inertia, sizeof g->inertia);
+        g->grid = -1;
+        double rb = 0.0;
+        for (int k = 0; k < s->nv; k++) {
+            e->vb[ov + k] = v3_load(s->v[k]);
+            rb = fmax(rb, v3_norm(e->vb[ov + k]));
+        }
+        g->bound = rb + s->radius;
+        for (int k = 0; k < s->ne; k++) {
+            e->edge[oe + k][0] = s->e[k][0];
+            e->edge[oe + k][1] = s->e[k][1];
+        }
+        for (int f = 0; f < s->nf; f++) {
+            e->fstart[g->fs0 + f] = ofv + s->face_start[f];
+            e->nb[of + f] = geom_face_normal(s, f);
+        }
+        e->fstart[g->fs0 + s->nf] = ofv + (s->nf > 0 ? s->face_start[s->nf] : 0);
+        int nfvi = s->nf > 0 ? s->face_start[s->nf] : 0;
+        for (int k = 0; k < nfvi; k++) {
+            if (s->face_v[k] < 0 || s->face_v[k] >= s->nv) {
+                snprintf(err, errlen, "spheropoly: body %d '%s': face uses a missing vertex", i, b->name);
+                goto fail;
+            }
+            e->fv[ofv + k] = s->face_v[k];
+        }
+        if (build_topology(e, i, s, err, errlen)) goto fail;
+        sp_state *st = &e->st[i];
+        st->x = v3_load(b->x);
+        st->q = q_normalize(q_load(b->q));
+        if (e->dim == 2) { /* keep 2D exactly planar */
+            st->x.z = 0.0;
+            st->q.x = st->q.y = 0.0;
+            st->q = q_normalize(st->q);
+        }
+        st->v = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->v);
+        st->w = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->w);
+        if (e->dim == 2) {
+            st->v.z = 0.0;
+            st->w.x = st->w.y = 0.0;
+        }
+        if (b->motion == LAHAR_MOTION_FREE) {
+            if (e->dim == 2) st->L = v3(0.0, 0.0, g->inertia[2] * st->w.z);
+            else {
+                vec3 wb = q_rotate_inv(st->q, st->w);
+                st->L = q_rotate(st->q, v3(g->inertia[0] * wb.x, g->inertia[1] * wb.y, g->inertia[2] * wb.z));
+            }
+            e->free_ids[e->nfree++] = i;
+            e->cell = fmax(e->cell, 2.0 * g->bound);
+        } else {
+            e->large_ids[e->nlarge++] = i;
+        }
+        if (s->nv + s->ne + s->nf > SP_GRID_MIN_FEATURES) {
+            if (dem_feature_grid_build(&e->grids[e->ngrid], s)) {
+                e->ngrid++;
+                snprintf(err, errlen, "spheropoly: out of memory for the feature grid of body '%s'", b->name);
+                goto fail;
+            }
+            g->grid = e->ngrid++;
+            maxv = s->nv > maxv ? s->nv : maxv;
+            maxe = s->ne > maxe ? s->ne : maxe;
+            maxf = s->nf > maxf ? s->nf : maxf;
+        }
+        ov += s->nv;
+        oe += s->ne;
+        of += s->nf;
+        ofv += nfvi;
+        body_update_world(e, i);
+    }
+    e->cell *= 1.0 + 1e-9;
+    e->nbucket = 16;
+    while (e->nbucket < 2 * e->nfree) e->nbucket *= 2;
+    e->bucket_start = xcalloc((size_t)e->nbucket + 1, sizeof(int));
+    e->bucket_items = xcalloc((size_t)nb, sizeof(int));
+    e->nthr = omp_get_max_threads();
+    if (e->nthr < 1) e->nthr = 1;
+    e->thr = xcalloc((size_t)e->nthr, sizeof(sp_thread));
+    if (!e->bucket_start || !e->bucket_items || !e->thr) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        goto fail;
+    }
+    for (int t = 0; t < e->nthr; t++)
+        if (dem_feature_query_init(&e->thr[t].fq, maxv, maxe, maxf)) {
+            snprintf(err, errlen, "spheropoly: out of memory");
+            goto fail;
+        }
+    e->dt_stable = stable_dt_of(e, c);
+    if (compute_forces(e, 0.0, err, errlen)) goto fail;
+    return e;
+fail:
+    sp_destroy(e);
+    return NULL;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Queries and restart                                                                             */
+
+static double sp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
+static int sp_nbody(const lahar_dem_engine *e) { return e->nbody; }
+static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev; }
+
+static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
+{
+    const sp_state *s = &e->st[i];
+    v3_store(s->x, out->x);
+    q_store(s->q, out->q);
+    v3_store(s->v, out->v);
+    v3_store(s->w, out->w);
+}
+
+static void sp_get_report(const lahar_dem_engine *e, int i, lahar_body_report *out)
+{
+    if (e->rep_n > 0) {
+        v3_store(e->rep_f[i], out->force);
+        v3_store(e->rep_t[i], out->torque);
+    } else {
+        v3_store(e->st[i].fc, out->force);
+        v3_store(e->st[i].tc, out->torque);
+    }
+    out->ncontacts = e->ncontact_body[i];
+}
+
+static double sp_kinetic_energy(const lahar_dem_engine *e)
+{
+    double k = 0.0;
+    for (int j = 0; j < e->nfree; j++) {
+        int i = e->free_ids[j];
+        const sp_state *s = &e->st[i];
+        k += 0.5 * e->geo[i].mass * v3_norm2(s->v) + 0.5 * v3_dot(s->L, s->w);
+    }
+    return k;
+}
+
+static const char sp_magic[8] = {'L', 'H', 'R', 'S', 'P', 'R', 'S', '1'};
+
+static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
+{
+    int ok = fwrite(sp_magic, 1, 8, f) == 8;
+    ok = ok && fwrite(&e->nbody, sizeof(int), 1, f) == 1;
+    ok = ok && fwrite(&e->step, sizeof(long), 1, f) == 1;
+    ok = ok && fwrite(e->st, sizeof(sp_state), (size_t)e->nbody, f) == (size_t)e->nbody;
+    ok = ok && fwrite(&e->nprev, sizeof(int), 1, f) == 1;
+    ok = ok && fwrite(e->prev, sizeof(sp_contact), (size_t)e->nprev, f) == (size_t)e->nprev;
+    ok = ok && fwrite(e->ncontact_body, sizeof(int), (size_t)e->nbody, f) == (size_t)e->nbody;
+    return ok ? 0 : -1;
+}
+
+static int sp_read_restart(lahar_dem_engine *e, FILE *f)
+{
+    char magic[8];
+    int nbody, n;
+    long step;
+    if (fread(magic, 1, 8, f) != 8 || memcmp(magic, sp_magic, 8) != 0) return -1;
+    if (fread(&nbody, sizeof(int), 1, f) != 1 || nbody != e->nbody) return -1;
+    if (fread(&step, sizeof(long), 1, f) != 1) return -1;
+    if (fread(e->st, sizeof(sp_state), (size_t)nbody, f) != (size_t)nbody) return -1;
+    if (fread(&n, sizeof(int), 1, f) != 1 || n < 0) return -1;
+    int cap = e->contact_cap, cap2 = e->contact_cap;
+    if (grow((void **)&e->cur, &cap, n, sizeof(sp_contact)) || grow((void **)&e->prev, &cap2, n, sizeof(sp_contact)))
+        return -1;
+    e->contact_cap = cap < cap2 ? cap : cap2;
+    if (fread(e->prev, sizeof(sp_contact), (size_t)n, f) != (size_t)n) return -1;
+    if (fread(e->ncontact_body, sizeof(int), (size_t)nbody, f) != (size_t)nbody) return -1;
+    e->nprev = n;
+    e->step = step;
+    e->rep_n = 0;
+    for (int i = 0; i < e->nbody; i++) body_update_world(e, i);
+    return history_rebuild(e);
+}
+
+const lahar_dem_engine_ops lahar_dem_spheropoly_ops = {
+    .name = "spheropoly",
+    .version = "1.0",
+    .create = sp_create,
+    .stable_dt = sp_stable_dt,
+    .advance = sp_advance,
+    .nbody = sp_nbody,
+    .get_state = sp_get_state,
+    .get_report = sp_get_report,
+    .ncontacts = sp_ncontacts,
+    .kinetic_energy = sp_kinetic_energy,
+    .write_restart = sp_write_restart,
+    .read_restart = sp_read_restart,
+    .destroy = sp_destroy,
+};
