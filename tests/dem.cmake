@@ -9,3 +9,5 @@ endfunction()
 
 lahar_dem_test(test_geometry fast)
 lahar_dem_test(test_dem_bounce fast)
+lahar_dem_test(test_dem_incline fast)
+lahar_dem_test(test_dem_slide fast)

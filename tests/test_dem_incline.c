@@ -1,0 +1,72 @@
+/* Sphere (3D) and disc (2D) on an incline (reference 06 sec. 6.4): rolling without slip at
+ * a = 5/7 g sin(theta) (disc 2/3) when mu >= 2/7 tan(theta) (disc 1/3), sliding at
+ * a = g (sin(theta) - mu cos(theta)) otherwise; within 1 %. The incline is a horizontal floor
+ * with gravity tilted by theta (same physics, exact geometry). The acceleration is measured from
+ * the COM velocity between t = 0.2 s (after the start transient) and t = 1.2 s. */
+#include <math.h>
+#include <stdio.h>
+#include "dem_test_util.h"
+
+static double incline_accel(int dim, double theta, double mu, double *spin_ratio)
+{
+    const double g = 9.81, R = 0.05, rp = 0.01, kn = 1e6;
+    double gv[3] = {g * sin(theta), 0, 0};
+    gv[dim == 3 ? 2 : 1] = -g * cos(theta);
+    lahar_case c;
+    dem_test_case_init(&c, dim, gv, 2);
+    int m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, kn, 0, 0, 0.5, mu);
+    if (dim == 3) {
+        const double centre[3] = {4, 0, 0}, n[3] = {0, 0, 1}, size[2] = {10, 2};
+        dem_test_plane(&c, "slope", m, centre, n, size, rp);
+    } else {
+        const double a[3] = {-1, 0, 0}, b[3] = {9, 0, 0};
+        dem_test_segment(&c, "slope", m, a, b, rp);
+    }
+    double x[3] = {0, 0, 0};
+    int s = dem_test_sphere(&c, "ball", m, R, x, LAHAR_MOTION_FREE);
+    /* start at the static overlap so that the normal transient is small */
+    c.bodies[s].x[dim == 3 ? 2 : 1] = R + rp - c.bodies[s].mass * g * cos(theta) / kn;
+    const lahar_dem_engine_ops *ops;
+    lahar_dem_engine *e = dem_test_engine(&c, &ops);
+    const double dt = 1e-3, t1 = 0.2, t2 = 1.2;
+    double v1 = 0.0, v2 = 0.0, w2 = 0.0;
+    char err[512];
+    for (int k = 1; k <= (int)lround(t2 / dt); k++) {
+        if (ops->advance(e, dt, NULL, err, sizeof err) < 0) {
+            dem_test_check(0, "advance: %s", err);
+            break;
+        }
+        lahar_body_state st;
+        ops->get_state(e, s, &st);
+        if (k == (int)lround(t1 / dt)) v1 = st.v[0];
+        if (k == (int)lround(t2 / dt)) {
+            v2 = st.v[0];
+            w2 = dim == 3 ? st.w[1] : -st.w[2];
+        }
+    }
+    *spin_ratio = w2 * R / v2; /* 1 when rolling without slip */
+    ops->destroy(e);
+    dem_test_case_free(&c);
+    return (v2 - v1) / (t2 - t1);
+}
+
+int main(void)
+{
+    const double g = 9.81, th = 30.0 * M_PI / 180.0;
+    double spin;
+    /* sphere: threshold mu = 2/7 tan 30 = 0.165 */
+    double a = incline_accel(3, th, 0.5, &spin);
+    dem_test_rel("sphere rolling (mu 0.5) acceleration vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
+    dem_test_rel("sphere rolling: w R / v", spin, 1.0, 0.01);
+    a = incline_accel(3, th, 0.1, &spin);
+    dem_test_rel("sphere sliding (mu 0.1) acceleration vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
+    dem_test_check(spin < 0.9, "sphere sliding: w R / v = %.3f < 1 (slips)", spin);
+    /* disc: threshold mu = 1/3 tan 30 = 0.192 */
+    a = incline_accel(2, th, 0.5, &spin);
+    dem_test_rel("disc rolling (mu 0.5) acceleration vs 2/3 g sin", a, 2.0 / 3.0 * g * sin(th), 0.01);
+    dem_test_rel("disc rolling: w R / v", spin, 1.0, 0.01);
+    a = incline_accel(2, th, 0.1, &spin);
+    dem_test_rel("disc sliding (mu 0.1) acceleration vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
+    dem_test_check(spin < 0.9, "disc sliding: w R / v = %.3f < 1 (slips)", spin);
+    return dem_test_failures ? 1 : 0;
+}
