@@ -501,7 +501,8 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
         return -1;
     }
     int oom = 0;
-#pragma omp parallel num_threads(e->nthr) reduction(| : oom)
+    for (int t = 0; t < e->nthr; t++) e->thr[t].n = 0;
+#pragma omp parallel num_threads(e->nthr) reduction(| : oom) if (e->npair >= 32)
     {
         sp_thread *t = &e->thr[omp_get_thread_num()];
         t->n = 0;
@@ -513,7 +514,7 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
         oom |= t->oom;
     }
     int total = 0;
-    for (int t = 0; t < e->nthr; t++) total += e->thr[t].n;
+    for (int t = 0; t < e->nthr; t++) total += e->thr[t].n; /* threads beyond the team size left n = 0 */
     if (oom || total > e->contact_cap) {
         int cap = e->contact_cap, cap2 = e->contact_cap;
         if (oom || grow((void **)&e->cur, &cap, total, sizeof(sp_contact)) ||
