@@ -1,0 +1,18 @@
+# HDF5/XDMF writers, the SWMR force stream, `lahar check` evaluation, tools/ (brief D).
+# Python parts need python3 with h5py/numpy (Debian's python3-h5py): prefer /usr/bin/python3,
+# where Debian installs them (tools/*.py also re-exec themselves there when h5py is missing).
+find_program(LAHAR_OUTPUT_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT LAHAR_OUTPUT_PYTHON)
+  find_program(LAHAR_OUTPUT_PYTHON python3)
+endif()
+set(LAHAR_OUTPUT_TEST_DIR ${CMAKE_BINARY_DIR}/test_output_data)
+
+function(lahar_output_test name)
+  add_executable(${name} ${LAHAR_TEST_DIR}/${name}.c)
+  target_link_libraries(${name} PRIVATE lahar_common)
+endfunction()
+
+lahar_output_test(test_output)
+add_test(NAME output_writers COMMAND test_output ${LAHAR_OUTPUT_TEST_DIR}/writers)
+set_tests_properties(output_writers PROPERTIES LABELS "fast;output" TIMEOUT 120
+  FIXTURES_SETUP output_files)
