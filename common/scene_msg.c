@@ -1,0 +1,284 @@
+/* lahar_case <-> lahar_scene_t (see scene_msg.h). */
+#include "scene_msg.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "case.h"
+
+int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
+                              int64_t run_id, lahar_scene_t *m)
+{
+    memset(m, 0, sizeof *m);
+    m->run_id = run_id;
+    m->step = -1;
+    m->dim = c->dim;
+    memcpy(m->gravity, c->gravity, sizeof m->gravity);
+    m->t_end = c->t_end;
+    m->dt_max = c->dt_max;
+    m->dt_min = c->dt_min;
+    m->output_interval = c->output_interval;
+    m->forces_interval = c->forces_interval;
+    m->output_dir = (char *)output_dir;
+    m->case_path = (char *)c->path;
+    m->output_fields = (int32_t)c->output_fields;
+    m->output_forces = (int8_t)(c->output_forces != 0);
+    m->has_dem = (int8_t)(has_dem != 0);
+    m->has_sph = (int8_t)(has_sph != 0);
+    m->dem_engine = (char *)c->dem_engine;
+    m->dem_dt_safety = c->dem_dt_safety;
+    m->sph_dx = c->sph_dx;
+    m->sph_density = c->sph_density;
+
+    m->nmaterial = c->nmaterial;
+    m->materials = calloc((size_t)(c->nmaterial > 0 ? c->nmaterial : 1), sizeof *m->materials);
+    m->nbody = c->nbody;
+    m->bodies = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *m->bodies);
+    m->nblock = c->nblock;
+    size_t nbl = (size_t)(c->nblock > 0 ? c->nblock : 1);
+    m->block_lo = calloc(nbl, sizeof *m->block_lo);
+    m->block_hi = calloc(nbl, sizeof *m->block_hi);
+    m->block_v = calloc(nbl, sizeof *m->block_v);
+    m->block_name = calloc(nbl, sizeof *m->block_name);
+    if (!m->materials || !m->bodies || !m->block_lo || !m->block_hi || !m->block_v || !m->block_name)
+        goto fail;
+    for (int i = 0; i < c->nmaterial; i++) {
+        const lahar_material *a = &c->materials[i];
+        lahar_material_t *b = &m->materials[i];
+        b->name = (char *)a->name;
+        b->density = a->density;
+        b->young = a->young;
+        b->poisson = a->poisson;
+        b->kn = a->kn;
+        b->kt_ratio = a->kt_ratio;
+        b->restitution = a->restitution;
+        b->friction = a->friction;
+        b->model = (int8_t)a->model;
+    }
+    for (int i = 0; i < c->nbody; i++) {
+        const lahar_body *a = &c->bodies[i];
+        const lahar_shape *s = &a->shape;
+        lahar_body_t *b = &m->bodies[i];
+        b->id = i;
+        b->name = (char *)a->name;
+        b->material = a->material;
+        b->motion = (int8_t)a->motion;
+        b->convex = (int8_t)(a->convex != 0);
+        b->radius = s->radius;
+        b->nv = s->nv;
+        b->v = calloc((size_t)(s->nv > 0 ? s->nv : 1), sizeof *b->v);
+        b->ne = s->ne;
+        b->e = calloc((size_t)(s->ne > 0 ? s->ne : 1), sizeof *b->e);
+        b->nf = s->nf;
+        b->face_start = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_start);
+        b->face_nv = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_nv);
+        if (!b->v || !b->e || !b->face_start || !b->face_nv)
+            goto fail;
+        for (int k = 0; k < s->nv; k++)
+            b->v[k] = (double *)s->v[k];
+        for (int k = 0; k < s->ne; k++)
+            b->e[k] = (int32_t *)s->e[k];
+        for (int f = 0; f < s->nf; f++) {
+            b->face_start[f] = s->face_start[f];
+            b->face_nv[f] = s->face_start[f + 1] - s->face_start[f];
+        }
+        b->nfv = s->nf > 0 ? s->face_start[s->nf] : 0;
+        b->face_v = (int32_t *)s->face_v;
+        b->mass = a->mass;
+        memcpy(b->inertia, a->inertia, sizeof b->inertia);
+        memcpy(b->x, a->x, sizeof b->x);
+        memcpy(b->q, a->q, sizeof b->q);
+        memcpy(b->vel, a->v, sizeof b->vel);
+        memcpy(b->w, a->w, sizeof b->w);
+    }
+    for (int i = 0; i < c->nblock; i++) {
+        m->block_name[i] = (char *)c->blocks[i].name;
+        m->block_lo[i] = (double *)c->blocks[i].lo;
+        m->block_hi[i] = (double *)c->blocks[i].hi;
+        m->block_v[i] = (double *)c->blocks[i].v;
+    }
+    return 0;
+fail:
+    lahar_scene_msg_release(m);
+    return -1;
+}
+
+void lahar_scene_msg_release(lahar_scene_t *m)
+{
+    if (m->bodies)
+        for (int i = 0; i < m->nbody; i++) {
+            free(m->bodies[i].v);
+            free(m->bodies[i].e);
+            free(m->bodies[i].face_start);
+            free(m->bodies[i].face_nv);
+        }
+    free(m->materials);
+    free(m->bodies);
+    free(m->block_lo);
+    free(m->block_hi);
+    free(m->block_v);
+    free(m->block_name);
+    memset(m, 0, sizeof *m);
+}
+
+static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
+{
+    snprintf(dst, LAHAR_NAME_MAX, "%s", src ? src : "");
+}
+
+int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
+{
+    memset(c, 0, sizeof *c);
+    if (m->nmaterial < 0 || m->nbody < 0 || m->nblock < 0 || (m->dim != 2 && m->dim != 3)) {
+        snprintf(err, errlen, "malformed scene message (counts or dimension)");
+        return -1;
+    }
+    snprintf(c->path, sizeof c->path, "%s", m->case_path ? m->case_path : "");
+    c->dim = m->dim;
+    c->output_fields = (unsigned)m->output_fields;
+    c->output_forces = m->output_forces;
+    memcpy(c->gravity, m->gravity, sizeof c->gravity);
+    c->t_end = m->t_end;
+    c->dt_max = m->dt_max;
+    c->dt_min = m->dt_min;
+    c->output_interval = m->output_interval;
+    c->forces_interval = m->forces_interval;
+    scene_copy_name(c->dem_engine, m->dem_engine);
+    c->dem_dt_safety = m->dem_dt_safety;
+    c->sph_dx = m->sph_dx;
+    c->sph_density = m->sph_density;
+
+    c->materials = calloc((size_t)(m->nmaterial > 0 ? m->nmaterial : 1), sizeof *c->materials);
+    c->bodies = calloc((size_t)(m->nbody > 0 ? m->nbody : 1), sizeof *c->bodies);
+    c->blocks = calloc((size_t)(m->nblock > 0 ? m->nblock : 1), sizeof *c->blocks);
+    if (!c->materials || !c->bodies || !c->blocks)
+        goto oom;
+    c->nmaterial = m->nmaterial;
+    for (int i = 0; i < m->nmaterial; i++) {
+        const lahar_material_t *a = &m->materials[i];
+        lahar_material *b = &c->materials[i];
+        scene_copy_name(b->name, a->name);
+        b->density = a->density;
+        b->young = a->young;
+        b->poisson = a->poisson;
+        b->kn = a->kn;
+        b->kt_ratio = a->kt_ratio;
+        b->restitution = a->restitution;
+        b->friction = a->friction;
+        b->model = (lahar_contact_model)a->model;
+    }
+    c->nbody = m->nbody;
+    for (int i = 0; i < m->nbody; i++) {
+        const lahar_body_t *a = &m->bodies[i];
+        lahar_body *b = &c->bodies[i];
+        lahar_shape *s = &b->shape;
+        if (a->nv < 0 || a->ne < 0 || a->nf < 0 || a->nfv < 0 || a->material < 0 || a->material >= m->nmaterial) {
+            snprintf(err, errlen, "malformed scene message (body %d)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        scene_copy_name(b->name, a->name);
+        b->material = a->material;
+        b->motion = (lahar_motion)a->motion;
+        b->convex = a->convex;
+        s->radius = a->radius;
+        s->nv = a->nv;
+        s->ne = a->ne;
+        s->nf = a->nf;
+        s->v = malloc((size_t)(a->nv > 0 ? a->nv : 1) * sizeof *s->v);
+        s->e = malloc((size_t)(a->ne > 0 ? a->ne : 1) * sizeof *s->e);
+        s->face_start = malloc((size_t)(a->nf + 1) * sizeof *s->face_start);
+        s->face_v = malloc((size_t)(a->nfv > 0 ? a->nfv : 1) * sizeof *s->face_v);
+        if (!s->v || !s->e || !s->face_start || !s->face_v)
+            goto oom;
+        for (int k = 0; k < a->nv; k++)
+            memcpy(s->v[k], a->v[k], sizeof s->v[k]);
+        for (int k = 0; k < a->ne; k++) {
+            s->e[k][0] = a->e[k][0];
+            s->e[k][1] = a->e[k][1];
+        }
+        for (int f = 0; f < a->nf; f++)
+            s->face_start[f] = a->face_start[f];
+        s->face_start[a->nf] = a->nfv;
+        for (int k = 0; k < a->nfv; k++)
+            s->face_v[k] = a->face_v[k];
+        b->mass = a->mass;
+        memcpy(b->inertia, a->inertia, sizeof b->inertia);
+        memcpy(b->x, a->x, sizeof b->x);
+        memcpy(b->q, a->q, sizeof b->q);
+        memcpy(b->v, a->vel, sizeof b->v);
+        memcpy(b->w, a->w, sizeof b->w);
+    }
+    c->nblock = m->nblock;
+    for (int i = 0; i < m->nblock; i++) {
+        scene_copy_name(c->blocks[i].name, m->block_name[i]);
+        memcpy(c->blocks[i].lo, m->block_lo[i], sizeof c->blocks[i].lo);
+        memcpy(c->blocks[i].hi, m->block_hi[i], sizeof c->blocks[i].hi);
+        memcpy(c->blocks[i].v, m->block_v[i], sizeof c->blocks[i].v);
+    }
+    return 0;
+oom:
+    snprintf(err, errlen, "out of memory building the scene");
+    lahar_case_free(c);
+    return -1;
+}
+
+/* ---- node side of the start of a run ------------------------------------------------------- */
+#include <unistd.h>
+#include "lahar_hello_t.h"
+
+int lahar_node_join(lahar_link *l, int role, const char *engine, const char *version, const char *const *caps,
+                    int ncaps, double wait_s, lahar_node_scene *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    lahar_link_msg msg;
+    int rc = lahar_link_wait(l, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_HELLO, -1, (int)(wait_s * 1e3), &msg);
+    if (rc != LAHAR_LINK_OK) {
+        snprintf(err, errlen, "no coordinator announced a run within %.0f s", wait_s);
+        return rc;
+    }
+    char host[256] = "";
+    gethostname(host, sizeof host - 1);
+    lahar_hello_t hello = {
+        .run_id = lahar_link_run_id(l), .step = -1, .role = role, .engine = (char *)engine,
+        .version = (char *)version, .protocol_version = 1, .ncapabilities = ncaps,
+        .capabilities = (char **)caps, .host = host, .pid = (int32_t)getpid(),
+    };
+    int src;
+    LAHAR_LINK_SEND(src, l, LAHAR_FRAME_T_MSG_HELLO, lahar_hello_t, -1, &hello);
+    if (src != 0 || lahar_link_heartbeat_start(l, LAHAR_HEARTBEAT_PERIOD) != 0) {
+        snprintf(err, errlen, "cannot publish (transport error)");
+        return LAHAR_LINK_ERROR;
+    }
+    lahar_link_watch(l, LAHAR_ROLE_COORDINATOR, LAHAR_NODE_COORDINATOR_SILENCE);
+    rc = lahar_link_wait(l, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_SCENE, -1, -1, &msg);
+    if (rc == LAHAR_LINK_LOST)
+        snprintf(err, errlen, "the coordinator has been silent for %.0f s before sending the scene",
+                 LAHAR_NODE_COORDINATOR_SILENCE);
+    if (rc != LAHAR_LINK_OK)
+        return rc;
+    lahar_scene_t sm;
+    if (lahar_scene_t_decode(msg.data, 0, msg.size, &sm) < 0) {
+        snprintf(err, errlen, "undecodable scene message");
+        return LAHAR_LINK_ERROR;
+    }
+    int crc = lahar_scene_msg_to_case(&sm, &out->scene, err, errlen);
+    if (crc == 0) {
+        snprintf(out->output_dir, sizeof out->output_dir, "%s", sm.output_dir ? sm.output_dir : ".");
+        out->has_dem = sm.has_dem;
+        out->has_sph = sm.has_sph;
+    }
+    lahar_scene_t_decode_cleanup(&sm);
+    return crc == 0 ? LAHAR_LINK_OK : LAHAR_LINK_ERROR;
+}
+
+int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t *st)
+{
+    st->run_id = lahar_link_run_id(l);
+    st->step = step;
+    st->role = role;
+    if (!st->message)
+        st->message = (char *)"";
+    int rc;
+    LAHAR_LINK_SEND(rc, l, LAHAR_FRAME_T_MSG_STATUS, lahar_status_t, step, st);
+    return rc;
+}

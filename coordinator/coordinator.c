@@ -1,0 +1,662 @@
+/* The coordinator (see coordinator.h, protocol in lcm_types/README.md). */
+#define _GNU_SOURCE
+#include "coordinator.h"
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <libgen.h>
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/random.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include "dem_node.h"
+#include "lahar_hello_t.h"
+#include "lahar_status_t.h"
+#include "lahar_step_t.h"
+#include "lahar_stop_t.h"
+#include "link.h"
+#include "netns.h"
+#include "output.h"
+#include "scene_msg.h"
+#include "sph_node.h"
+#include "transport.h"
+
+#define COORD_NODE_SILENCE 2.0   /* s without a frame from a node: node lost */
+#define COORD_HELLO_PERIOD_MS 100
+#define COORD_STOP_WAIT 3.0      /* s the nodes get to exit after STOP */
+
+typedef struct {
+    int role;
+    const char *exe_name;        /* lahar-dem, lahar-sph */
+    int needed;
+    pid_t pid;                   /* spawned process, 0 if none */
+    int exited, exit_status;
+    pthread_t thread;            /* --in-process */
+    int thread_started;
+    _Atomic int thread_done;
+    int thread_status;
+    int joined;
+    /* from hello_t and status_t */
+    char engine[160], version[64], host[128], engine_desc[160];
+    int remote_pid;
+    double compute_s, wait_s;
+    int64_t substeps, last_step;
+    double dt_proposed, dt_stable, kinetic_energy;
+    int ncontacts;
+} coord_node;
+
+typedef struct {
+    const lahar_case *c;
+    const lahar_coord_options *o;
+    char outdir[PATH_MAX];
+    const char *url;
+    const char *mode;
+    lahar_transport *t;
+    lahar_link *link;
+    int64_t run_id;
+    coord_node node[LAHAR_NROLES];
+    int64_t steps;
+    double sim_time;
+    double wall0;
+    const char *status;
+    char message[1024];
+    int exit_status;
+    int progress;           /* progress line on stderr */
+    double last_progress;
+} coord;
+
+static volatile sig_atomic_t coord_interrupted;
+static void coord_on_sigint(int sig)
+{
+    (void)sig;
+    coord_interrupted = 1;
+}
+
+/* ---- nodes: processes or threads ----------------------------------------------------------- */
+
+typedef struct {
+    coord_node *n;
+    const char *url;
+    int64_t run_id;
+    int threads;
+} coord_thread_arg;
+static coord_thread_arg coord_thread_args[LAHAR_NROLES];
+
+static void *coord_node_thread(void *arg)
+{
+    coord_thread_arg *a = arg;
+    if (a->n->role == LAHAR_ROLE_DEM) {
+        lahar_dem_node_options o = {.lcm_url = a->url, .run_id = a->run_id, .threads = a->threads};
+        a->n->thread_status = lahar_dem_node_run(&o);
+    } else {
+        lahar_sph_node_options o = {.lcm_url = a->url, .run_id = a->run_id, .threads = a->threads};
+        a->n->thread_status = lahar_sph_node_run(&o);
+    }
+    atomic_store(&a->n->thread_done, 1);
+    return NULL;
+}
+
+static int coord_exe_dir(char *dir, size_t n)
+{
+    char self[PATH_MAX];
+    ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (len <= 0)
+        return -1;
+    self[len] = '\0';
+    snprintf(dir, n, "%s", dirname(self));
+    return 0;
+}
+
+static int coord_start_node(coord *co, coord_node *n)
+{
+    if (co->o->in_process) {
+        coord_thread_arg *a = &coord_thread_args[n->role];
+        a->n = n;
+        a->url = co->url;
+        a->run_id = co->run_id;
+        a->threads = co->o->threads;
+        if (pthread_create(&n->thread, NULL, coord_node_thread, a) != 0) {
+            fprintf(stderr, "lahar: cannot start the %s thread\n", lahar_link_role_name(n->role));
+            return -1;
+        }
+        n->thread_started = 1;
+        return 0;
+    }
+    char dir[PATH_MAX], exe[PATH_MAX + 32], run[32], threads[16];
+    if (coord_exe_dir(dir, sizeof dir) != 0) {
+        fprintf(stderr, "lahar: cannot find my own executable (/proc/self/exe)\n");
+        return -1;
+    }
+    snprintf(exe, sizeof exe, "%s/%s", dir, n->exe_name);
+    if (access(exe, X_OK) != 0) {
+        fprintf(stderr, "lahar: %s not found next to lahar (%s); build it or use --in-process\n", n->exe_name, exe);
+        return -1;
+    }
+    snprintf(run, sizeof run, "%lld", (long long)co->run_id);
+    snprintf(threads, sizeof threads, "%d", co->o->threads);
+    char *argv[] = {exe, "--lcm-url", (char *)co->url, "--run-id", run, "--threads", threads, NULL};
+    pid_t parent = getpid();
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid < 0) {
+        fprintf(stderr, "lahar: fork: %s\n", strerror(errno));
+        return -1;
+    }
+    if (pid == 0) {
+        /* never outlive the coordinator; Ctrl-C is the coordinator's to handle */
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent)
+            _exit(3);
+        signal(SIGINT, SIG_IGN);
+        execv(exe, argv);
+        fprintf(stderr, "lahar: exec %s: %s\n", exe, strerror(errno));
+        _exit(127);
+    }
+    n->pid = pid;
+    return 0;
+}
+
+/* Reap a node that has ended; 1 if it has (exit status recorded). */
+static int coord_node_ended(coord_node *n)
+{
+    if (n->exited)
+        return 1;
+    if (n->pid > 0) {
+        int st;
+        if (waitpid(n->pid, &st, WNOHANG) == n->pid) {
+            n->exited = 1;
+            n->exit_status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+        }
+    } else if (n->thread_started && atomic_load(&n->thread_done)) {
+        pthread_join(n->thread, NULL);
+        n->joined = 1;
+        n->exited = 1;
+        n->exit_status = n->thread_status;
+    } else if (!n->thread_started) {
+        n->exited = 1;
+    }
+    return n->exited;
+}
+
+/* ---- messages ------------------------------------------------------------------------------ */
+
+static void coord_send_stop(coord *co, int reason, const char *message)
+{
+    lahar_stop_t s = {.run_id = co->run_id, .step = co->steps - 1, .reason = reason, .message = (char *)message};
+    int rc;
+    LAHAR_LINK_SEND(rc, co->link, LAHAR_FRAME_T_MSG_STOP, lahar_stop_t, s.step, &s);
+    (void)rc;
+}
+
+/* After STOP: give the nodes time to exit (re-sending STOP in case it was lost), then end them. */
+static void coord_finish_nodes(coord *co)
+{
+    double until = lahar_now() + COORD_STOP_WAIT;
+    for (;;) {
+        int all = 1;
+        for (int r = 1; r < LAHAR_NROLES; r++)
+            all &= coord_node_ended(&co->node[r]);
+        if (all || lahar_now() > until)
+            break;
+        lahar_link_poll(co->link, 100);
+        lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STOP, co->steps - 1);
+    }
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        coord_node *n = &co->node[r];
+        if (n->pid > 0 && !n->exited) {
+            kill(n->pid, SIGKILL);
+            int st;
+            waitpid(n->pid, &st, 0);
+            n->exited = 1;
+            n->exit_status = 128 + SIGKILL;
+        }
+        if (n->thread_started && !n->joined) {
+            /* a node thread that ignores STOP cannot be killed; the process exit ends it */
+            pthread_detach(n->thread);
+            n->joined = 1;
+        }
+    }
+}
+
+static void coord_read_hello(coord_node *n, const lahar_link_msg *m)
+{
+    lahar_hello_t h;
+    if (lahar_hello_t_decode(m->data, 0, m->size, &h) < 0)
+        return;
+    snprintf(n->engine, sizeof n->engine, "%s", h.engine ? h.engine : "");
+    snprintf(n->version, sizeof n->version, "%s", h.version ? h.version : "");
+    snprintf(n->host, sizeof n->host, "%s", h.host ? h.host : "");
+    n->remote_pid = h.pid;
+    lahar_hello_t_decode_cleanup(&h);
+}
+
+static int coord_hello(coord *co)
+{
+    char host[256] = "";
+    gethostname(host, sizeof host - 1);
+    lahar_hello_t h = {
+        .run_id = co->run_id, .step = -1, .role = LAHAR_ROLE_COORDINATOR, .engine = "lahar-coordinator",
+        .version = LAHAR_VERSION, .protocol_version = 1, .ncapabilities = 0, .capabilities = NULL, .host = host,
+        .pid = (int32_t)getpid(),
+    };
+    int rc;
+    LAHAR_LINK_SEND(rc, co->link, LAHAR_FRAME_T_MSG_HELLO, lahar_hello_t, -1, &h);
+    if (rc != 0) {
+        snprintf(co->message, sizeof co->message, "cannot publish on %s", co->url);
+        return LAHAR_EXIT_SETUP;
+    }
+    double wait_s = co->o->join_wait_s > 0 ? co->o->join_wait_s : 30.0;
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        coord_node *n = &co->node[r];
+        if (!n->needed)
+            continue;
+        double until = lahar_now() + wait_s;
+        lahar_link_msg m;
+        for (;;) {
+            rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_HELLO, -1, COORD_HELLO_PERIOD_MS, &m);
+            if (rc == LAHAR_LINK_OK)
+                break;
+            if (coord_interrupted) {
+                snprintf(co->message, sizeof co->message, "interrupted while waiting for the %s", lahar_link_role_name(r));
+                return LAHAR_EXIT_SETUP;
+            }
+            if ((n->pid > 0 || n->thread_started) && coord_node_ended(n)) {
+                snprintf(co->message, sizeof co->message, "the %s (%s) ended with status %d before joining the run",
+                         lahar_link_role_name(r), n->exe_name, n->exit_status);
+                return LAHAR_EXIT_SETUP;
+            }
+            if (lahar_now() > until) {
+                snprintf(co->message, sizeof co->message,
+                         "the %s did not answer within %.0f s on %s%s", lahar_link_role_name(r), wait_s, co->url,
+                         co->o->no_spawn ? " (with --no-spawn, start it yourself: see lahar run --help)" : "");
+                return LAHAR_EXIT_SETUP;
+            }
+            /* nodes started by hand learn the run id from this announcement */
+            lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_HELLO, -1);
+        }
+        coord_read_hello(n, &m);
+        lahar_link_watch(co->link, r, COORD_NODE_SILENCE);
+    }
+    return LAHAR_EXIT_OK;
+}
+
+/* Wait for STATUS(k) of every node; fills the node records. */
+static int coord_collect_status(coord *co, int64_t k)
+{
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        coord_node *n = &co->node[r];
+        if (!n->needed)
+            continue;
+        lahar_link_msg m;
+        int rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, -1, &m);
+        if (rc == LAHAR_LINK_LOST) {
+            int lost = lahar_link_lost_role(co->link);
+            coord_node *ln = &co->node[lost];
+            int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
+                                                                                 : lahar_link_peer_step(co->link, lost);
+            snprintf(co->message, sizeof co->message,
+                     "the %s%s has been silent for %.1f s; last completed step %lld (t = %.9g s)",
+                     lahar_link_role_name(lost), ln->pid > 0 ? " (lahar process died or hangs)" : "",
+                     COORD_NODE_SILENCE, (long long)last, co->sim_time);
+            co->status = "node lost";
+            return LAHAR_EXIT_NODE_LOST;
+        }
+        if (rc != LAHAR_LINK_OK) {
+            snprintf(co->message, sizeof co->message, "link error waiting for the %s", lahar_link_role_name(r));
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        lahar_status_t s;
+        if (lahar_status_t_decode(m.data, 0, m.size, &s) < 0) {
+            snprintf(co->message, sizeof co->message, "undecodable STATUS(%lld) from the %s", (long long)k,
+                     lahar_link_role_name(r));
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        int err = s.error;
+        if (err)
+            snprintf(co->message, sizeof co->message, "the %s reports at step %lld: %s", lahar_link_role_name(r),
+                     (long long)k, s.message ? s.message : "(no message)");
+        else if (k < 0)
+            snprintf(n->engine_desc, sizeof n->engine_desc, "%s", s.message ? s.message : "");
+        n->compute_s += s.compute_s;
+        n->wait_s += s.wait_s;
+        n->substeps += s.nsubsteps;
+        n->dt_proposed = s.dt_proposed;
+        n->dt_stable = s.dt_stable;
+        n->kinetic_energy = s.kinetic_energy;
+        n->ncontacts = s.ncontacts;
+        if (!err)
+            n->last_step = k;
+        lahar_status_t_decode_cleanup(&s);
+        if (err) {
+            co->status = "error";
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+    }
+    return LAHAR_EXIT_OK;
+}
+
+static void coord_progress(coord *co, int final)
+{
+    if (!co->progress)
+        return;
+    double now = lahar_now();
+    if (!final && now - co->last_progress < 0.25)
+        return;
+    co->last_progress = now;
+    double wall = now - co->wall0;
+    double rate = wall > 0 ? (double)co->steps / wall : 0.0;
+    double frac = co->c->t_end > 0 ? co->sim_time / co->c->t_end : 1.0;
+    double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
+    fprintf(stderr, "\r  t = %.4g / %.4g s   step %lld   %.0f steps/s   ETA %.0f s   ", co->sim_time, co->c->t_end,
+            (long long)co->steps, rate, eta);
+    if (final)
+        fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static int coord_lockstep(coord *co)
+{
+    const lahar_case *c = co->c;
+    lahar_clock clk;
+    lahar_clock_init(&clk, c->t_end, c->output_interval);
+    double dt_allowed = c->dt_max;
+    for (int r = 1; r < LAHAR_NROLES; r++)
+        if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed < dt_allowed)
+            dt_allowed = co->node[r].dt_proposed;
+    for (int64_t k = 0;; k++) {
+        if (coord_interrupted) {
+            co->status = "interrupted";
+            snprintf(co->message, sizeof co->message, "interrupted at step %lld (t = %.9g s)", (long long)k, co->sim_time);
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        if (dt_allowed < c->dt_min) {
+            co->status = "error";
+            snprintf(co->message, sizeof co->message,
+                     "time step collapse at step %lld (t = %.9g s): the nodes allow %.3g s < dt_min = %.3g s", (long long)k,
+                     co->sim_time, dt_allowed, c->dt_min);
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        double t, t_next;
+        int is_output;
+        if (lahar_clock_next(&clk, dt_allowed, &t, &t_next, &is_output))
+            return LAHAR_EXIT_OK;
+        int write_forces = 1;
+        if (c->forces_interval > 0)
+            write_forces = k == 0 || floor(t_next / c->forces_interval + 1e-9) > floor(t / c->forces_interval + 1e-9);
+        lahar_step_t s = {
+            .run_id = co->run_id, .step = k, .t = t, .dt = t_next - t, .t_next = t_next,
+            .write_output = (int8_t)is_output, .write_forces = (int8_t)write_forces,
+        };
+        int rc;
+        LAHAR_LINK_SEND(rc, co->link, LAHAR_FRAME_T_MSG_STEP, lahar_step_t, k, &s);
+        if (rc != 0) {
+            co->status = "error";
+            snprintf(co->message, sizeof co->message, "cannot publish STEP(%lld)", (long long)k);
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        rc = coord_collect_status(co, k);
+        if (rc != LAHAR_EXIT_OK)
+            return rc;
+        lahar_clock_advance(&clk);
+        lahar_link_set_step(co->link, k);
+        co->steps = k + 1;
+        co->sim_time = t_next;
+        dt_allowed = c->dt_max;
+        for (int r = 1; r < LAHAR_NROLES; r++)
+            if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed < dt_allowed)
+                dt_allowed = co->node[r].dt_proposed;
+        coord_progress(co, 0);
+    }
+}
+
+/* ---- summary ------------------------------------------------------------------------------- */
+
+static void coord_write_summary(coord *co)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "status", co->status);
+    cJSON_AddNumberToObject(root, "exit_status", co->exit_status);
+    cJSON_AddStringToObject(root, "message", co->message);
+    cJSON_AddStringToObject(root, "case", co->c->path);
+    cJSON_AddStringToObject(root, "output_dir", co->outdir);
+    cJSON_AddStringToObject(root, "mode", co->mode);
+    cJSON_AddStringToObject(root, "lcm_url", co->url ? co->url : "");
+    char run[32];
+    snprintf(run, sizeof run, "%016llx", (unsigned long long)co->run_id);
+    cJSON_AddStringToObject(root, "run_id", run);
+    cJSON_AddNumberToObject(root, "steps", (double)co->steps);
+    cJSON_AddNumberToObject(root, "sim_time", co->sim_time);
+    cJSON_AddNumberToObject(root, "t_end", co->c->t_end);
+    double wall = lahar_now() - co->wall0;
+    cJSON_AddNumberToObject(root, "wall_time_s", wall);
+    cJSON_AddNumberToObject(root, "steps_per_s", wall > 0 ? (double)co->steps / wall : 0.0);
+    cJSON_AddNumberToObject(root, "coordinator_wait_s", co->link ? lahar_link_wait_seconds(co->link) : 0.0);
+    cJSON *nodes = cJSON_AddObjectToObject(root, "nodes");
+    int64_t dem_substeps = 0;
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        coord_node *n = &co->node[r];
+        if (!n->needed)
+            continue;
+        cJSON *j = cJSON_AddObjectToObject(nodes, r == LAHAR_ROLE_DEM ? "dem" : "sph");
+        cJSON_AddStringToObject(j, "engine", n->engine);
+        cJSON_AddStringToObject(j, "engine_detail", n->engine_desc);
+        cJSON_AddStringToObject(j, "version", n->version);
+        cJSON_AddStringToObject(j, "host", n->host);
+        cJSON_AddNumberToObject(j, "pid", n->remote_pid);
+        cJSON_AddNumberToObject(j, "compute_s", n->compute_s);
+        cJSON_AddNumberToObject(j, "wait_s", n->wait_s);
+        cJSON_AddNumberToObject(j, "last_step", (double)n->last_step);
+        cJSON_AddNumberToObject(j, "dt_stable", n->dt_stable);
+        cJSON_AddNumberToObject(j, "kinetic_energy", n->kinetic_energy);
+        cJSON_AddNumberToObject(j, "contacts", n->ncontacts);
+        if (r == LAHAR_ROLE_DEM) {
+            cJSON_AddNumberToObject(j, "substeps", (double)n->substeps);
+            dem_substeps = n->substeps;
+        }
+        cJSON_AddNumberToObject(j, "exit_status", n->exit_status);
+    }
+    cJSON_AddNumberToObject(root, "dem_substeps", (double)dem_substeps);
+    /* Traffic as seen by the coordinator: what it sent, and every frame of the run it heard
+     * (it listens on all channels, so node-to-node traffic is included). */
+    cJSON *ch = cJSON_AddObjectToObject(root, "channels");
+    uint64_t resent = 0;
+    if (co->link) {
+        lahar_link_stats st[LAHAR_NMSG];
+        lahar_link_get_stats(co->link, st);
+        for (int ty = 1; ty < LAHAR_NMSG; ty++) {
+            const lahar_link_stats *s = &st[ty];
+            cJSON *j = cJSON_AddObjectToObject(ch, lahar_link_channel(ty));
+            cJSON_AddNumberToObject(j, "messages", (double)(s->msgs_sent + s->msgs_heard));
+            cJSON_AddNumberToObject(j, "bytes", (double)(s->bytes_sent + s->bytes_resent + s->bytes_heard));
+            cJSON_AddNumberToObject(j, "frames", (double)(s->frames_sent + s->frames_resent + s->frames_heard));
+            cJSON_AddNumberToObject(j, "resent_frames", (double)(s->frames_resent + s->frames_resent_heard));
+            cJSON_AddNumberToObject(j, "sent_messages", (double)s->msgs_sent);
+            cJSON_AddNumberToObject(j, "sent_bytes", (double)(s->bytes_sent + s->bytes_resent));
+            cJSON_AddNumberToObject(j, "heard_messages", (double)s->msgs_heard);
+            cJSON_AddNumberToObject(j, "heard_bytes", (double)s->bytes_heard);
+            cJSON_AddNumberToObject(j, "nacks_sent", (double)s->nacks_sent);
+            resent += s->frames_resent + s->frames_resent_heard;
+        }
+    }
+    cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
+    char *text = cJSON_Print(root);
+    char path[PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/summary.json", co->outdir);
+    FILE *f = fopen(path, "w");
+    if (f && text) {
+        fputs(text, f);
+        fputc('\n', f);
+    }
+    if (f)
+        fclose(f);
+    else
+        fprintf(stderr, "lahar: cannot write %s: %s\n", path, strerror(errno));
+    free(text);
+    cJSON_Delete(root);
+}
+
+/* ---- entry --------------------------------------------------------------------------------- */
+
+static int coord_mkdir_p(const char *path)
+{
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", path);
+    for (char *p = tmp + 1; *p; p++)
+        if (*p == '/') {
+            *p = '\0';
+            if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
+                return -1;
+            *p = '/';
+        }
+    return (mkdir(tmp, 0777) != 0 && errno != EEXIST) ? -1 : 0;
+}
+
+static int64_t coord_random_run_id(void)
+{
+    uint64_t r = 0;
+    if (getrandom(&r, sizeof r, 0) != (ssize_t)sizeof r) {
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        r = (uint64_t)ts.tv_nsec ^ ((uint64_t)ts.tv_sec << 20) ^ ((uint64_t)getpid() << 40);
+    }
+    r &= 0x7fffffffffffffffull; /* positive, so that it prints the same everywhere */
+    return r ? (int64_t)r : 1;
+}
+
+int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
+{
+    coord co;
+    memset(&co, 0, sizeof co);
+    co.c = c;
+    co.o = o;
+    co.status = "error";
+    co.wall0 = lahar_now();
+    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = c->nbody > 0, .last_step = -1};
+    co.node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
+    if (!co.node[LAHAR_ROLE_DEM].needed && !co.node[LAHAR_ROLE_SPH].needed) {
+        fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
+        return LAHAR_EXIT_SETUP;
+    }
+    if (coord_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
+        fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", o->outdir, strerror(errno));
+        return LAHAR_EXIT_SETUP;
+    }
+
+    /* Where the messages go. Default: a private network namespace of our own. */
+    char err[1024];
+    const char *env_url = getenv("LCM_DEFAULT_URL");
+    if (o->in_process) {
+        co.url = "memq://";
+        co.mode = "in-process";
+    } else if (o->lcm_url || env_url) {
+        co.url = o->lcm_url ? o->lcm_url : env_url;
+        co.mode = o->no_spawn ? "no-spawn" : "processes";
+        if (strncmp(co.url, "udpm://", 7) == 0 && !strstr(co.url, "recv_buf_size"))
+            fprintf(stderr, "lahar: warning: %s has no recv_buf_size; large messages may be lost "
+                            "(add ?recv_buf_size=8388608)\n", co.url);
+    } else {
+        if (lahar_netns_enter(err, sizeof err) != 0) {
+            fprintf(stderr, "lahar: %s\n", err);
+            return LAHAR_EXIT_SETUP;
+        }
+        co.url = LAHAR_NETNS_URL;
+        co.mode = o->no_spawn ? "no-spawn" : "processes";
+    }
+    co.run_id = coord_random_run_id();
+    co.progress = !o->quiet && isatty(STDERR_FILENO);
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = coord_on_sigint;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    int status = LAHAR_EXIT_SETUP;
+    co.t = lahar_transport_open(co.url, err, sizeof err);
+    if (!co.t) {
+        snprintf(co.message, sizeof co.message, "%s", err);
+        goto out;
+    }
+    co.link = lahar_link_create(co.t, LAHAR_ROLE_COORDINATOR, co.run_id,
+                                LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STATUS), err,
+                                sizeof err);
+    if (!co.link) {
+        snprintf(co.message, sizeof co.message, "%s", err);
+        goto out;
+    }
+    if (!o->no_spawn)
+        for (int r = 1; r < LAHAR_NROLES; r++)
+            if (co.node[r].needed && coord_start_node(&co, &co.node[r]) != 0) {
+                snprintf(co.message, sizeof co.message, "cannot start the %s", lahar_link_role_name(r));
+                goto stop;
+            }
+    if (o->no_spawn && !o->quiet)
+        fprintf(stderr, "lahar: run %lld on %s: waiting for%s%s (start them with --lcm-url '%s')\n",
+                (long long)co.run_id, co.url, co.node[LAHAR_ROLE_DEM].needed ? " lahar-dem" : "",
+                co.node[LAHAR_ROLE_SPH].needed ? " lahar-sph" : "", co.url);
+    lahar_link_set_step(co.link, -1);
+    if (lahar_link_heartbeat_start(co.link, LAHAR_HEARTBEAT_PERIOD) != 0) {
+        snprintf(co.message, sizeof co.message, "cannot start the heartbeat thread");
+        goto out;
+    }
+    status = coord_hello(&co);
+    if (status != LAHAR_EXIT_OK)
+        goto stop;
+
+    lahar_scene_t sm;
+    if (lahar_scene_msg_from_case(c, co.outdir, co.node[LAHAR_ROLE_DEM].needed, co.node[LAHAR_ROLE_SPH].needed,
+                                  co.run_id, &sm) != 0) {
+        snprintf(co.message, sizeof co.message, "out of memory");
+        status = LAHAR_EXIT_SETUP;
+        goto stop;
+    }
+    int rc;
+    LAHAR_LINK_SEND(rc, co.link, LAHAR_FRAME_T_MSG_SCENE, lahar_scene_t, -1, &sm);
+    lahar_scene_msg_release(&sm);
+    if (rc != 0) {
+        snprintf(co.message, sizeof co.message, "cannot publish the scene");
+        status = LAHAR_EXIT_SETUP;
+        goto stop;
+    }
+    status = coord_collect_status(&co, -1);
+    if (status != LAHAR_EXIT_OK)
+        goto stop;
+    status = coord_lockstep(&co);
+    if (status == LAHAR_EXIT_OK)
+        co.status = "finished";
+stop:
+    coord_progress(&co, 1);
+    coord_send_stop(&co, status == LAHAR_EXIT_OK ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
+                    co.message);
+    coord_finish_nodes(&co);
+out:
+    co.exit_status = status;
+    if (status != LAHAR_EXIT_OK)
+        fprintf(stderr, "lahar: %s\n", co.message[0] ? co.message : "run failed");
+    if (co.link)
+        lahar_link_heartbeat_stop(co.link);
+    coord_write_summary(&co);
+    if (co.node[LAHAR_ROLE_DEM].needed || co.node[LAHAR_ROLE_SPH].needed) {
+        if (lahar_output_xdmf_combine(co.outdir, err, sizeof err) != 0 && !o->quiet)
+            fprintf(stderr, "lahar: %s\n", err);
+    }
+    if (!o->quiet) {
+        printf("lahar: %s: %lld steps to t = %.6g s in %.2f s wall; output in %s\n", co.status, (long long)co.steps,
+               co.sim_time, lahar_now() - co.wall0, co.outdir);
+        printf("  look at it: paraview %s/lahar.xmf   |   h5dump -H %s/bodies.h5   |   python3 %s/plot_forces.py %s\n"
+               "  run summary: %s/summary.json\n",
+               co.outdir, co.outdir, LAHAR_TOOLS_DIR, co.outdir, co.outdir);
+    }
+    lahar_link_destroy(co.link);
+    lahar_transport_close(co.t);
+    return status;
+}

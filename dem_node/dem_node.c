@@ -1,0 +1,290 @@
+/* DEM node loop (see dem_node.h). Per step k:
+ *   wait STEP(k) -> [SPH node present: wait LOADS(k)] -> engine advance(dt_k, loads)
+ *   -> [SPH node present and moving bodies: publish BODY_STATE(k)] -> output -> STATUS(k).
+ * The loads of step k were computed by the SPH node from the body states at t_k (BODY_STATE(k-1)
+ * or the scene for k = 0) and are held constant over the engine's substeps. */
+#include "dem_node.h"
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "case.h"
+#include "dem_engine.h"
+#include "lahar_body_state_t.h"
+#include "lahar_loads_t.h"
+#include "lahar_step_t.h"
+#include "lahar_stop_t.h"
+#include "link.h"
+#include "output.h"
+#include "scene_msg.h"
+#include "transport.h"
+
+#define ROLE LAHAR_ROLE_DEM
+
+typedef struct {
+    lahar_link *link;
+    lahar_node_scene ns;
+    const lahar_dem_engine_ops *ops;
+    lahar_dem_engine *engine;
+    lahar_body_output *out;
+    lahar_body_state *states;
+    lahar_body_report *reports;
+    lahar_body_load *loads;
+    /* BODY_STATE of the moving bodies: LCM row pointers into preallocated rows */
+    int nmoving;
+    int32_t *moving_id;
+    double (*bx)[3], (*bq)[4], (*bv)[3], (*bw)[3];
+    double **px, **pq, **pv, **pw;
+} dem_node;
+
+static void dem_node_free(dem_node *d)
+{
+    lahar_body_output_close(d->out);
+    if (d->engine)
+        d->ops->destroy(d->engine);
+    free(d->states);
+    free(d->reports);
+    free(d->loads);
+    free(d->moving_id);
+    free(d->bx);
+    free(d->bq);
+    free(d->bv);
+    free(d->bw);
+    free(d->px);
+    free(d->pq);
+    free(d->pv);
+    free(d->pw);
+    lahar_case_free(&d->ns.scene);
+}
+
+static int dem_node_alloc(dem_node *d)
+{
+    int n = d->ns.scene.nbody > 0 ? d->ns.scene.nbody : 1;
+    d->states = calloc((size_t)n, sizeof *d->states);
+    d->reports = calloc((size_t)n, sizeof *d->reports);
+    d->loads = calloc((size_t)n, sizeof *d->loads);
+    d->moving_id = calloc((size_t)n, sizeof *d->moving_id);
+    d->bx = calloc((size_t)n, sizeof *d->bx);
+    d->bq = calloc((size_t)n, sizeof *d->bq);
+    d->bv = calloc((size_t)n, sizeof *d->bv);
+    d->bw = calloc((size_t)n, sizeof *d->bw);
+    d->px = calloc((size_t)n, sizeof *d->px);
+    d->pq = calloc((size_t)n, sizeof *d->pq);
+    d->pv = calloc((size_t)n, sizeof *d->pv);
+    d->pw = calloc((size_t)n, sizeof *d->pw);
+    if (!d->states || !d->reports || !d->loads || !d->moving_id || !d->bx || !d->bq || !d->bv || !d->bw ||
+        !d->px || !d->pq || !d->pv || !d->pw)
+        return -1;
+    d->nmoving = 0;
+    for (int i = 0; i < d->ns.scene.nbody; i++)
+        if (d->ns.scene.bodies[i].motion != LAHAR_MOTION_FIXED) {
+            int m = d->nmoving++;
+            d->moving_id[m] = i;
+            d->px[m] = d->bx[m];
+            d->pq[m] = d->bq[m];
+            d->pv[m] = d->bv[m];
+            d->pw[m] = d->bw[m];
+        }
+    return 0;
+}
+
+static void dem_node_get_states(dem_node *d)
+{
+    for (int i = 0; i < d->ns.scene.nbody; i++)
+        d->ops->get_state(d->engine, i, &d->states[i]);
+}
+
+static int dem_node_send_body_state(dem_node *d, int64_t k, double t)
+{
+    for (int m = 0; m < d->nmoving; m++) {
+        const lahar_body_state *s = &d->states[d->moving_id[m]];
+        memcpy(d->bx[m], s->x, sizeof d->bx[m]);
+        memcpy(d->bq[m], s->q, sizeof d->bq[m]);
+        memcpy(d->bv[m], s->v, sizeof d->bv[m]);
+        memcpy(d->bw[m], s->w, sizeof d->bw[m]);
+    }
+    lahar_body_state_t bs = {
+        .run_id = lahar_link_run_id(d->link), .step = k, .t = t, .n = d->nmoving, .id = d->moving_id,
+        .x = d->px, .q = d->pq, .v = d->pv, .w = d->pw,
+    };
+    int rc;
+    LAHAR_LINK_SEND(rc, d->link, LAHAR_FRAME_T_MSG_BODY_STATE, lahar_body_state_t, k, &bs);
+    return rc;
+}
+
+/* Loads of step k from the SPH node, one entry per body (zero for bodies not listed). */
+static int dem_node_read_loads(dem_node *d, const lahar_link_msg *msg, char *err, size_t errlen)
+{
+    lahar_loads_t lm;
+    if (lahar_loads_t_decode(msg->data, 0, msg->size, &lm) < 0) {
+        snprintf(err, errlen, "undecodable LOADS(%lld)", (long long)msg->step);
+        return -1;
+    }
+    memset(d->loads, 0, (size_t)d->ns.scene.nbody * sizeof *d->loads);
+    int rc = 0;
+    for (int i = 0; i < lm.nbody; i++) {
+        int b = lm.body_id[i];
+        if (b < 0 || b >= d->ns.scene.nbody) {
+            snprintf(err, errlen, "LOADS(%lld) names body %d, the scene has %d", (long long)msg->step, b,
+                     d->ns.scene.nbody);
+            rc = -1;
+            break;
+        }
+        memcpy(d->loads[b].force, lm.force[i], sizeof d->loads[b].force);
+        memcpy(d->loads[b].torque, lm.torque[i], sizeof d->loads[b].torque);
+    }
+    lahar_loads_t_decode_cleanup(&lm);
+    return rc;
+}
+
+/* Wait for the coordinator to end the run after an error (the STATUS carried the message). */
+static int dem_node_wait_stop(dem_node *d)
+{
+    lahar_link_msg msg;
+    for (;;) {
+        int rc = lahar_link_wait(d->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STOP, LAHAR_LINK_ANY_STEP, -1, &msg);
+        if (rc == LAHAR_LINK_OK || rc == LAHAR_LINK_LOST || rc == LAHAR_LINK_ERROR)
+            return rc;
+    }
+}
+
+static int dem_node_loop(dem_node *d)
+{
+    char err[2048];
+    lahar_link_msg msg;
+    const int has_sph = d->ns.has_sph;
+    for (int64_t k = 0;; k++) {
+        double wait0 = lahar_link_wait_seconds(d->link);
+        int rc = lahar_link_wait(d->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, &msg);
+        if (rc == LAHAR_LINK_STOP)
+            return 0;
+        if (rc == LAHAR_LINK_LOST) {
+            fprintf(stderr, "lahar-dem: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n",
+                    LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
+            return 3;
+        }
+        if (rc != LAHAR_LINK_OK)
+            return 1;
+        lahar_step_t step;
+        if (lahar_step_t_decode(msg.data, 0, msg.size, &step) < 0)
+            return 1;
+        lahar_status_t st = {0};
+        err[0] = '\0';
+        if (has_sph) {
+            rc = lahar_link_wait(d->link, LAHAR_ROLE_SPH, LAHAR_FRAME_T_MSG_LOADS, k, -1, &msg);
+            if (rc == LAHAR_LINK_STOP)
+                return 0;
+            if (rc == LAHAR_LINK_LOST)
+                return 3;
+            if (rc != LAHAR_LINK_OK || dem_node_read_loads(d, &msg, err, sizeof err) != 0)
+                st.error = 1;
+        }
+        double c0 = lahar_now();
+        int nsub = st.error ? -1 : d->ops->advance(d->engine, step.dt, has_sph ? d->loads : NULL, err, sizeof err);
+        double compute = lahar_now() - c0;
+        if (nsub < 0)
+            st.error = 1;
+        dem_node_get_states(d);
+        if (has_sph && d->nmoving > 0 && !st.error)
+            dem_node_send_body_state(d, k, step.t_next);
+        for (int i = 0; i < d->ns.scene.nbody; i++)
+            d->ops->get_report(d->engine, i, &d->reports[i]);
+        if (lahar_body_output_forces(d->out, k + 1, step.t_next, d->reports) != 0 && !st.error) {
+            st.error = 1;
+            snprintf(err, sizeof err, "cannot append to forces.h5 in %s", d->ns.output_dir);
+        }
+        /* On an engine error the last state is kept as a snapshot to look at. */
+        if ((step.write_output || st.error) && lahar_body_output_snapshot(d->out, k + 1, step.t_next, d->states) != 0 &&
+            !st.error) {
+            st.error = 1;
+            snprintf(err, sizeof err, "cannot write a snapshot to bodies.h5 in %s", d->ns.output_dir);
+        }
+        st.dt_proposed = 0.0; /* the engine subcycles: no limit on the coordinator step */
+        st.dt_stable = d->ops->stable_dt(d->engine);
+        st.compute_s = compute;
+        st.wait_s = lahar_link_wait_seconds(d->link) - wait0;
+        st.ncontacts = d->ops->ncontacts(d->engine);
+        st.nsubsteps = nsub > 0 ? nsub : 0;
+        st.kinetic_energy = d->ops->kinetic_energy(d->engine);
+        st.message = err;
+        lahar_node_send_status(d->link, ROLE, k, &st);
+        if (st.error) {
+            fprintf(stderr, "lahar-dem: step %lld: %s\n", (long long)k, err);
+            dem_node_wait_stop(d);
+            return 1;
+        }
+        lahar_link_set_step(d->link, k);
+    }
+}
+
+int lahar_dem_node_run(const lahar_dem_node_options *o)
+{
+    char err[2048];
+    if (o->threads > 0)
+        omp_set_num_threads(o->threads);
+    lahar_transport *t = lahar_transport_open(o->lcm_url, err, sizeof err);
+    if (!t) {
+        fprintf(stderr, "lahar-dem: %s\n", err);
+        return 2;
+    }
+    dem_node d;
+    memset(&d, 0, sizeof d);
+    unsigned want = LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_SCENE) |
+                    LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STEP) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_LOADS) |
+                    LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STOP);
+    d.link = lahar_link_create(t, ROLE, o->run_id, want, err, sizeof err);
+    if (!d.link) {
+        fprintf(stderr, "lahar-dem: %s\n", err);
+        lahar_transport_close(t);
+        return 2;
+    }
+    static const char *const caps[] = {"dim2", "dim3", "hertz", "linear", "subcycle", "restart"};
+    int status = 0;
+    int rc = lahar_node_join(d.link, ROLE, lahar_dem_engine_names(), LAHAR_VERSION, caps, 6,
+                             o->join_wait_s > 0 ? o->join_wait_s : 30.0, &d.ns, err, sizeof err);
+    if (rc == LAHAR_LINK_STOP)
+        goto done;
+    if (rc != LAHAR_LINK_OK) {
+        fprintf(stderr, "lahar-dem: %s\n", err);
+        status = rc == LAHAR_LINK_LOST ? 3 : 2;
+        goto done;
+    }
+    /* Ready = STATUS(-1); an error here (unknown engine, unwritable output) stops the run. */
+    lahar_status_t st = {0};
+    err[0] = '\0';
+    d.ops = lahar_dem_engine_find(d.ns.scene.dem_engine);
+    if (!d.ops)
+        snprintf(err, sizeof err, "unknown DEM engine '%s' (known: %s)", d.ns.scene.dem_engine, lahar_dem_engine_names());
+    else if (dem_node_alloc(&d) != 0)
+        snprintf(err, sizeof err, "out of memory");
+    else if (!(d.engine = d.ops->create(&d.ns.scene, err, sizeof err)))
+        ;
+    else if (!(d.out = lahar_body_output_open(d.ns.output_dir, &d.ns.scene, err, sizeof err)))
+        ;
+    else {
+        dem_node_get_states(&d);
+        if (lahar_body_output_snapshot(d.out, 0, 0.0, d.states) != 0)
+            snprintf(err, sizeof err, "cannot write the first snapshot in %s", d.ns.output_dir);
+    }
+    char engine_desc[128];
+    if (d.ops)
+        snprintf(engine_desc, sizeof engine_desc, "%s %s", d.ops->name, d.ops->version);
+    st.error = err[0] != '\0';
+    st.message = st.error ? err : (d.ops ? engine_desc : (char *)"");
+    st.dt_stable = d.engine ? d.ops->stable_dt(d.engine) : 0.0;
+    st.kinetic_energy = d.engine ? d.ops->kinetic_energy(d.engine) : 0.0;
+    lahar_node_send_status(d.link, ROLE, -1, &st);
+    if (st.error) {
+        fprintf(stderr, "lahar-dem: %s\n", err);
+        dem_node_wait_stop(&d);
+        status = 1;
+        goto done;
+    }
+    status = dem_node_loop(&d);
+done:
+    lahar_link_heartbeat_stop(d.link);
+    dem_node_free(&d);
+    lahar_link_destroy(d.link);
+    lahar_transport_close(t);
+    return status;
+}
