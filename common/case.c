@@ -552,7 +552,7 @@ static int read_faces(reader *r, yaml_node_t *n, const char *key, int **fs, int 
         }
         total += seq_len(fn);
     }
-    *fs = calloc((size_t)cnt + 1, sizeof **fs);
+    *fs = calloc((size_t)(unsigned)cnt + 1, sizeof **fs);
     *fv = calloc((size_t)(total ? total : 1), sizeof **fv);
     if (!*fs || !*fv) {
         free(*fs);
@@ -565,8 +565,8 @@ static int read_faces(reader *r, yaml_node_t *n, const char *key, int **fs, int 
         yaml_node_t *fn = seq_item(r, n, f);
         (*fs)[f] = k;
         for (int i = 0; i < seq_len(fn); i++) {
-            char ik[KEY_MAX];
-            snprintf(ik, sizeof ik, "%.*s[%d][%d]", KEY_MAX - 24, key, f, i);
+            char ik[KEY_MAX + 32];
+            snprintf(ik, sizeof ik, "%.*s[%d][%d]", KEY_MAX - 8, key, f, i);
             double v;
             if (node_number(r, seq_item(r, fn, i), ik, &v) != 0 || v != floor(v) || v < 0 || v > INT_MAX) {
                 rd_fail(r, seq_item(r, fn, i), ik, "expected a vertex index (an integer >= 0)");

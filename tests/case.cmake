@@ -1,0 +1,15 @@
+# Case files, shapes and mass properties (common/case.c, common/shape_build.c).
+add_executable(lahar-case-check ${LAHAR_TEST_DIR}/case_check_main.c)
+target_link_libraries(lahar-case-check PRIVATE lahar_common)
+
+add_executable(test_case ${LAHAR_TEST_DIR}/test_case.c)
+target_link_libraries(test_case PRIVATE lahar_common)
+# every case in cases/ loads; mass properties, principal frames, hulls and STL against analytic values
+add_test(NAME case_shapes COMMAND test_case ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR})
+set_tests_properties(case_shapes PROPERTIES LABELS fast)
+
+add_executable(test_case_bad ${LAHAR_TEST_DIR}/test_case_bad.c)
+target_link_libraries(test_case_bad PRIVATE lahar_common)
+# one fixture per class of bad input: exit status 2, message names file, line and key
+add_test(NAME case_bad_inputs COMMAND test_case_bad $<TARGET_FILE:lahar-case-check> ${LAHAR_TEST_DIR}/bad_cases)
+set_tests_properties(case_bad_inputs PROPERTIES LABELS fast)

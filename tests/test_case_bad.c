@@ -1,0 +1,114 @@
+/* Bad-input test: every tests/bad_cases/<name>.yaml holds one class of mistake and says what the
+ * loader must report in its first lines:
+ *     # expect: bodies[0].radius: must be > 0
+ *     # line: 12
+ * The fixture is run through lahar-case-check, which must exit with status 2 and print exactly
+ * one line on stderr that starts with `<fixture path>:<line>:` and contains the expected
+ * fragment. (Under the sanitizer build a leak on the error path changes the exit status, so this
+ * also checks that nothing stays allocated on failure.) */
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static int name_cmp(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* Run prog with arg; stderr into buf. Returns the exit status (or -1). */
+static int run_capture(const char *prog, const char *arg, char *buf, size_t n)
+{
+    int fd[2];
+    if (pipe(fd) != 0)
+        return -1;
+    pid_t pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        dup2(fd[1], 2);
+        close(fd[0]);
+        close(fd[1]);
+        execl(prog, prog, arg, (char *)NULL);
+        _exit(127);
+    }
+    close(fd[1]);
+    size_t k = 0;
+    ssize_t got;
+    while ((got = read(fd[0], buf + k, n - 1 - k)) > 0 && k + 1 < n)
+        k += (size_t)got;
+    buf[k] = '\0';
+    close(fd[0]);
+    int st = 0;
+    if (waitpid(pid, &st, 0) < 0)
+        return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s LAHAR_CASE_CHECK BAD_CASES_DIR\n", argv[0]);
+        return 1;
+    }
+    DIR *d = opendir(argv[2]);
+    if (!d) {
+        perror(argv[2]);
+        return 1;
+    }
+    char *names[512];
+    int n = 0;
+    struct dirent *de;
+    while ((de = readdir(d)) && n < 512) {
+        size_t l = strlen(de->d_name);
+        if (l > 5 && strcmp(de->d_name + l - 5, ".yaml") == 0)
+            names[n++] = strdup(de->d_name);
+    }
+    closedir(d);
+    qsort(names, (size_t)n, sizeof *names, name_cmp);
+    int failures = 0;
+    for (int i = 0; i < n; i++) {
+        char path[2048], expect[1100] = "", line[1100] = "", buf[8192], want[4200];
+        snprintf(path, sizeof path, "%s/%s", argv[2], names[i]);
+        FILE *fp = fopen(path, "r");
+        if (!fp) {
+            perror(path);
+            failures++;
+            continue;
+        }
+        char l[1024];
+        while (fgets(l, sizeof l, fp) && l[0] == '#') {
+            l[strcspn(l, "\n")] = '\0';
+            if (strncmp(l, "# expect: ", 10) == 0)
+                snprintf(expect, sizeof expect, "%.1000s", l + 10);
+            else if (strncmp(l, "# line: ", 8) == 0)
+                snprintf(line, sizeof line, "%.1000s", l + 8);
+        }
+        fclose(fp);
+        if (!expect[0] || !line[0]) {
+            printf("FAIL %s: fixture lacks '# expect:' or '# line:' header\n", names[i]);
+            failures++;
+            continue;
+        }
+        int st = run_capture(argv[1], path, buf, sizeof buf);
+        snprintf(want, sizeof want, "%s:%s: ", path, line);
+        int one_line = strchr(buf, '\n') == buf + strlen(buf) - 1;
+        const char *why = st != 2 ? "exit status is not 2"
+                          : strncmp(buf, want, strlen(want)) != 0 ? "message does not start with <path>:<line>:"
+                          : !strstr(buf, expect) ? "expected fragment missing"
+                          : !one_line ? "not exactly one line on stderr" : NULL;
+        if (why) {
+            printf("FAIL %s: %s (status %d)\n  want: %s... %s\n  got:  %s\n", names[i], why, st, want, expect, buf);
+            failures++;
+        } else {
+            printf("ok   %s\n     %s", names[i], buf);
+        }
+    }
+    for (int i = 0; i < n; i++)
+        free(names[i]);
+    if (n < 20) {
+        printf("FAIL: only %d fixtures found in %s (expected one per error class, >= 20)\n", n, argv[2]);
+        failures++;
+    }
+    printf("%d fixtures, %d failures\n", n, failures);
+    return failures ? 1 : 0;
+}
