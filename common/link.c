@@ -144,11 +144,15 @@ static int link_publish_frames(lahar_link *l, int type, int64_t step, int64_t se
             .size = chunk, .payload = (uint8_t *)(data + offset),
         };
         int n = lahar_frame_t_encode(l->frame_buf, 0, LINK_FRAME_BUF, &f);
-        if (n < 0 || lahar_transport_publish(l->t, lahar_link_channel(type), l->frame_buf, (size_t)n) != 0) {
+        if (n < 0) {
             rc = -1;
             continue;
         }
         lahar_link_stats *s = &l->stats[type];
+        /* A datagram the kernel refuses (a firewall drop, a full buffer) is a lost frame like any
+         * other: the receiver NACKs it and the kept copy goes out again. */
+        if (lahar_transport_publish(l->t, lahar_link_channel(type), l->frame_buf, (size_t)n) != 0)
+            s->send_failures++;
         if (resend) {
             s->frames_resent++;
             s->bytes_resent += (uint64_t)n;

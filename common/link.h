@@ -44,6 +44,7 @@ typedef struct {
     uint64_t msgs_heard, frames_heard, bytes_heard;      /* frames of this run from other processes */
     uint64_t frames_resent_heard;                        /* ... of which were re-sends */
     uint64_t nacks_sent;                                 /* NACKs this process sent for this channel */
+    uint64_t send_failures;                              /* frames the transport refused (repaired by NACK) */
 } lahar_link_stats;
 
 const char *lahar_link_channel(int type);      /* "LAHAR_STEP", ... */

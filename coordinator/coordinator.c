@@ -484,6 +484,7 @@ static void coord_write_summary(coord *co)
             cJSON_AddNumberToObject(j, "heard_messages", (double)s->msgs_heard);
             cJSON_AddNumberToObject(j, "heard_bytes", (double)s->bytes_heard);
             cJSON_AddNumberToObject(j, "nacks_sent", (double)s->nacks_sent);
+            cJSON_AddNumberToObject(j, "send_failures", (double)s->send_failures);
             resent += s->frames_resent + s->frames_resent_heard;
         }
     }
