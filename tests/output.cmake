@@ -16,3 +16,15 @@ lahar_output_test(test_output)
 add_test(NAME output_writers COMMAND test_output ${LAHAR_OUTPUT_TEST_DIR}/writers)
 set_tests_properties(output_writers PROPERTIES LABELS "fast;output" TIMEOUT 120
   FIXTURES_SETUP output_files)
+
+add_test(NAME output_xdmf COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_output_xdmf.py
+  ${LAHAR_OUTPUT_TEST_DIR}/writers)
+set_tests_properties(output_xdmf PROPERTIES LABELS "fast;output" TIMEOUT 60
+  FIXTURES_REQUIRED output_files)
+
+lahar_output_test(test_output_swmr)
+add_test(NAME output_swmr COMMAND test_output_swmr ${LAHAR_OUTPUT_TEST_DIR}/swmr)
+set_tests_properties(output_swmr PROPERTIES LABELS "fast;output" TIMEOUT 60)
+add_test(NAME output_swmr_h5py COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_output_swmr_h5py.py
+  $<TARGET_FILE:test_output_swmr> ${LAHAR_OUTPUT_TEST_DIR}/swmr_h5py)
+set_tests_properties(output_swmr_h5py PROPERTIES LABELS "fast;output" TIMEOUT 60)

@@ -1,0 +1,29 @@
+"""Shared start-up for lahar's python tools: make sure h5py/numpy (and matplotlib when asked)
+import. Debian installs them for /usr/bin/python3 (python3-h5py, python3-matplotlib); when the
+`python3` first on PATH is another interpreter (pyenv, venv) without them, re-run the script under
+/usr/bin/python3 once instead of failing."""
+import importlib
+import os
+import sys
+
+SYSTEM_PYTHON = "/usr/bin/python3"
+
+
+def require(*modules):
+    """Import `modules` or re-exec under Debian's python3; exit 3 with a message if impossible."""
+    missing = []
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            missing.append(name)
+    if not missing:
+        return
+    if (os.path.exists(SYSTEM_PYTHON) and os.path.realpath(sys.executable) != os.path.realpath(SYSTEM_PYTHON)
+            and not os.environ.get("LAHAR_PY_REEXEC")):
+        os.environ["LAHAR_PY_REEXEC"] = "1"
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON] + sys.argv)
+    pkgs = " ".join("python3-" + m for m in missing)
+    sys.stderr.write(f"{os.path.basename(sys.argv[0])}: python modules missing: {', '.join(missing)} "
+                     f"(apt-get install {pkgs})\n")
+    sys.exit(3)
