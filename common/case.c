@@ -1038,11 +1038,13 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
                 continue;
             double d = geom_body_core_distance(&a->shape, a->x, a->q, &b->shape, b->x, b->q);
             double halo = a->shape.radius + b->shape.radius;
-            if (d < halo * (1.0 - 1e-9)) {
+            /* touching is fine, and so is an overlap below 1e-6 of the radii (rounding of
+             * coordinates written with a few digits); anything more starts with a force kick */
+            if (d < halo * (1.0 - 1e-6)) {
                 char key[KEY_MAX];
                 snprintf(key, sizeof key, "bodies[%d]", j);
                 rd_fail(r, seq_item(r, bodies, j), key, "'%s' overlaps '%s' (bodies[%d]) by %.3g m at t = 0 (core "
-                        "distance %.3g m < sum of radii %.3g m); move the bodies apart", b->name, a->name, i,
+                        "distance %.6g m < sum of radii %.6g m); move the bodies apart", b->name, a->name, i,
                         halo - d, d, halo);
             }
         }
