@@ -8,10 +8,11 @@ static double harmonic_mean(double a, double b) { return (a > 0.0 && b > 0.0) ? 
 int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair_law *out,
                       char *err, size_t errlen)
 {
-    /* Hertz wins when the two materials disagree: a Hertz material needs E and nu, which the
-     * combined E* then uses from both sides. */
-    out->model = (a->model == LAHAR_CONTACT_HERTZ || b->model == LAHAR_CONTACT_HERTZ) ? LAHAR_CONTACT_HERTZ
-                                                                                     : LAHAR_CONTACT_LINEAR;
+    /* Hertz when either material asks for it and both give E (E* needs both sides); a Hertz
+     * material meeting a linear one without E falls back to the linear law (needs kn on both). */
+    int hertz = a->model == LAHAR_CONTACT_HERTZ || b->model == LAHAR_CONTACT_HERTZ;
+    if (hertz && !(a->young > 0.0 && b->young > 0.0) && a->kn > 0.0 && b->kn > 0.0) hertz = 0;
+    out->model = hertz ? LAHAR_CONTACT_HERTZ : LAHAR_CONTACT_LINEAR;
     out->kn = harmonic_mean(a->kn, b->kn);
     out->estar = 0.0;
     if (a->young > 0.0 && b->young > 0.0)
@@ -20,7 +21,7 @@ int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair
     out->e = a->restitution < b->restitution ? a->restitution : b->restitution;
     out->mu = a->friction < b->friction ? a->friction : b->friction;
     if (out->model == LAHAR_CONTACT_HERTZ && !(out->estar > 0.0)) {
-        snprintf(err, errlen, "materials '%s'/'%s': Hertz contact needs young > 0 for both", a->name, b->name);
+        snprintf(err, errlen, "materials '%s'/'%s': Hertz contact needs young > 0 for both (or kn > 0 for both to fall back to linear)", a->name, b->name);
         return -1;
     }
     if (out->model == LAHAR_CONTACT_LINEAR && !(out->kn > 0.0)) {

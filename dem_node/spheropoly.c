@@ -53,6 +53,7 @@ typedef struct {
     sp_contact *c;
     int n, cap;
     dem_feature_query fq;
+    int *keep[2][3]; /* per side of a pair: features near the other body (vertex, edge, face) */
     int oom;
 } sp_thread;
 
@@ -382,6 +383,33 @@ static void pair_narrow(sp_pair_ctx *x, const sp_side *A, const sp_side *B)
     }
 }
 
+static void side_filter(const lahar_dem_engine *e, sp_side *sd, const sp_geo *g, vec3 c, double rad, int *keep[3])
+{
+    double r2 = rad * rad;
+    int n = 0;
+    for (int k = 0; k < sd->nv; k++) {
+        int i = side_id(sd->v, k);
+        if (v3_norm2(v3_sub(e->vw[g->v0 + i], c)) < r2) keep[0][n++] = i;
+    }
+    sd->v = keep[0];
+    sd->nv = n;
+    n = 0;
+    for (int k = 0; k < sd->ne; k++) {
+        int i = side_id(sd->e, k);
+        vec3 p0 = e->vw[g->v0 + e->edge[g->e0 + i][0]], p1 = e->vw[g->v0 + e->edge[g->e0 + i][1]];
+        if (geom_point_segment(c, p0, p1, NULL) < rad) keep[1][n++] = i;
+    }
+    sd->e = keep[1];
+    sd->ne = n;
+    n = 0;
+    for (int k = 0; k < sd->nf; k++) {
+        int i = side_id(sd->f, k);
+        if (fabs(v3_dot(v3_sub(c, e->fw[e->fstart[g->fs0 + i]]), e->nw[g->f0 + i])) < rad) keep[2][n++] = i;
+    }
+    sd->f = keep[2];
+    sd->nf = n;
+}
+
 /* All contacts of broad-phase pair (a, b), a < b, into the thread buffer. */
 static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread *t)
 {
@@ -408,7 +436,11 @@ static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread
         big->e = t->fq.out[DEM_FEATURE_EDGE];
         big->f = t->fq.out[DEM_FEATURE_FACE];
     }
-    pair_narrow(&x, &A, &B);
+    /* keep only the features that can reach the other body's bounding ball: a feature of A
+     * touches B only if its core is within bound_B + R_A of B's centre */
+    side_filter(e, &A, ga, e->st[b].x, gb->bound + ga->radius, t->keep[0]);
+    side_filter(e, &B, gb, e->st[a].x, ga->bound + gb->radius, t->keep[1]);
+    if ((A.nv || A.ne || A.nf) && (B.nv || B.ne || B.nf)) pair_narrow(&x, &A, &B);
 }
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -698,6 +730,8 @@ static void sp_destroy(lahar_dem_engine *e)
         for (int t = 0; t < e->nthr; t++) {
             free(e->thr[t].c);
             dem_feature_query_free(&e->thr[t].fq);
+            for (int sd = 0; sd < 2; sd++)
+                for (int k = 0; k < 3; k++) free(e->thr[t].keep[sd][k]);
         }
     free(e->thr);
     free(e->grids);
@@ -986,11 +1020,26 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         snprintf(err, errlen, "spheropoly: out of memory");
         goto fail;
     }
-    for (int t = 0; t < e->nthr; t++)
-        if (dem_feature_query_init(&e->thr[t].fq, maxv, maxe, maxf)) {
+    int allv = 1, alle = 1, allf = 1;
+    for (int i = 0; i < nb; i++) {
+        allv = e->geo[i].nv > allv ? e->geo[i].nv : allv;
+        alle = e->geo[i].ne > alle ? e->geo[i].ne : alle;
+        allf = e->geo[i].nf > allf ? e->geo[i].nf : allf;
+    }
+    for (int t = 0; t < e->nthr; t++) {
+        sp_thread *th = &e->thr[t];
+        int bad = dem_feature_query_init(&th->fq, maxv, maxe, maxf);
+        for (int sd = 0; sd < 2; sd++) {
+            th->keep[sd][0] = malloc(sizeof(int) * (size_t)allv);
+            th->keep[sd][1] = malloc(sizeof(int) * (size_t)alle);
+            th->keep[sd][2] = malloc(sizeof(int) * (size_t)allf);
+            bad |= !th->keep[sd][0] || !th->keep[sd][1] || !th->keep[sd][2];
+        }
+        if (bad) {
             snprintf(err, errlen, "spheropoly: out of memory");
             goto fail;
         }
+    }
     e->dt_stable = stable_dt_of(e, c);
     if (compute_forces(e, 0.0, err, errlen)) goto fail;
     return e;
