@@ -521,6 +521,9 @@ static int check_fail(const char *outdir, const char *reference, const char *msg
 /* python3 tools/plot_check.py OUT; a missing python3/matplotlib only costs the plot. */
 static void check_plot(const char *outdir)
 {
+    const char *skip = getenv("LAHAR_CHECK_NO_PLOT");
+    if (skip && *skip && strcmp(skip, "0") != 0)
+        return;
     const char *py = getenv("LAHAR_PYTHON");
     if (!py || !*py)
         py = "python3";

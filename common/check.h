@@ -6,7 +6,9 @@
  *              "info": {...measured and reference quantities...},
  *              "plot": {"title", "xlabel", "ylabel", "t": [...], "measured": [...], "reference": [...]}}
  * A metric passes when value <= bound. Metrics computed but not named in the case go to "info";
- * a case without metrics gets the reference's default metric and bound. */
+ * a case without metrics gets the reference's default metric and bound.
+ * The plot runs `$LAHAR_PYTHON` (default python3) on tools/plot_check.py; LAHAR_CHECK_NO_PLOT=1
+ * skips it. */
 #ifndef LAHAR_CHECK_H
 #define LAHAR_CHECK_H
 #include <stddef.h>

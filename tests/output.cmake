@@ -28,3 +28,8 @@ set_tests_properties(output_swmr PROPERTIES LABELS "fast;output" TIMEOUT 60)
 add_test(NAME output_swmr_h5py COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_output_swmr_h5py.py
   $<TARGET_FILE:test_output_swmr> ${LAHAR_OUTPUT_TEST_DIR}/swmr_h5py)
 set_tests_properties(output_swmr_h5py PROPERTIES LABELS "fast;output" TIMEOUT 60)
+
+lahar_output_test(test_check)
+add_test(NAME output_check COMMAND test_check ${LAHAR_OUTPUT_TEST_DIR}/check)
+set_tests_properties(output_check PROPERTIES LABELS "fast;output" TIMEOUT 120
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
