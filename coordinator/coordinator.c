@@ -304,9 +304,10 @@ static int coord_collect_status(coord *co, int64_t k)
             int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
                                                                                  : lahar_link_peer_step(co->link, lost);
             snprintf(co->message, sizeof co->message,
-                     "the %s%s has been silent for %.1f s; last completed step %lld (t = %.9g s)",
-                     lahar_link_role_name(lost), ln->pid > 0 ? " (lahar process died or hangs)" : "",
-                     COORD_NODE_SILENCE, (long long)last, co->sim_time);
+                     "lost the %s (%s, pid %d on %s): silent for %.1f s (died or hangs); last completed step %lld "
+                     "(t = %.9g s); stopping the run",
+                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE,
+                     (long long)last, co->sim_time);
             co->status = "node lost";
             return LAHAR_EXIT_NODE_LOST;
         }

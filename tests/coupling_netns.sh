@@ -1,0 +1,158 @@
+#!/usr/bin/env bash
+# Co-simulation over LCM: the same DEM scene run in every way lahar can run it must give bitwise
+# the same trajectories (the in-process run over memq:// is the reference), and faults must end a
+# run cleanly. Every multicast run happens inside a private network namespace: `lahar run`'s own,
+# or one this script makes with `unshare --user --map-root-user --net` (lo up, multicast on, route
+# 224.0.0.0/4 via lo, ttl=0 or ttl=1 on an isolated veth link). Nothing leaves the host.
+#
+#   coupling_netns.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
+#   TEST: processes | packet_loss | node_killed | concurrent | cross_host
+set -u
+test_name=$1 bin=$2 tools=$3 work=$4
+python=/usr/bin/python3
+[ -x "$python" ] || python=python3
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work" || exit 2
+URL_LO='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608'
+URL_LINK='udpm://239.255.76.67:7667?ttl=1&recv_buf_size=8388608'
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# A few spheres and a box falling on a fixed plate; collisions within the first 0.3 s.
+write_case() { # file t_end
+    cat > "$1" <<YAML
+dimensions: 3
+gravity: [0, 0, -9.81]
+time: {end: $2, dt_max: 1e-3, output_interval: 0.05}
+materials:
+  rock: {density: 2650, model: hertz, young: 1e7, poisson: 0.25, restitution: 0.5, friction: 0.5}
+bodies:
+  - {name: ball, shape: sphere, radius: 0.05, material: rock, position: [0, 0, 0.2]}
+  - {name: crate, shape: box, size: [0.2, 0.1, 0.1], radius: 0.02, material: rock, position: [0.3, 0, 0.15]}
+  - {name: ball2, shape: sphere, radius: 0.04, material: rock, position: [0.02, 0.01, 0.4], velocity: [0, 0, -1]}
+  - {name: floor, shape: plane, motion: fixed, normal: [0, 0, 1], size: [2, 2], radius: 0.02, material: rock, position: [0, 0, 0]}
+YAML
+}
+
+# Bitwise comparison of every dataset of bodies.h5 and forces.h5 with the reference run.
+same_as_reference() { # outdir
+    for f in bodies.h5 forces.h5; do
+        "$python" "$tools/h5_compare.py" --quiet ref/$f "$1/$f" || fail "$1/$f differs from the in-process reference"
+    done
+}
+
+summary() { # outdir python-expression on s
+    "$python" -c "import json,sys; s=json.load(open('$1/summary.json')); print($2)"
+}
+
+reference() {
+    write_case case.yaml 0.3
+    "$bin/lahar" run case.yaml -o ref --in-process -q || fail "in-process reference run failed"
+    [ "$(summary ref "s['status'], s['steps'], s['sim_time']")" = "finished 300 0.3" ] ||
+        fail "reference run: unexpected summary $(summary ref "s['status'], s['steps'], s['sim_time']")"
+}
+
+# Run a shell snippet inside a fresh private user + network namespace with multicast on lo.
+in_private_netns() {
+    unshare --user --map-root-user --net bash -c "
+        set -e
+        ip link set lo up; ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo
+        $1"
+}
+
+case $test_name in
+processes)
+    # `lahar run` (own namespace, nodes as processes) == `lahar run --in-process`
+    reference
+    "$bin/lahar" run case.yaml -o proc -q || fail "multi-process run failed"
+    same_as_reference proc
+    [ "$(summary proc "s['mode']")" = processes ] || fail "mode is not processes"
+    ;;
+packet_loss)
+    # 2 % of all UDP datagrams dropped by nft: NACKs repair, the result stays bitwise the same.
+    reference
+    in_private_netns "
+        nft add table inet lahar_test
+        nft add chain inet lahar_test out '{ type filter hook output priority 0; }'
+        nft add rule inet lahar_test out meta l4proto udp numgen random mod 100 '<' 2 drop
+        '$bin/lahar' run case.yaml -o lossy -q --lcm-url '$URL_LO'" || fail "run with 2 % packet loss failed"
+    same_as_reference lossy
+    resent=$(summary lossy "s['resent_frames']")
+    nacks=$(summary lossy "sum(c['nacks_sent'] for c in s['channels'].values())")
+    echo "packet loss: $resent frames re-sent, $nacks NACKs sent by the coordinator"
+    [ "$resent" -gt 0 ] || fail "no re-sent frames although 2 % of the datagrams were dropped"
+    ;;
+node_killed)
+    # kill -9 the DEM node mid-run: the coordinator stops within ~2-3 s, names the node and the
+    # last completed step, exits 3, and what was written so far opens.
+    write_case long.yaml 30
+    "$bin/lahar" run long.yaml -o killed -q 2> stderr.txt &
+    lahar_pid=$!
+    dem_pid=""
+    for _ in $(seq 100); do
+        dem_pid=$(pgrep -P "$lahar_pid" -x lahar-dem || true)
+        [ -n "$dem_pid" ] && [ -e killed/bodies.h5 ] && break
+        sleep 0.05
+    done
+    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found"; }
+    sleep 0.5
+    kill -9 "$dem_pid"
+    t0=$(date +%s.%N)
+    wait "$lahar_pid"
+    rc=$?
+    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+    cat stderr.txt
+    echo "coordinator exited with $rc after ${elapsed} s"
+    [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
+    "$python" -c "import sys; sys.exit(0 if $elapsed < 4.0 else 1)" || fail "took ${elapsed} s to notice (limit 4 s)"
+    grep -q "DEM node" stderr.txt || fail "message does not name the DEM node"
+    grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
+    h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
+    [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
+    ;;
+concurrent)
+    # Two runs at the same time, each in its own namespace, and two more sharing one namespace
+    # (different run ids on the same multicast group): all equal the reference.
+    reference
+    "$bin/lahar" run case.yaml -o a -q & pa=$!
+    "$bin/lahar" run case.yaml -o b -q & pb=$!
+    in_private_netns "
+        '$bin/lahar' run case.yaml -o c -q --lcm-url '$URL_LO' & pc=\$!
+        '$bin/lahar' run case.yaml -o d -q --lcm-url '$URL_LO' & pd=\$!
+        wait \$pc; wait \$pd" || fail "runs sharing one namespace failed"
+    wait $pa || fail "run a failed"
+    wait $pb || fail "run b failed"
+    for o in a b c d; do same_as_reference $o; done
+    ;;
+cross_host)
+    # Two "hosts": network namespaces joined by a veth pair inside a private namespace; the
+    # coordinator on one, the DEM node (started by hand, ttl=1) on the other.
+    reference
+    unshare --user --map-root-user --net bash -c "
+        set -e
+        ip link set lo up
+        unshare --net sleep 600 & host_b=\$!
+        trap 'kill \$host_b 2>/dev/null' EXIT
+        for _ in \$(seq 50); do [ \"\$(readlink /proc/\$host_b/ns/net)\" != \"\$(readlink /proc/self/ns/net)\" ] && break; sleep 0.02; done
+        ip link add lahar_a type veth peer name lahar_b netns \$host_b
+        ip addr add 10.231.7.1/24 dev lahar_a
+        ip link set lahar_a up multicast on
+        ip route add 224.0.0.0/4 dev lahar_a
+        nsenter --net=/proc/\$host_b/ns/net sh -c '
+            ip link set lo up
+            ip addr add 10.231.7.2/24 dev lahar_b
+            ip link set lahar_b up multicast on
+            ip route add 224.0.0.0/4 dev lahar_b'
+        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' & dem=\$!
+        '$bin/lahar' run case.yaml -o xhost -q --no-spawn --lcm-url '$URL_LINK'
+        wait \$dem" || fail "cross-host run failed"
+    same_as_reference xhost
+    [ "$(summary xhost "s['mode']")" = no-spawn ] || fail "mode is not no-spawn"
+    ;;
+*)
+    echo "unknown test $test_name" >&2
+    exit 2
+    ;;
+esac
+echo "PASS: $test_name"
