@@ -534,7 +534,7 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
     }
     int oom = 0;
     for (int t = 0; t < e->nthr; t++) e->thr[t].n = 0;
-#pragma omp parallel num_threads(e->nthr) reduction(| : oom) if (e->npair >= 32)
+#pragma omp parallel num_threads(e->nthr) reduction(| : oom) if (e->npair >= 512)
     {
         sp_thread *t = &e->thr[omp_get_thread_num()];
         t->n = 0;
@@ -772,7 +772,7 @@ static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c)
 {
     double safety = c->dem_dt_safety > 0.0 ? c->dem_dt_safety : 0.02;
     vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
-    double vmax = 0.0, rmax = 0.0;
+    double vmax = 0.0;
     for (int i = 0; i < e->nbody; i++) {
         const sp_geo *g = &e->geo[i];
         for (int k = 0; k < g->nv; k++) {
@@ -782,25 +782,35 @@ static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c)
         }
         double v = v3_norm(e->st[i].v) + v3_norm(e->st[i].w) * g->bound;
         if (v > vmax) vmax = v;
-        if (g->radius > rmax) rmax = g->radius;
     }
     double extent = e->nbody > 0 ? v3_norm(v3_sub(hi, lo)) : 0.0;
     double vimpact = vmax + sqrt(2.0 * v3_norm(e->g) * extent) + 1.0;
+    /* per material: largest sweep radius, and whether free / non-free bodies use it (O(N nmat)) */
     double period = DBL_MAX;
-    int nfree_all = e->nfree;
-    for (int k = 0; k < e->nfree; k++) {
-        const sp_geo *g = &e->geo[e->free_ids[k]];
-        for (int j = 0; j < e->nbody; j++) {
-            const sp_geo *o = &e->geo[j];
-            if (o->motion == LAHAR_MOTION_FREE && nfree_all < 2) continue;
-            double mstar = o->motion == LAHAR_MOTION_FREE ? 0.5 * g->mass : g->mass;
-            const dem_pair_law *law = &e->laws[g->material * e->nmat + o->material];
-            double rstar = fmax(g->radius, o->radius); /* largest R* gives the shortest Hertz contact */
-            double p = dem_contact_period(law, mstar, rstar, vimpact);
-            if (p < period) period = p;
+    for (int j = 0; j < e->nmat; j++) {
+        double rj = 0.0;
+        int has_free = 0, has_fixed = 0;
+        for (int i = 0; i < e->nbody; i++) {
+            const sp_geo *o = &e->geo[i];
+            if (o->material != j) continue;
+            rj = fmax(rj, o->radius);
+            if (o->motion == LAHAR_MOTION_FREE) has_free = 1;
+            else has_fixed = 1;
+        }
+        if (!has_free && !has_fixed) continue;
+        for (int k = 0; k < e->nfree; k++) {
+            const sp_geo *g = &e->geo[e->free_ids[k]];
+            const dem_pair_law *law = &e->laws[g->material * e->nmat + j];
+            double rstar = fmax(g->radius, rj); /* largest R* gives the shortest Hertz contact */
+            for (int side = 0; side < 2; side++) {
+                if (side == 0 && !(has_free && e->nfree >= 2)) continue;
+                if (side == 1 && !has_fixed) continue;
+                double mstar = side == 0 ? 0.5 * g->mass : g->mass;
+                double p = dem_contact_period(law, mstar, rstar, vimpact);
+                if (p < period) period = p;
+            }
         }
     }
-    (void)rmax;
     if (period == DBL_MAX) period = c->dt_max > 0.0 ? c->dt_max / safety : 1.0;
     return safety * period;
 }
