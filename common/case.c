@@ -233,7 +233,7 @@ static int node_number(reader *r, yaml_node_t *n, const char *key, double *out)
     if (r->failed)
         return -1;
     if (n->type != YAML_SCALAR_NODE) {
-        rd_fail(r, n, key, "expected a number, got %s", node_kind(n));
+        rd_fail(r, n, key, "expected a number, got %s; write a plain number such as 0.05 or 1e-3", node_kind(n));
         return -1;
     }
     const char *s = scalar(n);
@@ -243,7 +243,7 @@ static int node_number(reader *r, yaml_node_t *n, const char *key, double *out)
     while (end && (*end == ' ' || *end == '\t'))
         end++;
     if (end == s || !end || *end != '\0' || errno == ERANGE || !isfinite(v)) {
-        rd_fail(r, n, key, "expected a finite number, got '%s'", s);
+        rd_fail(r, n, key, "expected a finite number, got '%s'; write a plain number such as 0.05 or 1e-3", s);
         return -1;
     }
     *out = v;
@@ -778,7 +778,7 @@ static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
                 if (read_faces(r, fn, fkey, &fs, &fv, &nf) == 0) {
                     rc = lahar_shape_make_polyhedron(s, (const double(*)[3])p, np, fs, fv, nf, radius, err, sizeof err);
                     if (rc != 0)
-                        rd_fail(r, fn, fkey, "%s (degenerate polyhedron); fix the faces or drop `faces:` to use the "
+                        rd_fail(r, fn, fkey, "%s; fix the faces or drop `faces:` to use the "
                                 "convex hull of the vertices", err);
                     else if (lahar_shape_core_volume(s) <= 0) {
                         rd_fail(r, fn, fkey, "the faces are clockwise seen from outside (the core volume is %g); "
