@@ -5,9 +5,60 @@
  * the COM velocity between t = 0.2 s (after the start transient) and t = 1.2 s. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include "dem_test_util.h"
+#include "shape_build.h"
 
-static double incline_accel(int dim, double theta, double mu, double *spin_ratio)
+/* A fixed terrain made of many small features (so the engine gives it a feature grid): 3D a
+ * sheet of 2 x 60 x 8 triangles, 2D a polyline of 100 segments, both flat at height 0. */
+static void add_terrain(lahar_case *c, int mat, double rp)
+{
+    lahar_body *b = &c->bodies[c->nbody++];
+    snprintf(b->name, sizeof b->name, "terrain");
+    b->material = mat;
+    b->motion = LAHAR_MOTION_FIXED;
+    b->q[0] = 1.0;
+    char err[256];
+    int rc;
+    if (c->dim == 3) {
+        enum { NX = 60, NY = 8 };
+        static double v[(NX + 1) * (NY + 1)][3];
+        static int fs[2 * NX * NY + 1], fv[6 * NX * NY];
+        for (int j = 0; j <= NY; j++)
+            for (int i = 0; i <= NX; i++) {
+                v[j * (NX + 1) + i][0] = -1.0 + 10.0 * i / NX;
+                v[j * (NX + 1) + i][1] = -0.4 + 0.8 * j / NY;
+                v[j * (NX + 1) + i][2] = 0.0;
+            }
+        int nf = 0;
+        for (int j = 0; j < NY; j++)
+            for (int i = 0; i < NX; i++) {
+                int a = j * (NX + 1) + i, bb = a + 1, cc = a + NX + 2, d = a + NX + 1;
+                int tri[2][3] = {{a, bb, cc}, {a, cc, d}}; /* counter-clockwise seen from +z */
+                for (int t = 0; t < 2; t++) {
+                    fs[nf] = 3 * nf;
+                    for (int k = 0; k < 3; k++) fv[3 * nf + k] = tri[t][k];
+                    nf++;
+                }
+            }
+        fs[nf] = 3 * nf;
+        rc = lahar_shape_make_polyhedron(&b->shape, (const double(*)[3])v, (NX + 1) * (NY + 1), fs, fv, nf, rp, err,
+                                         sizeof err);
+    } else {
+        static double p[101][3];
+        for (int i = 0; i <= 100; i++) {
+            p[i][0] = -1.0 + 10.0 * i / 100;
+            p[i][1] = p[i][2] = 0.0;
+        }
+        rc = lahar_shape_make_polyline(&b->shape, (const double(*)[3])p, 101, 0, rp, err, sizeof err);
+    }
+    if (rc) {
+        fprintf(stderr, "terrain: %s\n", err);
+        exit(2);
+    }
+}
+
+static double incline_accel_on(int dim, double theta, double mu, double *spin_ratio, int terrain)
 {
     const double g = 9.81, R = 0.05, rp = 0.01, kn = 1e6;
     double gv[3] = {g * sin(theta), 0, 0};
@@ -15,14 +66,16 @@ static double incline_accel(int dim, double theta, double mu, double *spin_ratio
     lahar_case c;
     dem_test_case_init(&c, dim, gv, 2);
     int m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, kn, 0, 0, 0.5, mu);
-    if (dim == 3) {
+    if (terrain) {
+        add_terrain(&c, m, rp);
+    } else if (dim == 3) {
         const double centre[3] = {4, 0, 0}, n[3] = {0, 0, 1}, size[2] = {10, 2};
         dem_test_plane(&c, "slope", m, centre, n, size, rp);
     } else {
         const double a[3] = {-1, 0, 0}, b[3] = {9, 0, 0};
         dem_test_segment(&c, "slope", m, a, b, rp);
     }
-    double x[3] = {0, 0, 0};
+    double x[3] = {0, 0.0371, 0}; /* off the mesh lines */
     int s = dem_test_sphere(&c, "ball", m, R, x, LAHAR_MOTION_FREE);
     /* start at the static overlap so that the normal transient is small */
     c.bodies[s].x[dim == 3 ? 2 : 1] = R + rp - c.bodies[s].mass * g * cos(theta) / kn;
@@ -50,6 +103,11 @@ static double incline_accel(int dim, double theta, double mu, double *spin_ratio
     return (v2 - v1) / (t2 - t1);
 }
 
+static double incline_accel(int dim, double theta, double mu, double *spin_ratio)
+{
+    return incline_accel_on(dim, theta, mu, spin_ratio, 0);
+}
+
 int main(void)
 {
     const double g = 9.81, th = 30.0 * M_PI / 180.0;
@@ -68,5 +126,12 @@ int main(void)
     a = incline_accel(2, th, 0.1, &spin);
     dem_test_rel("disc sliding (mu 0.1) acceleration vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
     dem_test_check(spin < 0.9, "disc sliding: w R / v = %.3f < 1 (slips)", spin);
+    /* the same on a fine terrain mesh (feature grid; contacts move across triangles/segments) */
+    a = incline_accel_on(3, th, 0.5, &spin, 1);
+    dem_test_rel("sphere rolling on a 960-triangle terrain vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
+    a = incline_accel_on(3, th, 0.1, &spin, 1);
+    dem_test_rel("sphere sliding on a 960-triangle terrain vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
+    a = incline_accel_on(2, th, 0.5, &spin, 1);
+    dem_test_rel("disc rolling on a 100-segment polyline vs 2/3 g sin", a, 2.0 / 3.0 * g * sin(th), 0.01);
     return dem_test_failures ? 1 : 0;
 }
