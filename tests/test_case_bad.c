@@ -3,9 +3,9 @@
  *     # expect: bodies[0].radius: must be > 0
  *     # line: 12
  * The fixture is run through lahar-case-check, which must exit with status 2 and print exactly
- * one line on stderr that starts with `<fixture path>:<line>:` and contains the expected
- * fragment. (Under the sanitizer build a leak on the error path changes the exit status, so this
- * also checks that nothing stays allocated on failure.) */
+ * one line on stderr that starts with `<fixture path>:<line>:` and contains every expected
+ * fragment (one `# expect:` line each, up to 4). Under the sanitizer build a leak on the error
+ * path changes the exit status, so this also checks that nothing stays allocated on failure. */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,7 +67,8 @@ int main(int argc, char **argv)
     qsort(names, (size_t)n, sizeof *names, name_cmp);
     int failures = 0;
     for (int i = 0; i < n; i++) {
-        char path[2048], expect[1100] = "", line[1100] = "", buf[8192], want[4200];
+        char path[2048], expect[4][1100] = {"", "", "", ""}, line[1100] = "", buf[8192], want[4200];
+        int nexpect = 0;
         snprintf(path, sizeof path, "%s/%s", argv[2], names[i]);
         FILE *fp = fopen(path, "r");
         if (!fp) {
@@ -78,26 +79,28 @@ int main(int argc, char **argv)
         char l[1024];
         while (fgets(l, sizeof l, fp) && l[0] == '#') {
             l[strcspn(l, "\n")] = '\0';
-            if (strncmp(l, "# expect: ", 10) == 0)
-                snprintf(expect, sizeof expect, "%.1000s", l + 10);
+            if (strncmp(l, "# expect: ", 10) == 0 && nexpect < 4)
+                snprintf(expect[nexpect++], sizeof expect[0], "%.1000s", l + 10);
             else if (strncmp(l, "# line: ", 8) == 0)
                 snprintf(line, sizeof line, "%.1000s", l + 8);
         }
         fclose(fp);
-        if (!expect[0] || !line[0]) {
+        if (!nexpect || !line[0]) {
             printf("FAIL %s: fixture lacks '# expect:' or '# line:' header\n", names[i]);
             failures++;
             continue;
         }
         int st = run_capture(argv[1], path, buf, sizeof buf);
         snprintf(want, sizeof want, "%s:%s: ", path, line);
-        int one_line = strchr(buf, '\n') == buf + strlen(buf) - 1;
+        int one_line = strchr(buf, '\n') == buf + strlen(buf) - 1, found = 1;
+        for (int e = 0; e < nexpect; e++)
+            found &= strstr(buf, expect[e]) != NULL;
         const char *why = st != 2 ? "exit status is not 2"
                           : strncmp(buf, want, strlen(want)) != 0 ? "message does not start with <path>:<line>:"
-                          : !strstr(buf, expect) ? "expected fragment missing"
+                          : !found ? "an expected fragment is missing"
                           : !one_line ? "not exactly one line on stderr" : NULL;
         if (why) {
-            printf("FAIL %s: %s (status %d)\n  want: %s... %s\n  got:  %s\n", names[i], why, st, want, expect, buf);
+            printf("FAIL %s: %s (status %d)\n  want: %s... %s\n  got:  %s\n", names[i], why, st, want, expect[0], buf);
             failures++;
         } else {
             printf("ok   %s\n     %s", names[i], buf);
