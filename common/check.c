@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "geometry.h"
+#include "output.h"
 #include "vec.h"
 
 extern char **environ;
@@ -46,7 +47,7 @@ static int check_load_forces(const char *outdir, lahar_check_data *d)
     snprintf(path, sizeof path, "%s/forces.h5", outdir);
     if (access(path, R_OK) != 0)
         return 0;
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
+    hid_t f = lahar_h5_file_open(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT, 0);
     if (f < 0)
         return -1;
     int rc = -1;
@@ -80,7 +81,7 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
     }
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_file_locking(fapl, 0, 1);
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    hid_t f = lahar_h5_file_open(path, H5F_ACC_RDONLY, fapl, 0);
     H5Pclose(fapl);
     if (f < 0) {
         snprintf(err, n, "%s: not a readable HDF5 file", path);

@@ -22,6 +22,19 @@
 
 /* ---------------------------------------------------------------- small HDF5 helpers ---- */
 
+/* H5Fcreate/H5Fopen without HDF5's error-stack dump on failure: callers report one message of
+ * their own (a missing output directory is a user error, not a library trace). */
+int64_t lahar_h5_file_open(const char *path, unsigned flags, int64_t fapl, int create)
+{
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    hid_t f = create ? H5Fcreate(path, flags, H5P_DEFAULT, (hid_t)fapl) : H5Fopen(path, flags, (hid_t)fapl);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+    return f;
+}
+
 /* Files that are closed between snapshots are opened without HDF5's file lock so that a viewer
  * holding the file open (ParaView) never makes the next snapshot fail. */
 static hid_t out_fapl_unlocked(void)
@@ -321,7 +334,7 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
-    fs->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    fs->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
     if (fs->file < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", path);
@@ -420,13 +433,14 @@ static int forces_flush(forces_stream *fs)
 
 static void forces_close(forces_stream *fs)
 {
-    forces_flush(fs);
-    hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts};
-    for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
-        if (ids[k] >= 0)
-            H5Dclose(ids[k]);
-    if (fs->file >= 0)
+    if (fs->file >= 0) { /* forces_open set every id (invalid until created) */
+        forces_flush(fs);
+        hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts};
+        for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
+            if (ids[k] >= 0)
+                H5Dclose(ids[k]);
         H5Fclose(fs->file);
+    }
     free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont);
     memset(fs, 0, sizeof *fs);
     fs->file = H5I_INVALID_HID;
@@ -487,7 +501,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
         return NULL;
     }
     hid_t fapl = out_fapl_unlocked();
-    hid_t f = H5Fcreate(o->h5path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
@@ -545,7 +559,7 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
         }
     }
     hid_t fapl = out_fapl_unlocked();
-    hid_t f = H5Fopen(o->h5path, H5F_ACC_RDWR, fapl);
+    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
     H5Pclose(fapl);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
@@ -663,7 +677,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
     hid_t fapl = out_fapl_unlocked();
-    hid_t f = H5Fcreate(o->h5path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
@@ -707,7 +721,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
 {
     hid_t fapl = out_fapl_unlocked();
-    hid_t f = H5Fopen(o->h5path, H5F_ACC_RDWR, fapl);
+    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
     H5Pclose(fapl);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
@@ -816,7 +830,7 @@ static int64_t out_read_snapshot_list(const char *path, out_snap_entry **list)
         return 0;
     fclose(probe);
     hid_t fapl = out_fapl_unlocked();
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    hid_t f = lahar_h5_file_open(path, H5F_ACC_RDONLY, fapl, 0);
     H5Pclose(fapl);
     if (f < 0)
         return -1;
@@ -885,7 +899,7 @@ int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n)
     lahar_xdmf_particles xp = {"particles.h5", 0};
     if (nbs > 0) {
         hid_t fapl = out_fapl_unlocked();
-        hid_t f = H5Fopen(bpath, H5F_ACC_RDONLY, fapl);
+        hid_t f = lahar_h5_file_open(bpath, H5F_ACC_RDONLY, fapl, 0);
         H5Pclose(fapl);
         int64_t v[6] = {0};
         if (f >= 0) {
@@ -902,7 +916,7 @@ int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n)
     }
     if (nps > 0) {
         hid_t fapl = out_fapl_unlocked();
-        hid_t f = H5Fopen(ppath, H5F_ACC_RDONLY, fapl);
+        hid_t f = lahar_h5_file_open(ppath, H5F_ACC_RDONLY, fapl, 0);
         H5Pclose(fapl);
         int64_t v = 0;
         if (f >= 0) {

@@ -81,6 +81,10 @@ typedef struct {
     int32_t *cell;      /* ncell * nodes_per_cell vertex indices */
 } lahar_display_mesh;
 
+/* H5Fcreate (create = 1) / H5Fopen with HDF5's automatic error printing off: callers print one
+ * message of their own. fapl is an hid_t (int64_t here to keep hdf5.h out of this header). */
+int64_t lahar_h5_file_open(const char *path, unsigned flags, int64_t fapl, int create);
+
 int lahar_display_mesh_build(const lahar_shape *s, int dim, int convex, lahar_display_mesh *m);
 void lahar_display_mesh_free(lahar_display_mesh *m);
 

@@ -6,6 +6,7 @@ if(NOT LAHAR_OUTPUT_PYTHON)
   find_program(LAHAR_OUTPUT_PYTHON python3)
 endif()
 set(LAHAR_OUTPUT_TEST_DIR ${CMAKE_BINARY_DIR}/test_output_data)
+file(MAKE_DIRECTORY ${LAHAR_OUTPUT_TEST_DIR})
 
 function(lahar_output_test name)
   add_executable(${name} ${LAHAR_TEST_DIR}/${name}.c)

@@ -408,6 +408,13 @@ int main(int argc, char **argv)
     test_bodies(d3, 3);
     test_bodies(d2, 2);
     test_particles(d2);
+    /* a missing output directory: NULL, one message naming the file, nothing leaked (ASan) */
+    lahar_case c;
+    make_case(&c, 3);
+    char err[512] = "";
+    lahar_body_output *o = lahar_body_output_open("/nonexistent/lahar_out", &c, err, sizeof err);
+    CHECK(o == NULL && strstr(err, "/nonexistent/lahar_out/bodies.h5"), "open in a missing directory: %s", err);
+    free_case();
     if (failures) {
         fprintf(stderr, "test_output: %d failure(s)\n", failures);
         return 1;
