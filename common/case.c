@@ -1182,11 +1182,10 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     }
     snprintf(c->check.reference, sizeof c->check.reference, "%s", ref);
+    c->check.enabled = 1;
     yaml_node_t *mn = rmap_get(&m, "metrics");
-    if (!mn) {
-        rmap_missing(&m, "metrics", "{restitution_rel_error: 0.01}");
-        return;
-    }
+    if (!mn)
+        return; /* the reference's default metric and bound apply (common/check.c) */
     if (rmap_open(r, mn, "check.metrics", &mm) != 0)
         return;
     int nm = (int)(mn->data.mapping.pairs.top - mn->data.mapping.pairs.start);
@@ -1216,7 +1215,6 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
         c->check.metric[i].bound = v;
         c->check.nmetric = i + 1;
     }
-    c->check.enabled = 1;
 }
 
 /* --- entry points ------------------------------------------------------------------------------- */
