@@ -34,3 +34,7 @@ lahar_output_test(test_check)
 add_test(NAME output_check COMMAND test_check ${LAHAR_OUTPUT_TEST_DIR}/check)
 set_tests_properties(output_check PROPERTIES LABELS "fast;output" TIMEOUT 120
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+add_test(NAME output_h5_compare COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_h5_compare.py
+  ${LAHAR_OUTPUT_TEST_DIR}/h5_compare)
+set_tests_properties(output_h5_compare PROPERTIES LABELS "fast;output" TIMEOUT 60)
