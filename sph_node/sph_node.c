@@ -45,7 +45,7 @@ int64_t lahar_sph_particles_create(lahar_sph_particles *p, int dim, double dx, d
             lahar_sph_particles_free(p);
             return -1;
         }
-    if (!(p->id = calloc(cap, sizeof *p->id))) {
+    if (!(p->id = calloc(cap, sizeof *p->id)) || !(p->phase = calloc(cap, sizeof *p->phase))) {
         lahar_sph_particles_free(p);
         return -1;
     }
@@ -80,6 +80,7 @@ void lahar_sph_particles_free(lahar_sph_particles *p)
     free(p->density);
     free(p->pressure);
     free(p->id);
+    free(p->phase);
     memset(p, 0, sizeof *p);
 }
 
@@ -124,7 +125,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
 {
     lahar_particles_view v = {
         .n = s->p.n, .x = s->p.x, .y = s->p.y, .z = s->p.z, .vx = s->p.vx, .vy = s->p.vy, .vz = s->p.vz,
-        .density = s->p.density, .pressure = s->p.pressure, .id = s->p.id,
+        .density = s->p.density, .pressure = s->p.pressure, .phase = s->p.phase, .id = s->p.id,
     };
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }

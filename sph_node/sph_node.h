@@ -16,6 +16,7 @@ typedef struct {
 typedef struct {
     int64_t n;
     double *x, *y, *z, *vx, *vy, *vz, *density, *pressure;
+    int32_t *phase; /* 0 = fluid for now */
     int64_t *id;
 } lahar_sph_particles;
 

@@ -5,8 +5,8 @@
 # or one this script makes with `unshare --user --map-root-user --net` (lo up, multicast on, route
 # 224.0.0.0/4 via lo, ttl=0 or ttl=1 on an isolated veth link). Nothing leaves the host.
 #
-#   coupling_netns.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: processes | packet_loss | node_killed | concurrent | cross_host
+#   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
+#   TEST: inprocess_both | processes | packet_loss | node_killed | concurrent | cross_host
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -32,6 +32,19 @@ bodies:
   - {name: crate, shape: box, size: [0.2, 0.1, 0.1], radius: 0.02, material: rock, position: [0.3, 0, 0.15]}
   - {name: ball2, shape: sphere, radius: 0.04, material: rock, position: [0.02, 0.01, 0.4], velocity: [0, 0, -1]}
   - {name: floor, shape: plane, motion: fixed, normal: [0, 0, 1], size: [2, 2], radius: 0.02, material: rock, position: [0, 0, 0]}
+YAML
+}
+
+# The same bodies with a block of SPH particles beside them: both nodes, LOADS and BODY_STATE
+# every step. Particles fall freely (no forces yet); the SPH node chooses dt (CFL).
+write_case_both() { # file
+    write_case "$1" 0.2
+    cat >> "$1" <<YAML
+sph:
+  dx: 0.02
+  density: 1000
+  blocks:
+    - {name: water, box: {lo: [-1, -1, 0.5], hi: [-0.8, -0.9, 0.6]}, velocity: [0.5, 0, 1]}
 YAML
 }
 
@@ -62,12 +75,50 @@ in_private_netns() {
 }
 
 case $test_name in
+inprocess_both)
+    # DEM and SPH nodes as threads. References: every particle's velocity is v0 + g t exactly at
+    # every snapshot (time is consistent between coordinator and node: the steps sum to t), the
+    # snapshot times are exactly j * output_interval, one LOADS and one BODY_STATE per step.
+    write_case_both both.yaml
+    "$bin/lahar" run both.yaml -o both -q --in-process || fail "in-process DEM + SPH run failed"
+    "$python" - both <<'PY' || fail "in-process DEM + SPH run: wrong results"
+import json, sys
+import h5py, numpy as np
+out = sys.argv[1]
+s = json.load(open(out + "/summary.json"))
+steps = s["steps"]
+assert s["status"] == "finished" and s["sim_time"] == 0.2, (s["status"], s["sim_time"])
+assert set(s["nodes"]) == {"dem", "sph"}, s["nodes"].keys()
+for ch in ("LAHAR_LOADS", "LAHAR_BODY_STATE", "LAHAR_STEP"):
+    assert s["channels"][ch]["messages"] == steps, (ch, s["channels"][ch]["messages"], steps)
+with h5py.File(out + "/particles.h5", "r") as f:
+    names = sorted(f["snapshots"])
+    assert len(names) == 5, names  # t = 0, 0.05, ..., 0.2
+    worst = 0.0
+    for j, name in enumerate(names):
+        g = f["snapshots"][name]
+        t = float(g.attrs["time"])
+        assert t == j * 0.05, (name, t, j * 0.05)
+        vz, vx = np.asarray(g["vz"]), np.asarray(g["vx"])
+        worst = max(worst, float(np.max(np.abs(vz - (1.0 - 9.81 * t)))))
+        assert np.all(vx == 0.5)
+    assert worst < 1e-9, worst
+print("inprocess_both: %d steps, %d particle snapshots, max |vz - (v0 + g t)| = %.2e m/s" % (steps, len(names), worst))
+PY
+    ;;
 processes)
     # `lahar run` (own namespace, nodes as processes) == `lahar run --in-process`
     reference
     "$bin/lahar" run case.yaml -o proc -q || fail "multi-process run failed"
     same_as_reference proc
     [ "$(summary proc "s['mode']")" = processes ] || fail "mode is not processes"
+    # both nodes, with LOADS / BODY_STATE between them
+    write_case_both both.yaml
+    "$bin/lahar" run both.yaml -o both_ip -q --in-process || fail "in-process DEM + SPH run failed"
+    "$bin/lahar" run both.yaml -o both_proc -q || fail "multi-process DEM + SPH run failed"
+    for f in bodies.h5 forces.h5 particles.h5; do
+        "$python" "$tools/h5_compare.py" --quiet both_ip/$f both_proc/$f || fail "DEM + SPH: $f differs between modes"
+    done
     ;;
 packet_loss)
     # 2 % of all UDP datagrams dropped by nft: NACKs repair, the result stays bitwise the same.

@@ -1,0 +1,36 @@
+# Protocol, coordinator and nodes (brief C): common/link.c, common/transport.c, common/netns.c,
+# coordinator/, dem_node/dem_node.c, sph_node/. The run tests need `unshare` of user + network
+# namespaces and nft (label netns); each multicast run happens in a private namespace.
+add_executable(test_coupling_clock ${LAHAR_TEST_DIR}/test_coupling_clock.c)
+target_link_libraries(test_coupling_clock PRIVATE lahar_coord)
+add_test(NAME coupling_clock COMMAND test_coupling_clock)
+set_tests_properties(coupling_clock PROPERTIES LABELS "fast;coupling")
+
+add_executable(test_coupling_link ${LAHAR_TEST_DIR}/test_coupling_link.c)
+target_link_libraries(test_coupling_link PRIVATE lahar_common)
+add_test(NAME coupling_link COMMAND test_coupling_link)
+set_tests_properties(coupling_link PROPERTIES LABELS "fast;coupling" TIMEOUT 60)
+
+add_executable(test_sph_particles ${LAHAR_TEST_DIR}/test_sph_particles.c)
+target_link_libraries(test_sph_particles PRIVATE lahar_sph)
+add_test(NAME sph_particles COMMAND test_sph_particles)
+set_tests_properties(sph_particles PROPERTIES LABELS "fast;coupling")
+
+find_program(LAHAR_COUPLING_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT LAHAR_COUPLING_PYTHON)
+  find_program(LAHAR_COUPLING_PYTHON python3)
+endif()
+# coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
+function(lahar_coupling_run_test name labels)
+  add_test(NAME coupling_${name}
+           COMMAND bash ${LAHAR_TEST_DIR}/coupling_runs.sh ${name} $<TARGET_FILE_DIR:lahar>
+                   ${CMAKE_SOURCE_DIR}/tools ${CMAKE_CURRENT_BINARY_DIR}/coupling_${name})
+  set_tests_properties(coupling_${name} PROPERTIES LABELS "${labels}" TIMEOUT 180
+                       DEPENDS "" REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
+endfunction()
+lahar_coupling_run_test(inprocess_both "fast;coupling")
+lahar_coupling_run_test(processes "fast;netns;coupling")
+lahar_coupling_run_test(packet_loss "fast;netns;coupling")
+lahar_coupling_run_test(node_killed "slow;netns;coupling")
+lahar_coupling_run_test(concurrent "slow;netns;coupling")
+lahar_coupling_run_test(cross_host "slow;netns;coupling")
