@@ -108,6 +108,43 @@ static double incline_accel(int dim, double theta, double mu, double *spin_ratio
     return incline_accel_on(dim, theta, mu, spin_ratio, 0);
 }
 
+/* The same with a really tilted plane (normal (-sin, 0, cos)) and vertical gravity: the
+ * acceleration along the slope, from the velocity component along it. */
+static double tilted_plane_accel(double theta, double mu)
+{
+    const double g = 9.81, R = 0.05, rp = 0.01, kn = 1e6;
+    const double gv[3] = {0, 0, -g};
+    lahar_case c;
+    dem_test_case_init(&c, 3, gv, 2);
+    int m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, kn, 0, 0, 0.5, mu);
+    const double n[3] = {-sin(theta), 0, cos(theta)}, centre[3] = {0, 0, 0}, size[2] = {12, 2};
+    dem_test_plane(&c, "slope", m, centre, n, size, rp);
+    double up[3] = {cos(theta), 0, sin(theta)}; /* up the slope (the surface rises along +x) */
+    double x[3];
+    int s = dem_test_sphere(&c, "ball", m, R, up, LAHAR_MOTION_FREE);
+    double hgt = R + rp - c.bodies[s].mass * g * cos(theta) / kn;
+    for (int k = 0; k < 3; k++) x[k] = 2.0 * up[k] + hgt * n[k];
+    for (int k = 0; k < 3; k++) c.bodies[s].x[k] = x[k];
+    const lahar_dem_engine_ops *ops;
+    lahar_dem_engine *e = dem_test_engine(&c, &ops);
+    char err[512];
+    double v1 = 0.0, v2 = 0.0;
+    for (int k = 1; k <= 1200; k++) {
+        if (ops->advance(e, 1e-3, NULL, err, sizeof err) < 0) {
+            dem_test_check(0, "advance: %s", err);
+            break;
+        }
+        lahar_body_state st;
+        ops->get_state(e, s, &st);
+        double vs = -(st.v[0] * up[0] + st.v[1] * up[1] + st.v[2] * up[2]);
+        if (k == 200) v1 = vs;
+        if (k == 1200) v2 = vs;
+    }
+    ops->destroy(e);
+    dem_test_case_free(&c);
+    return (v2 - v1) / 1.0;
+}
+
 int main(void)
 {
     const double g = 9.81, th = 30.0 * M_PI / 180.0;
@@ -126,6 +163,10 @@ int main(void)
     a = incline_accel(2, th, 0.1, &spin);
     dem_test_rel("disc sliding (mu 0.1) acceleration vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
     dem_test_check(spin < 0.9, "disc sliding: w R / v = %.3f < 1 (slips)", spin);
+    a = tilted_plane_accel(th, 0.5);
+    dem_test_rel("sphere rolling on a tilted plane vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
+    a = tilted_plane_accel(th, 0.1);
+    dem_test_rel("sphere sliding on a tilted plane vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
     /* the same on a fine terrain mesh (feature grid; contacts move across triangles/segments) */
     a = incline_accel_on(3, th, 0.5, &spin, 1);
     dem_test_rel("sphere rolling on a 960-triangle terrain vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
