@@ -197,12 +197,15 @@ static int check_fixed_touched(const lahar_case *c, const lahar_check_data *d, i
 
 /* ---------------------------------------------------------------- restitution ----------- */
 
+static double check_gap(const lahar_case *c, int j, vec3 x, double R, vec3 *normal);
+
 /* A sphere dropped on a fixed floor (reference 06 §6.2/6.3/6.7). Between contacts the body is
  * in free flight, so each snapshot fixes a parabola h(t) = h_k + u_k (t - t_k) - g (t - t_k)^2/2
- * along -g. The impact instant of a bounce is where the parabola of the last snapshot before it
- * meets the one of the first snapshot after it (their difference is linear in t; contact time
- * neglected, an error of order g t_c / v); the speeds of both parabolas there give
- * e = rebound / impact, independent of where the floor is and of the snapshot interval. */
+ * along -g. A bounce lies between the last snapshot moving down and the first moving up; e is
+ * the speed of the rising parabola over the speed of the falling one, both taken at the touching
+ * height (where the overlap is zero: contact start and end) when the nearest fixed body is a
+ * horizontal surface, otherwise at the instant where the two parabolas meet (contact time
+ * neglected, an error of order g t_c (1 - e) / 2v). Independent of the snapshot interval. */
 static int check_restitution(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
 {
     int b = check_first_free_body(c);
@@ -242,9 +245,32 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
         if (!(ti >= tp && ti <= tq))
             continue;
         double u_imp = -(up - g * (ti - tp)), u_reb = uq - g * (ti - tq);
+        double hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp);
+        /* With a flat floor under the ball the contact starts and ends at the touching height
+         * h_c (zero overlap), and energy along each parabola gives the speeds there exactly:
+         * u^2 = u_k^2 + 2 g (h_k - h_c). This removes the g t_c/2 bias of the meeting point. */
+        int floor_j = -1;
+        double gap_p = INFINITY;
+        vec3 xp = check_vec(d, d->x, p, b), nrm;
+        for (int j = 0; j < c->nbody; j++) {
+            if (c->bodies[j].motion != LAHAR_MOTION_FIXED || c->bodies[j].shape.nv == 0)
+                continue;
+            double gap = check_gap(c, j, xp, c->bodies[b].shape.radius, NULL);
+            if (gap < gap_p)
+                gap_p = gap, floor_j = j;
+        }
+        if (floor_j >= 0 && c->bodies[b].shape.nv == 1) {
+            check_gap(c, floor_j, xp, c->bodies[b].shape.radius, &nrm);
+            double hc = hp - gap_p;
+            if (-v3_dot(nrm, gh) > 0.999 && hp >= hc && hq >= hc) {
+                u_imp = sqrt(up * up + 2.0 * g * (hp - hc));
+                u_reb = sqrt(uq * uq + 2.0 * g * (hq - hc));
+                hi = hc;
+            }
+        }
         if (u_imp <= 0.0 || u_reb <= 0.0)
             continue;
-        double e = u_reb / u_imp, hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp);
+        double e = u_reb / u_imp;
         if (nb == 0) {
             e_first = e, u_imp_first = u_imp, u_reb_first = u_reb, t_first = ti, h_contact = hi, p_first = p;
         }
