@@ -443,6 +443,78 @@ static void test_stl(const char *tmpdir)
     CHECK(lahar_shape_read_stl(&s, path, 0.01, err, sizeof err) != 0 && strstr(err, path), "missing STL named: %s", err);
 }
 
+/* Loader paths not covered by cases/: STL body (path relative to the case, scale, placement),
+ * prescribed body, defaults, 2D polygon/box with orientation. Runs after test_stl (cube.stl). */
+static void test_loader_misc(const char *tmpdir)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/misc3d.yaml", tmpdir);
+    FILE *fp = fopen(path, "w");
+    if (!fp) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(fp, "dimensions: 3\ntime: {end: 2.0}\n"
+                "materials: {rock: {density: 1000, young: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                "bodies:\n"
+                "  - {name: terrain, shape: stl, file: cube.stl, scale: 2, motion: fixed, radius: 0.01,\n"
+                "     material: rock, position: [10, 0, 0], orientation: {axis: [0, 0, 1], angle_deg: 90}}\n"
+                "  - {name: gate, shape: box, size: [0.2, 0.2, 0.2], radius: 0.01, motion: prescribed,\n"
+                "     material: rock, position: [0, 0, 5], velocity: [0, 0, 0.1]}\n");
+    fclose(fp);
+    lahar_case c;
+    CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
+    if (c.nbody == 2) {
+        /* defaults */
+        CHECK(c.gravity[2] == -9.81 && c.dt_max == 1e-3 && c.dt_min == 1e-9 && c.output_interval == 0.02 &&
+                  c.forces_interval == 0 && strcmp(c.dem_engine, "spheropoly") == 0 && c.dem_dt_safety == 0.02 &&
+                  c.materials[0].model == LAHAR_CONTACT_HERTZ && c.materials[0].poisson == 0.25 &&
+                  fabs(c.materials[0].kt_ratio - 2.0 / 7.0) < 1e-15 && c.output_fields == 0x1f && c.output_forces == 1,
+              "defaults filled in");
+        const lahar_body *t = &c.bodies[0], *g = &c.bodies[1];
+        /* cube.stl spans [0, 1]^3; scaled by 2, turned 90 deg about z, moved to x = 10:
+         * world x in [8, 10], y in [0, 2], z in [0, 2] */
+        double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+        for (int v = 0; v < t->shape.nv; v++)
+            for (int k = 0; k < 3; k++) {
+                lo[k] = fmin(lo[k], t->shape.v[v][k]);
+                hi[k] = fmax(hi[k], t->shape.v[v][k]);
+            }
+        CHECK(fabs(lo[0] - 8) + fabs(hi[0] - 10) + fabs(lo[1]) + fabs(hi[1] - 2) + fabs(lo[2]) + fabs(hi[2] - 2) < 1e-12,
+              "STL placed in the world: [%g %g] [%g %g] [%g %g]", lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+        CHECK(t->motion == LAHAR_MOTION_FIXED && t->mass == 0 && t->q[0] == 1 && t->x[0] == 0, "fixed body frame");
+        CHECK(g->motion == LAHAR_MOTION_PRESCRIBED && g->v[2] == 0.1 && g->mass > 0 && g->x[2] == 5,
+              "prescribed body keeps its velocity, has mass properties");
+    }
+    lahar_case_free(&c);
+
+    snprintf(path, sizeof path, "%s/misc2d.yaml", tmpdir);
+    fp = fopen(path, "w");
+    if (!fp) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(fp, "dimensions: 2\ntime: {end: 1.0}\n"
+                "materials: {rock: {density: 2000, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
+                "bodies:\n"
+                "  - {name: tri, shape: polygon, radius: 0.01, material: rock, position: [1, 1],\n"
+                "     vertices: [[0, 0], [0.3, 0], [0, 0.3], [0.05, 0.05]], angular_velocity: 2}\n"
+                "  - {name: slab, shape: box, size: [0.4, 0.1], radius: 0.01, material: rock, position: [0, 0],\n"
+                "     orientation: {angle_deg: 30}}\n");
+    fclose(fp);
+    CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
+    if (c.nbody == 2) {
+        const lahar_body *t = &c.bodies[0], *s = &c.bodies[1];
+        CHECK(t->shape.nv == 3 && t->shape.nf == 0 && t->shape.ne == 3, "2D hull drops the interior point");
+        CHECK(t->w[2] == 2 && t->x[2] == 0 && fabs(t->q[1]) + fabs(t->q[2]) < 1e-15, "2D body stays in the plane");
+        double ang = 2 * atan2(s->q[3], s->q[0]) * 180 / M_PI;
+        CHECK(fabs(ang - 30) < 1e-9, "2D box orientation %.12g deg", ang);
+        double R = 0.01, a = 0.38, b = 0.08, A = a * b + 2 * R * (a + b) + M_PI * R * R;
+        CHECK(rel(s->mass, 2000 * A) < 1e-12, "2D box mass per unit thickness %.15g vs %.15g", s->mass, 2000 * A);
+    }
+    lahar_case_free(&c);
+}
+
 static void test_jacobi(void)
 {
     uint64_t st = 99;
@@ -547,6 +619,7 @@ int main(int argc, char **argv)
     test_rotated_box(argv[2]);
     test_rock_grid();
     test_stl(argv[2]);
+    test_loader_misc(argv[2]);
     test_cases_dir(argv[1]);
     printf("%d checks, %d failures\n", checks, failures);
     return failures ? 1 : 0;
