@@ -226,7 +226,8 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
     /* u_k follows u_{k-1} - g dt in free flight (exact for leap-frog under constant gravity) */
 #define FREE(k0, k1) (fabs(U(k1) - (U(k0) - g * (d->t[k1] - d->t[k0]))) <= 1e-6 * (fabs(U(k0)) + g * (d->t[k1] - d->t[k0])) + 1e-12)
     int nb = 0;
-    double e_first = NAN, err_max = 0.0, u_imp_first = 0.0, u_reb_first = 0.0, t_first = 0.0, h_contact = 0.0;
+    double e_first = NAN, err_max = 0.0, u_imp_first = 0.0, u_reb_first = 0.0, t_first = 0.0, h_contact = 0.0,
+           t_sep_first = 0.0;
     int64_t p_first = 0;
     for (int64_t k = 0; k + 1 < d->nsnap; k++) {
         if (!(U(k) < 0.0 && U(k + 1) > 0.0))
@@ -245,7 +246,7 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
         if (!(ti >= tp && ti <= tq))
             continue;
         double u_imp = -(up - g * (ti - tp)), u_reb = uq - g * (ti - tq);
-        double hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp);
+        double hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp), t_touch = ti, t_sep = ti;
         /* With a flat floor under the ball the contact starts and ends at the touching height
          * h_c (zero overlap), and energy along each parabola gives the speeds there exactly:
          * u^2 = u_k^2 + 2 g (h_k - h_c). This removes the g t_c/2 bias of the meeting point. */
@@ -266,13 +267,16 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
                 u_imp = sqrt(up * up + 2.0 * g * (hp - hc));
                 u_reb = sqrt(uq * uq + 2.0 * g * (hq - hc));
                 hi = hc;
+                t_touch = tp + (up + u_imp) / g; /* u(t) = up - g (t - tp) reaches -u_imp */
+                t_sep = tq - (u_reb - uq) / g;   /* and the rising parabola left h_c at +u_reb */
             }
         }
         if (u_imp <= 0.0 || u_reb <= 0.0)
             continue;
         double e = u_reb / u_imp;
         if (nb == 0) {
-            e_first = e, u_imp_first = u_imp, u_reb_first = u_reb, t_first = ti, h_contact = hi, p_first = p;
+            e_first = e, u_imp_first = u_imp, u_reb_first = u_reb, t_first = t_touch, h_contact = hi, p_first = p;
+            t_sep_first = t_sep;
         }
         /* later bounces count only while the flight after them spans >= 3 snapshots, so that no
          * second bounce hides between two snapshots */
@@ -302,12 +306,14 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
     snprintf(r->xlabel, sizeof r->xlabel, "t [s]");
     snprintf(r->ylabel, sizeof r->ylabel, "height along -g [m]");
     /* reference: the measured pre-impact flight, then bounces at the impact height with e_ref */
-    double t0 = t_first, u0 = e_ref * u_imp_first;
+    double t0 = t_sep_first, u0 = e_ref * u_imp_first;
     double hp = H(p_first), up = U(p_first), tp = d->t[p_first];
     for (int64_t k = 0; k < d->nsnap && r->nseries < LAHAR_CHECK_MAX_SERIES; k++) {
         double t = d->t[k], href;
         if (t <= t_first) {
             href = hp + up * (t - tp) - 0.5 * g * (t - tp) * (t - tp);
+        } else if (t <= t_sep_first) {
+            href = h_contact; /* in contact (the overlap is not drawn) */
         } else {
             while (u0 > 1e-9 && t > t0 + 2.0 * u0 / g) {
                 t0 += 2.0 * u0 / g;
