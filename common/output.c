@@ -500,6 +500,9 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
         lahar_body_output_close(o);
         return NULL;
     }
+    char stale[OUT_PATH_MAX + 16];
+    snprintf(stale, sizeof stale, "%s/lahar.xmf", outdir); /* a previous run's, rebuilt at close */
+    unlink(stale);
     hid_t fapl = out_fapl_unlocked();
     hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
@@ -538,6 +541,9 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
 
 int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, const lahar_body_state *s)
 {
+    /* the force rows so far reach the disk with every snapshot too, even if the run then stalls */
+    if (forces_flush(&o->fs))
+        fprintf(stderr, "lahar: %s/forces.h5: flushing the force stream failed\n", o->dir);
     int nb = o->nbody;
     double *X = o->state, *Q = X + 3 * nb, *V = Q + 4 * nb, *W = V + 3 * nb;
     int64_t iv = 0;
