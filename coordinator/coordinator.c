@@ -640,6 +640,14 @@ stop:
     coord_send_stop(&co, status == LAHAR_EXIT_OK ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
                     co.message);
     coord_finish_nodes(&co);
+    /* a node that fails on its way out (an output error at close, a sanitizer report) fails the run */
+    for (int r = 1; r < LAHAR_NROLES && status == LAHAR_EXIT_OK; r++)
+        if (co.node[r].needed && co.node[r].exited && co.node[r].exit_status != 0) {
+            snprintf(co.message, sizeof co.message, "the %s exited with status %d after the run",
+                     lahar_link_role_name(r), co.node[r].exit_status);
+            co.status = "error";
+            status = LAHAR_EXIT_RUN_ERROR;
+        }
 out:
     co.exit_status = status;
     if (status != LAHAR_EXIT_OK)
