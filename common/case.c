@@ -957,7 +957,9 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
         /* walls keep world-frame geometry with identity orientation, mass 0 marks "immovable" */
         lahar_shape_transform(s, (const double(*)[3])R, pos, 1.0);
         b->q[0] = 1.0;
-        b->convex = lahar_shape_is_convex(s, dim, 1e-9 * (s->radius + 1.0));
+        /* the test costs faces x vertices: large meshes (terrain) are marked non-convex, which
+         * only means the engine treats them with the general mesh path */
+        b->convex = (double)s->nf * s->nv <= 5e7 && lahar_shape_is_convex(s, dim, 1e-9 * (s->radius + 1.0));
         return;
     }
     char err[256] = "";

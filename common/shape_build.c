@@ -359,8 +359,8 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
         shape_err(err, errlen, "a polyhedron needs at least 4 vertices (got %d)", n);
         return -1;
     }
-    if (n > 1024) {
-        shape_err(err, errlen, "too many points for the convex hull (%d > 1024); give faces", n);
+    if (n > 512) { /* O(n^3): 400 points take about a second */
+        shape_err(err, errlen, "too many points for the convex hull (%d > 512); give faces", n);
         return -1;
     }
     double L = points_scale(p, n), eps = 1e-9 * L;
@@ -377,11 +377,6 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
     for (int i = 0; i < n; i++)
         for (int j = i + 1; j < n; j++)
             for (int k = j + 1; k < n; k++) {
-                int known = 0;
-                for (int f = 0; f < nfc && !known; f++)
-                    known = member[(size_t)f * n + i] && member[(size_t)f * n + j] && member[(size_t)f * n + k];
-                if (known)
-                    continue;
                 vec3 a = v3_load(p[i]), b = v3_load(p[j]), c = v3_load(p[k]);
                 vec3 nn = v3_cross(v3_sub(b, a), v3_sub(c, a));
                 if (v3_norm(nn) <= 1e-12 * L * L)
@@ -400,6 +395,11 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
                     shape_err(err, errlen, "all %d vertices are coplanar (degenerate polyhedron)", n);
                     goto done;
                 }
+                int known = 0; /* a face already found through another triple of its points */
+                for (int f = 0; f < nfc && !known; f++)
+                    known = member[(size_t)f * n + i] && member[(size_t)f * n + j] && member[(size_t)f * n + k];
+                if (known)
+                    continue;
                 if (pos) { /* outward normal: the other points are behind the face */
                     nn = v3_neg(nn);
                     d = -d;

@@ -37,7 +37,8 @@ int lahar_shape_make_polygon_hull(lahar_shape *s, const double (*p)[3], int n, d
                                   size_t errlen);
 /* 3D convex hull of n >= 4 points; coplanar triangles are merged into polygonal faces and points
  * inside the hull or on its faces/edges are dropped. Fails (degenerate) if all points are
- * coplanar. Exact supporting-plane enumeration: meant for rocks of up to a few hundred points. */
+ * coplanar. Exact supporting-plane enumeration, O(n^3): meant for rocks (at most 512 points;
+ * 200 points take 0.1 s). */
 int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double radius, char *err, size_t errlen);
 /* Polyhedron from vertices and faces (face f = face_v[face_start[f] .. face_start[f+1])), which
  * must be counter-clockwise seen from outside. Edges are built from the faces. Checks indices,
