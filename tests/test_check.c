@@ -206,6 +206,12 @@ int main(int argc, char **argv)
     char png[1200];
     snprintf(png, sizeof png, "%s/check.png", dir);
     CHECK(access(png, R_OK) == 0, "no %s (python3 + matplotlib needed)", png);
+    /* without python3/matplotlib: said on stderr, check.json still written, status unchanged */
+    setenv("LAHAR_PYTHON", "/nonexistent/python3", 1);
+    char json[1200];
+    snprintf(json, sizeof json, "%s/check.json", dir);
+    unlink(json);
+    CHECK(lahar_check_evaluate(&c, dir) == 0 && access(json, R_OK) == 0, "no python: status or check.json wrong");
     /* a metric the reference does not have */
     snprintf(c.check.metric[0].name, sizeof c.check.metric[0].name, "restitution_error");
     setenv("LAHAR_CHECK_NO_PLOT", "1", 1);
