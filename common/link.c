@@ -70,6 +70,7 @@ typedef struct {
     int used;
     int64_t step, seq;
     int size;
+    double t_pub; /* last (re)publication */
     link_buf buf;
 } link_cached;
 
@@ -183,6 +184,7 @@ int lahar_link_send(lahar_link *l, int type, int64_t step, const void *data, int
         c->step = step;
         c->seq = seq;
         c->size = size;
+        c->t_pub = lahar_now();
         l->cache_next[type] = (l->cache_next[type] + 1) % LINK_CACHE_DEPTH;
         l->stats[type].msgs_sent++;
         rc = link_publish_frames(l, type, step, seq, c->buf.data, size, NULL, 0, 0);
@@ -203,11 +205,19 @@ static link_cached *link_cache_find(lahar_link *l, int type, int64_t step)
     return best;
 }
 
-static int link_resend(lahar_link *l, int type, int64_t step, const int32_t *which, int nwhich)
+/* min_age: do not re-publish a copy that went out less than min_age seconds ago. A NACK that
+ * waited in the queue while this process computed the message it asks for is answered by the
+ * original publication; if that was lost, the requester asks again after its back-off. */
+static int link_resend(lahar_link *l, int type, int64_t step, const int32_t *which, int nwhich, double min_age)
 {
     pthread_mutex_lock(&l->send_lock);
     link_cached *c = link_cache_find(l, type, step);
-    int rc = c ? link_publish_frames(l, type, step, c->seq, c->buf.data, c->size, which, nwhich, 1) : -1;
+    int rc = -1;
+    double now = lahar_now();
+    if (c && now - c->t_pub >= min_age) {
+        c->t_pub = now;
+        rc = link_publish_frames(l, type, step, c->seq, c->buf.data, c->size, which, nwhich, 1);
+    }
     pthread_mutex_unlock(&l->send_lock);
     return rc;
 }
@@ -216,7 +226,7 @@ int lahar_link_republish(lahar_link *l, int type, int64_t step)
 {
     if (type <= 0 || type >= LAHAR_NMSG)
         return -1;
-    return link_resend(l, type, step, NULL, 0);
+    return link_resend(l, type, step, NULL, 0, 0.0);
 }
 
 /* Ask `target` for its message (type, step); lists the frames still missing when part of it is
@@ -326,7 +336,7 @@ static void link_on_nack(lahar_link *l, const uint8_t *data, int size)
     if (lahar_nack_t_decode(data, 0, size, &n) < 0)
         return;
     if (n.target == l->role && n.type > 0 && n.type < LAHAR_NMSG)
-        link_resend(l, n.type, n.step, n.nmissing > 0 ? n.missing : NULL, n.nmissing);
+        link_resend(l, n.type, n.step, n.nmissing > 0 ? n.missing : NULL, n.nmissing, LINK_NACK_FIRST / 2);
     lahar_nack_t_decode_cleanup(&n);
 }
 
