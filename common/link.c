@@ -340,12 +340,46 @@ static void link_on_nack(lahar_link *l, const uint8_t *data, int size)
     lahar_nack_t_decode_cleanup(&n);
 }
 
+/* Decode a frame_t without copying its payload (the generated decoder would allocate a copy of
+ * every frame): the header is decoded field by field with LCM's own primitives, in the order of
+ * lcm_types/frame_t.lcm, and the payload, the last field, is used where it lies. */
+static int link_frame_parse(const void *buf, int len, lahar_frame_t *f)
+{
+    int pos = 0, n;
+    int64_t hash;
+#define LINK_DECODE(T, ptr)                                                                        \
+    do {                                                                                           \
+        if ((n = __##T##_decode_array(buf, pos, len - pos, (ptr), 1)) < 0)                         \
+            return -1;                                                                             \
+        pos += n;                                                                                  \
+    } while (0)
+    LINK_DECODE(int64_t, &hash);
+    if (hash != __lahar_frame_t_get_hash())
+        return -1;
+    LINK_DECODE(int64_t, &f->run_id);
+    LINK_DECODE(int32_t, &f->sender);
+    LINK_DECODE(int64_t, &f->step);
+    LINK_DECODE(int32_t, &f->type);
+    LINK_DECODE(int64_t, &f->msg_seq);
+    LINK_DECODE(int32_t, &f->nframes);
+    LINK_DECODE(int32_t, &f->index);
+    LINK_DECODE(int32_t, &f->total_size);
+    LINK_DECODE(int32_t, &f->offset);
+    LINK_DECODE(int8_t, &f->flags);
+    LINK_DECODE(int32_t, &f->size);
+#undef LINK_DECODE
+    if (f->size < 0 || f->size > len - pos)
+        return -1;
+    f->payload = (uint8_t *)buf + pos;
+    return pos + f->size;
+}
+
 static void link_on_frame(const char *channel, const void *data, size_t size, void *user)
 {
     (void)channel;
     lahar_link *l = user;
     lahar_frame_t f;
-    if (size > (size_t)INT32_MAX || lahar_frame_t_decode(data, 0, (int)size, &f) < 0)
+    if (size > (size_t)INT32_MAX || link_frame_parse(data, (int)size, &f) < 0)
         return;
     int64_t run = atomic_load(&l->run_id);
     if (run == 0 && f.sender == LAHAR_ROLE_COORDINATOR && f.type == LAHAR_FRAME_T_MSG_HELLO && f.run_id != 0) {
@@ -355,7 +389,7 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     if (f.run_id != run || run == 0 || f.sender == l->role || f.sender < 0 || f.sender >= LAHAR_NROLES ||
         f.type <= 0 || f.type >= LAHAR_NMSG || f.nframes <= 0 || f.index < 0 || f.index >= f.nframes ||
         f.total_size < 0 || f.offset < 0 || f.size < 0 || f.offset > f.total_size - f.size)
-        goto done;
+        return;
 
     l->last_heard[f.sender] = lahar_now();
     lahar_link_stats *st = &l->stats[f.type];
@@ -373,24 +407,22 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
                 l->peer_step[f.sender] = hb.step;
             lahar_heartbeat_t_decode_cleanup(&hb);
         }
-        goto done;
+        return;
     }
     if (f.type == LAHAR_FRAME_T_MSG_NACK) {
         if (f.nframes == 1)
             link_on_nack(l, f.payload, f.size);
-        goto done;
+        return;
     }
     if (!(l->want & LAHAR_MSG_BIT(f.type)) || link_window_seen(&l->window[f.sender][f.type], f.msg_seq))
-        goto done;
+        return;
     link_slot *s = link_slot_for(l, &f);
     if (!s || s->complete || s->nframes != f.nframes || s->total != f.total_size || s->got.data[f.index])
-        goto done;
+        return;
     memcpy(s->buf.data + f.offset, f.payload, (size_t)f.size);
     s->got.data[f.index] = 1;
     if (++s->nrecv == s->nframes)
         s->complete = 1;
-done:
-    lahar_frame_t_decode_cleanup(&f);
 }
 
 /* ---- waiting ------------------------------------------------------------------------------- */
