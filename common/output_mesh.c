@@ -180,10 +180,14 @@ static int mesh_polyhedron(mesh_builder *b, const lahar_shape *s)
     mesh_dedge *de = malloc((size_t)nfv * sizeof *de);
     int *first = malloc((size_t)s->nv * sizeof *first); /* a face corner at each vertex */
     int *corner = malloc((size_t)(nfv + 1) * sizeof *corner);
-    if (!offset_index || !normal || !de || !first || !corner) {
-        free(offset_index), free(normal), free(de), free(first), free(corner);
+    int *corner_face = malloc((size_t)(nfv + 1) * sizeof *corner_face); /* face of each corner */
+    if (!offset_index || !normal || !de || !first || !corner || !corner_face) {
+        free(offset_index), free(normal), free(de), free(first), free(corner), free(corner_face);
         return -1;
     }
+    for (int f = 0; f < s->nf; f++)
+        for (int k = s->face_start[f]; k < s->face_start[f + 1]; k++)
+            corner_face[k] = f;
     const double r = s->radius;
     for (int i = 0; i < s->nv; i++)
         first[i] = -1;
@@ -234,8 +238,7 @@ static int mesh_polyhedron(mesh_builder *b, const lahar_shape *s)
             vec3 out = v3(0, 0, 0);
             for (int guard = 0; guard <= nfv; guard++) {
                 /* cur: corner index (face_start[f] + i) of vertex vi in face f */
-                for (f = 0; s->face_start[f + 1] <= cur; f++)
-                    ;
+                f = corner_face[cur];
                 int fs = s->face_start[f], fn = s->face_start[f + 1] - fs, i = cur - fs;
                 corner[nc++] = offset_index[cur];
                 out = v3_add(out, normal[f]);
@@ -255,7 +258,7 @@ static int mesh_polyhedron(mesh_builder *b, const lahar_shape *s)
                     mesh_add_triangle_facing(b, corner[0], corner[k], corner[k + 1], out);
         }
     }
-    free(offset_index), free(normal), free(de), free(first), free(corner);
+    free(offset_index), free(normal), free(de), free(first), free(corner), free(corner_face);
     return 0;
 }
 
@@ -374,7 +377,9 @@ int lahar_display_mesh_build(const lahar_shape *s, int dim, int convex, lahar_di
     if (s->nv <= 0) {
         rc = 0;
     } else if (dim == 2) {
-        rc = (convex || s->nv <= 2) ? mesh_outline_convex(&b, s) : mesh_outline_edges(&b, s);
+        /* a closed convex polygon (or a disc / segment) gets its rounded outline; open chains
+         * (polylines, terrain) and non-convex bodies get a thin quad per edge */
+        rc = (s->nv <= 2 || (convex && s->ne == s->nv)) ? mesh_outline_convex(&b, s) : mesh_outline_edges(&b, s);
     } else if (s->nf > 0) {
         rc = mesh_polyhedron(&b, s);
     } else {

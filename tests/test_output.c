@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include "output.h"
 #include "shape_build.h"
 #include "vec.h"
@@ -102,6 +103,47 @@ static void test_meshes(void)
     CHECK(lahar_display_mesh_build(&s, 3, 1, &m) == 0 && m.ncell > 0, "capsule mesh");
     lahar_display_mesh_free(&m);
     lahar_shape_free(&s);
+
+    /* terrain: an open height-field surface of 2 * 100^2 triangles (fixed-body STL size) must
+     * mesh in well under a second: corner walks and edge twins are looked up, not searched */
+    {
+        enum { G = 100 };
+        double(*tv)[3] = malloc(sizeof *tv * (G + 1) * (G + 1));
+        int *fs = malloc(sizeof *fs * (2 * G * G + 1)), *fv = malloc(sizeof *fv * 6 * G * G);
+        for (int i = 0; i <= G; i++)
+            for (int j = 0; j <= G; j++) {
+                tv[i * (G + 1) + j][0] = 0.1 * i, tv[i * (G + 1) + j][1] = 0.1 * j;
+                tv[i * (G + 1) + j][2] = 0.05 * sin(0.3 * i) * cos(0.2 * j);
+            }
+        int nf = 0;
+        for (int i = 0; i < G; i++)
+            for (int j = 0; j < G; j++) {
+                int a = i * (G + 1) + j, b2 = a + G + 1;
+                int tri[2][3] = {{a, b2, b2 + 1}, {a, b2 + 1, a + 1}};
+                for (int t = 0; t < 2; t++, nf++) {
+                    fs[nf] = 3 * nf;
+                    memcpy(fv + 3 * nf, tri[t], sizeof tri[t]);
+                }
+            }
+        fs[nf] = 3 * nf;
+        char terr[256];
+        int ok = lahar_shape_make_polyhedron(&s, (const double(*)[3])tv, (G + 1) * (G + 1), fs, fv, nf, 0.01, terr,
+                                             sizeof terr) == 0;
+        CHECK(ok, "terrain polyhedron: %s", terr);
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        CHECK(ok && lahar_display_mesh_build(&s, 3, 0, &m) == 0, "terrain mesh");
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        /* faces + 2 per interior edge + the fans of the (G-1)^2 interior vertices (6 faces each) */
+        int interior_edges = 3 * G * G - 2 * G;
+        int expect = nf + 2 * interior_edges + 4 * (G - 1) * (G - 1);
+        CHECK(m.ncell == expect, "terrain mesh has %d triangles, expected %d", m.ncell, expect);
+        CHECK(sec < 1.0, "terrain mesh took %.2f s", sec);
+        lahar_display_mesh_free(&m);
+        lahar_shape_free(&s);
+        free(tv), free(fs), free(fv);
+    }
 
     /* 2D disc: a closed 48-gon, area 24 R^2 sin(2 pi/48) */
     CHECK(lahar_shape_make_sphere(&s, 0.1) == 0, "make disc");
