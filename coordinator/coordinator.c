@@ -575,6 +575,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     }
     co.run_id = coord_random_run_id();
     co.progress = !o->quiet && isatty(STDERR_FILENO);
+    co.last_progress = co.wall0;
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);

@@ -6,7 +6,8 @@
 # 224.0.0.0/4 via lo, ttl=0 or ttl=1 on an isolated veth link). Nothing leaves the host.
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: inprocess_both | processes | packet_loss | node_killed | concurrent | cross_host
+#   TEST: inprocess_both | processes | packet_loss | node_killed | coordinator_killed | concurrent |
+#         cross_host
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -163,6 +164,28 @@ node_killed)
     grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
     h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
     [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
+    ;;
+coordinator_killed)
+    # A node started by hand (--no-spawn: no PR_SET_PDEATHSIG) gives up 5 s after the coordinator
+    # went silent, with exit status 3.
+    write_case long.yaml 30
+    in_private_netns "
+        '$bin/lahar-dem' --lcm-url '$URL_LO' 2> dem_stderr.txt & dem=\$!
+        '$bin/lahar' run long.yaml -o orphan -q --no-spawn --lcm-url '$URL_LO' & coord=\$!
+        for _ in \$(seq 100); do [ -e orphan/bodies.h5 ] && break; sleep 0.05; done
+        sleep 0.5
+        kill -9 \$coord
+        t0=\$(date +%s.%N)
+        set +e
+        wait \$dem
+        echo \$? > dem_rc.txt
+        '$python' -c \"import time; print(round(time.time() - \$t0, 2))\" > dem_elapsed.txt" || fail "setup failed"
+    cat dem_stderr.txt
+    rc=$(cat dem_rc.txt) elapsed=$(cat dem_elapsed.txt)
+    echo "lahar-dem exited with $rc, ${elapsed} s after the coordinator was killed"
+    [ "$rc" -eq 3 ] || fail "lahar-dem exit status $rc, expected 3"
+    "$python" -c "import sys; sys.exit(0 if 4.5 < $elapsed < 7.5 else 1)" || fail "gave up after ${elapsed} s (expected ~5 s)"
+    grep -q "coordinator has been silent" dem_stderr.txt || fail "lahar-dem does not say why it stopped"
     ;;
 concurrent)
     # Two runs at the same time, each in its own namespace, and two more sharing one namespace
