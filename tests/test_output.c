@@ -84,6 +84,37 @@ static void test_meshes(void)
     lahar_display_mesh_free(&m);
     lahar_shape_free(&s);
 
+    /* irregular rock (hull of 20 points): closed, and its volume lies between core + R * core
+     * area (offset faces only) and the exact swept volume (the flat bevels and corner fans cut
+     * the rounded edges and corners) */
+    {
+        double pts[20][3];
+        unsigned seed = 12345;
+        for (int i = 0; i < 20; i++)
+            for (int k = 0; k < 3; k++) {
+                seed = seed * 1103515245u + 12345u;
+                pts[i][k] = ((seed >> 8) % 10000) / 10000.0 * (k == 2 ? 0.06 : 0.1) - (k == 2 ? 0.03 : 0.05);
+            }
+        char herr[256];
+        CHECK(lahar_shape_make_hull(&s, (const double(*)[3])pts, 20, 0.005, herr, sizeof herr) == 0, "hull: %s", herr);
+        CHECK(lahar_display_mesh_build(&s, 3, 1, &m) == 0, "rock mesh");
+        CHECK(mesh_closed(&m), "rock display mesh is not a closed oriented surface");
+        double area = 0.0;
+        for (int f = 0; f < s.nf; f++) {
+            vec3 nw = v3(0, 0, 0);
+            int f0 = s.face_start[f], k = s.face_start[f + 1] - f0;
+            for (int i = 0; i < k; i++)
+                nw = v3_add(nw, v3_cross(v3_load(s.v[s.face_v[f0 + i]]), v3_load(s.v[s.face_v[f0 + (i + 1) % k]])));
+            area += 0.5 * v3_norm(nw);
+        }
+        lahar_mass_props mp;
+        CHECK(lahar_shape_mass_properties(&s, 3, &mp, herr, sizeof herr) == 0, "mass props: %s", herr);
+        double lo = lahar_shape_core_volume(&s) + 0.005 * area, vm = mesh_volume(&m);
+        CHECK(vm > lo && vm < mp.volume, "rock mesh volume %.9g not in (%.9g, %.9g)", vm, lo, mp.volume);
+        lahar_display_mesh_free(&m);
+        lahar_shape_free(&s);
+    }
+
     /* sphere: icosphere on the radius, closed, volume just under 4/3 pi R^3 */
     CHECK(lahar_shape_make_sphere(&s, 0.05) == 0, "make_sphere");
     CHECK(lahar_display_mesh_build(&s, 3, 1, &m) == 0, "sphere mesh");
