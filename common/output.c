@@ -650,9 +650,10 @@ void lahar_body_output_close(lahar_body_output *o)
     free(o->mesh), free(o->moving), free(o->state), free(o->vert), free(o->vvel), free(o->xml);
     free(o);
     if (had_snapshots) {
+        /* best effort: the other writer (another process) may still be writing its file; the
+         * coordinator rebuilds lahar.xmf once every node has finished */
         char err[256];
-        if (lahar_output_xdmf_combine(dir, err, sizeof err))
-            fprintf(stderr, "lahar: %s\n", err);
+        lahar_output_xdmf_combine(dir, err, sizeof err);
     }
 }
 
@@ -813,9 +814,10 @@ void lahar_particle_output_close(lahar_particle_output *o)
     free(o->xml);
     free(o);
     if (had_snapshots) {
+        /* best effort: the other writer (another process) may still be writing its file; the
+         * coordinator rebuilds lahar.xmf once every node has finished */
         char err[256];
-        if (lahar_output_xdmf_combine(dir, err, sizeof err))
-            fprintf(stderr, "lahar: %s\n", err);
+        lahar_output_xdmf_combine(dir, err, sizeof err);
     }
 }
 
@@ -887,7 +889,21 @@ static int out_read_attr_int64(hid_t loc, const char *obj, const char *name, int
     return rc < 0 ? -1 : 0;
 }
 
+static int out_xdmf_combine(const char *outdir, char *err, size_t n);
+
 int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n)
+{
+    /* files still being written may not open cleanly: one message, no HDF5 error stacks */
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int rc = out_xdmf_combine(outdir, err, n);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+    return rc;
+}
+
+static int out_xdmf_combine(const char *outdir, char *err, size_t n)
 {
     char bpath[OUT_PATH_MAX + 16], ppath[OUT_PATH_MAX + 16], xpath[OUT_PATH_MAX + 16], tpath[OUT_PATH_MAX + 32];
     snprintf(bpath, sizeof bpath, "%s/bodies.h5", outdir);
