@@ -532,7 +532,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
         return NULL;
     }
     snprintf(path, sizeof path, "%s/forces.h5", outdir);
-    if (c->output_forces && forces_open(&o->fs, path, c, err, n)) {
+    if (c->output_forces && c->nbody > 0 && forces_open(&o->fs, path, c, err, n)) {
         lahar_body_output_close(o);
         return NULL;
     }
