@@ -18,6 +18,7 @@
 #define LINK_NACK_MAX 0.200
 #define LINK_MAX_MISSING 256
 #define LINK_FRAME_BUF (LAHAR_FRAME_PAYLOAD + 256)
+#define LINK_MAX_MESSAGE (1 << 28) /* as LCM_MAX_MESSAGE_SIZE: a larger claim is a corrupt frame */
 
 static const char *const link_channels[LAHAR_NMSG] = {
     "LAHAR_UNKNOWN", "LAHAR_HELLO", "LAHAR_SCENE", "LAHAR_STEP", "LAHAR_STATUS",
@@ -388,7 +389,9 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     }
     if (f.run_id != run || run == 0 || f.sender == l->role || f.sender < 0 || f.sender >= LAHAR_NROLES ||
         f.type <= 0 || f.type >= LAHAR_NMSG || f.nframes <= 0 || f.index < 0 || f.index >= f.nframes ||
-        f.total_size < 0 || f.offset < 0 || f.size < 0 || f.offset > f.total_size - f.size)
+        f.total_size < 0 || f.total_size > LINK_MAX_MESSAGE || f.offset < 0 || f.size < 0 ||
+        f.offset > f.total_size - f.size || f.nframes != (f.total_size + LAHAR_FRAME_PAYLOAD - 1) / LAHAR_FRAME_PAYLOAD +
+                                                             (f.total_size == 0))
         return;
 
     l->last_heard[f.sender] = lahar_now();
@@ -667,5 +670,8 @@ int64_t lahar_link_run_id(const lahar_link *l) { return atomic_load(&l->run_id);
 
 void lahar_link_get_stats(const lahar_link *l, lahar_link_stats out[LAHAR_NMSG])
 {
+    /* the heartbeat thread counts its frames under the lock */
+    pthread_mutex_lock((pthread_mutex_t *)&l->send_lock);
     memcpy(out, l->stats, sizeof l->stats);
+    pthread_mutex_unlock((pthread_mutex_t *)&l->send_lock);
 }
