@@ -14,6 +14,20 @@ double geom_point_segment(vec3 p, vec3 a, vec3 b, vec3 *c);
  * degenerate (zero-length) segments. */
 double geom_segment_segment(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 *cp, vec3 *cq);
 
+/* Squared distance from p to segment [a, b] and the parameter t in [0, 1] of the closest point
+ * (inline, no sqrt: for the culling loops of the DEM narrow phase). */
+static inline double geom_point_segment_dist2(vec3 p, vec3 a, vec3 b, double *t)
+{
+    vec3 ab = v3_sub(b, a), ap = v3_sub(p, a);
+    double l2 = v3_norm2(ab), s = 0.0;
+    if (l2 > 0.0) {
+        s = v3_dot(ap, ab) / l2;
+        s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    }
+    if (t) *t = s;
+    return v3_norm2(v3_sub(ap, v3_scale(ab, s)));
+}
+
 /* As geom_point_segment, also returning the parameter t in [0, 1] of c = a + t (b - a). */
 double geom_point_segment_param(vec3 p, vec3 a, vec3 b, vec3 *c, double *t);
 

@@ -321,11 +321,10 @@ static void test_vertex_edge(sp_pair_ctx *x, const sp_geo *gv, int i, const sp_g
     const lahar_dem_engine *e = x->e;
     vec3 p = e->vw[gv->v0 + i];
     vec3 q0 = e->vw[ge->v0 + e->edge[ge->e0 + j][0]], q1 = e->vw[ge->v0 + e->edge[ge->e0 + j][1]];
-    vec3 c;
     double t;
     double rsum = gv->radius + ge->radius;
-    double d = geom_point_segment_param(p, q0, q1, &c, &t);
-    if (d >= rsum || t <= 0.0 || t >= 1.0) return; /* ends belong to vertex-vertex */
+    if (geom_point_segment_dist2(p, q0, q1, &t) >= rsum * rsum || t <= 0.0 || t >= 1.0) return; /* ends: vertex-vertex */
+    vec3 c = v3_axpy(t, v3_sub(q1, q0), q0);
     if (edge_face_owns(e, ge, j, p)) return;
     vec3 dir = v3_normalize(v3_sub(e->st[x->b].x, e->st[x->a].x));
     if (v_is_a) contact_emit(x, SP_VE, i, j, p, c, 0, 0, dir);
@@ -397,7 +396,7 @@ static void side_filter(const lahar_dem_engine *e, sp_side *sd, const sp_geo *g,
     for (int k = 0; k < sd->ne; k++) {
         int i = side_id(sd->e, k);
         vec3 p0 = e->vw[g->v0 + e->edge[g->e0 + i][0]], p1 = e->vw[g->v0 + e->edge[g->e0 + i][1]];
-        if (geom_point_segment(c, p0, p1, NULL) < rad) keep[1][n++] = i;
+        if (geom_point_segment_dist2(c, p0, p1, NULL) < r2) keep[1][n++] = i;
     }
     sd->e = keep[1];
     sd->ne = n;
