@@ -94,6 +94,9 @@ int lahar_netns_enter(char *err, size_t errlen)
                   " (or an AppArmor profile allowing userns for lahar).";
         else if (max_userns == 0)
             why = " user.max_user_namespaces is 0: `sudo sysctl -w user.max_user_namespaces=15000`.";
+        else if (e == ENOSPC)
+            why = " The limit of user namespaces is reached (user.max_user_namespaces, or 32 nested levels):"
+                  " raise it with `sudo sysctl -w user.max_user_namespaces=15000` or run lahar less deeply nested.";
         else if (e == EINVAL)
             why = " (the process already runs threads, or the kernel lacks user namespaces).";
         else if (e == EPERM)

@@ -7,7 +7,7 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | coordinator_killed | concurrent |
-#         cross_host
+#         cross_host | no_namespace
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -225,6 +225,22 @@ cross_host)
         wait \$dem" || fail "cross-host run failed"
     same_as_reference xhost
     [ "$(summary xhost "s['mode']")" = no-spawn ] || fail "mode is not no-spawn"
+    ;;
+no_namespace)
+    # When no user namespace can be created (here: nested to the kernel's limit), lahar run exits 2
+    # before anything runs and says why and what to use instead.
+    write_case case.yaml 0.3
+    cat > nest.sh <<'SH'
+if unshare --user --map-root-user true 2>/dev/null; then exec unshare --user --map-root-user bash "$0" "$@"; fi
+"$@"
+SH
+    bash nest.sh "$bin/lahar" run case.yaml -o nons -q 2> stderr.txt
+    rc=$?
+    cat stderr.txt
+    [ "$rc" -eq 2 ] || fail "exit status $rc, expected 2"
+    grep -q "cannot create a private network namespace" stderr.txt || fail "no explanation"
+    grep -q -- "--in-process" stderr.txt || fail "no alternative offered"
+    [ ! -e nons/summary.json ] || fail "a run started without a namespace"
     ;;
 *)
     echo "unknown test $test_name" >&2
