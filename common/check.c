@@ -422,17 +422,18 @@ static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, la
         snprintf(r->err, sizeof r->err, "incline_roll: no fixed body (the incline) in the case");
         return -1;
     }
-    /* contact snapshots: from the first one touching the incline, while touching */
+    /* contact snapshots: the longest run of consecutive snapshots touching the incline (a ball
+     * placed above it may bounce first; one rolling off the end leaves it) */
     double tol = 0.02 * R;
-    int64_t i0 = -1, i1 = -1;
-    for (int64_t k = 0; k < d->nsnap; k++) {
-        int touching = check_gap(c, inc, check_vec(d, d->x, k, b), R, NULL) <= tol;
-        if (touching && i0 < 0)
-            i0 = k;
-        if (i0 >= 0) {
-            if (!touching)
-                break;
-            i1 = k;
+    int64_t i0 = -1, i1 = -1, run0 = -1;
+    for (int64_t k = 0; k <= d->nsnap; k++) {
+        int touching = k < d->nsnap && check_gap(c, inc, check_vec(d, d->x, k, b), R, NULL) <= tol;
+        if (touching && run0 < 0)
+            run0 = k;
+        if (!touching && run0 >= 0) {
+            if (k - run0 > i1 - i0 + 1 || i0 < 0)
+                i0 = run0, i1 = k - 1;
+            run0 = -1;
         }
     }
     if (i0 < 0) {
