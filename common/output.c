@@ -30,9 +30,30 @@ int64_t lahar_h5_file_open(const char *path, unsigned flags, int64_t fapl, int c
     void *data;
     H5Eget_auto2(H5E_DEFAULT, &func, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-    hid_t f = create ? H5Fcreate(path, flags, H5P_DEFAULT, (hid_t)fapl) : H5Fopen(path, flags, (hid_t)fapl);
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE);
+    H5Pset_obj_track_times(fcpl, 0); /* the root group too: same run, same bytes */
+    hid_t f = create ? H5Fcreate(path, flags, fcpl, (hid_t)fapl) : H5Fopen(path, flags, (hid_t)fapl);
+    H5Pclose(fcpl);
     H5Eset_auto2(H5E_DEFAULT, func, data);
     return f;
+}
+
+/* Creation property lists without object modification times, so that the same run writes
+ * byte-identical files (HDF5 stamps every object header with a time by default). */
+static hid_t out_dcpl(void)
+{
+    hid_t p = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_obj_track_times(p, 0);
+    return p;
+}
+
+static hid_t out_group(hid_t loc, const char *name)
+{
+    hid_t p = H5Pcreate(H5P_GROUP_CREATE);
+    H5Pset_obj_track_times(p, 0);
+    hid_t g = H5Gcreate2(loc, name, H5P_DEFAULT, p, H5P_DEFAULT);
+    H5Pclose(p);
+    return g;
 }
 
 /* Files that are closed between snapshots are opened without HDF5's file lock so that a viewer
@@ -79,7 +100,9 @@ static int out_dataset(hid_t loc, const char *name, hid_t memtype, hid_t filetyp
 {
     hsize_t dims[2] = {d0, d1};
     hid_t sp = H5Screate_simple(rank, dims, NULL);
-    hid_t ds = H5Dcreate2(loc, name, filetype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t dcpl = out_dcpl();
+    hid_t ds = H5Dcreate2(loc, name, filetype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    H5Pclose(dcpl);
     herr_t rc = ds < 0 ? -1 : 0;
     if (ds >= 0 && d0 * (rank == 2 ? d1 : 1) > 0)
         rc = H5Dwrite(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
@@ -179,7 +202,7 @@ static int out_write_mesh_set(hid_t g, const lahar_body_output *o, const lahar_c
 static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_case *c)
 {
     int rc = 0, nb = c->nbody, nm = c->nmaterial;
-    hid_t h = H5Gcreate2(f, "header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t h = out_group(f, "header");
     if (h < 0)
         return -1;
     rc |= out_attr_int64(h, "dimensions", c->dim);
@@ -231,7 +254,7 @@ static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_cas
     rc |= out_dataset(h, "inertia", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, dv);
 
     /* material table: one dataset per property, indexed by /header/material */
-    hid_t mg = H5Gcreate2(h, "materials", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t mg = out_group(h, "materials");
     if (mg < 0)
         rc = -1;
     else {
@@ -268,7 +291,7 @@ static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_cas
 static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_case *c)
 {
     int rc = 0;
-    hid_t g = H5Gcreate2(f, "geometry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t g = out_group(f, "geometry");
     if (g < 0)
         return -1;
     rc |= out_attr_int64(g, "nodes_per_cell", o->dim == 2 ? 2 : 3);
@@ -276,11 +299,11 @@ static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_c
     rc |= out_attr_int64(g, "moving_cells", o->nmoving_cell);
     rc |= out_attr_int64(g, "fixed_vertices", o->nfixed_vert);
     rc |= out_attr_int64(g, "fixed_cells", o->nfixed_cell);
-    hid_t bg = H5Gcreate2(g, "bodies", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t bg = out_group(g, "bodies");
     for (int b = 0; bg >= 0 && b < o->nbody; b++) {
         char name[32];
         snprintf(name, sizeof name, "%06d", b);
-        hid_t one = H5Gcreate2(bg, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        hid_t one = out_group(bg, name);
         if (one < 0) {
             rc = -1;
             break;
@@ -298,7 +321,7 @@ static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_c
     else
         rc = -1;
     for (int moving = 0; moving < 2; moving++) {
-        hid_t s = H5Gcreate2(g, moving ? "moving" : "fixed", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        hid_t s = out_group(g, moving ? "moving" : "fixed");
         if (s < 0 || out_write_mesh_set(s, o, c, moving))
             rc = -1;
         if (s >= 0)
@@ -357,7 +380,7 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
         hsize_t dims[3] = {0, (hsize_t)nb, 3}, maxd[3] = {H5S_UNLIMITED, (hsize_t)nb, 3};
         hsize_t ch[3] = {chunk_rows, (hsize_t)(nb > 0 ? nb : 1), 3};
         hid_t sp = H5Screate_simple(ds[k].rank, dims, maxd);
-        hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+        hid_t dcpl = out_dcpl();
         H5Pset_chunk(dcpl, ds[k].rank, ch);
         *ds[k].id = H5Dcreate2(fs->file, ds[k].name, ds[k].type, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
         H5Pclose(dcpl);
@@ -513,7 +536,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     }
     int rc = out_write_header(f, o, c);
     rc |= out_write_geometry(f, o, c);
-    hid_t sg = H5Gcreate2(f, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t sg = out_group(f, "snapshots");
     if (sg < 0)
         rc = -1;
     else
@@ -573,7 +596,7 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
     }
     char name[48];
     snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
-    hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t g = out_group(f, name);
     int rc = g < 0 ? -1 : 0;
     if (g >= 0) {
         rc |= out_attr_double(g, "time", t);
@@ -692,7 +715,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
         return NULL;
     }
     int rc = 0;
-    hid_t h = H5Gcreate2(f, "header", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t h = out_group(f, "header");
     if (h < 0)
         rc = -1;
     else {
@@ -706,7 +729,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
         rc |= out_attr_double(h, "rest_density", c->sph_density);
         H5Gclose(h);
     }
-    hid_t sg = H5Gcreate2(f, "snapshots", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t sg = out_group(f, "snapshots");
     if (sg < 0)
         rc = -1;
     else
@@ -736,7 +759,7 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
     }
     char name[48];
     snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
-    hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t g = out_group(f, name);
     int rc = g < 0 ? -1 : 0;
     hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
     if (g >= 0) {
@@ -767,7 +790,9 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
                 if (col[k].field == 0 && col[k].name[0] == 'z') {
                     /* 2D: z is never written, the dataset's fill value (0) stands for it */
                     hid_t sp = H5Screate_simple(1, &n, NULL);
-                    hid_t ds = H5Dcreate2(g, "z", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+                    hid_t dcpl = out_dcpl();
+                    hid_t ds = H5Dcreate2(g, "z", H5T_IEEE_F64LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+                    H5Pclose(dcpl);
                     if (ds < 0)
                         rc = -1;
                     else
