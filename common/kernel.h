@@ -1,0 +1,99 @@
+/* SPH smoothing kernels, in one place: W(r, h) = sigma_D / h^D * f(q), q = r / h, compact support
+ * kappa h. Three kernels, selectable by name through a table (kernel_find):
+ *   "cubic"     cubic spline (Monaghan & Lattanzio 1985), kappa = 2,
+ *               sigma 2D 10/(7 pi), 3D 1/pi. This is the f(q) printed in paper 000 eq. 4.
+ *   "quintic"   quintic spline (Morris et al. 1997), kappa = 3,
+ *               sigma 2D 7/(478 pi), 3D 1/(120 pi). Paper 000 eq. 4 prints these constants
+ *               beside the cubic f(q): they belong to this kernel (shared/papers/README.md). The
+ *               README's 3D value 3/(359 pi) (as in Liu & Liu 2003) integrates to 1.0028, not 1;
+ *               1/(120 pi) integrates to 1 within 1e-6 (tests/test_kernel.c).
+ *   "wendland2" Wendland C2 (Wendland 1995; Dehnen & Aly 2012 in the q = r/h, support 2h
+ *               scaling), kappa = 2, sigma 2D 7/(4 pi), 3D 21/(16 pi).
+ * The hot loops call kernel_w / kernel_dwdr, static inline with a switch on the kind, which is
+ * loop-invariant: the compiler hoists it, or callers switch once outside the pair loop and pass a
+ * constant kind to kernel_shape / kernel_dshape. */
+#ifndef LAHAR_KERNEL_H
+#define LAHAR_KERNEL_H
+
+typedef enum { KERNEL_CUBIC = 0, KERNEL_QUINTIC = 1, KERNEL_WENDLAND2 = 2, KERNEL_COUNT } kernel_kind;
+
+/* One entry of the kernel table: the dimensionless shape f(q) and df/dq, the support radius in
+ * units of h and the normalisation constants. */
+typedef struct {
+    const char *name;
+    kernel_kind kind;
+    double kappa;     /* support radius / h */
+    double sigma[2];  /* sigma for D = 2, 3: W = sigma / h^D f(q) */
+    double (*f)(double q);
+    double (*dfdq)(double q);
+} kernel_def;
+
+/* A kernel ready for use: kind, dimension and smoothing length folded into constants. */
+typedef struct {
+    kernel_kind kind;
+    int dim;
+    double h, inv_h;
+    double support;   /* kappa h */
+    double norm;      /* sigma_D / h^D */
+    double dnorm;     /* sigma_D / h^(D+1) */
+} kernel;
+
+/* The table entry called `name` ("cubic", "quintic", "wendland2"), or NULL. */
+const kernel_def *kernel_find(const char *name);
+/* The table entry of a kind. */
+const kernel_def *kernel_def_of(kernel_kind kind);
+/* Fill k for kernel `name` in dimension dim (2 or 3) with smoothing length h > 0. Returns 0, or -1
+ * for an unknown name, dimension or h <= 0. */
+int kernel_init(kernel *k, const char *name, int dim, double h);
+
+/* Dimensionless shapes; q >= 0. */
+static inline double kernel_shape(kernel_kind kind, double q)
+{
+    switch (kind) {
+    case KERNEL_CUBIC:
+        if (q < 1.0) return 1.0 - 1.5 * q * q + 0.75 * q * q * q;
+        if (q < 2.0) { double a = 2.0 - q; return 0.25 * a * a * a; }
+        return 0.0;
+    case KERNEL_QUINTIC: {
+        double w = 0.0, a;
+        if (q < 3.0) { a = 3.0 - q; w += a * a * a * a * a; }
+        if (q < 2.0) { a = 2.0 - q; w -= 6.0 * a * a * a * a * a; }
+        if (q < 1.0) { a = 1.0 - q; w += 15.0 * a * a * a * a * a; }
+        return w;
+    }
+    case KERNEL_WENDLAND2:
+        if (q < 2.0) { double a = 1.0 - 0.5 * q; return a * a * a * a * (2.0 * q + 1.0); }
+        return 0.0;
+    default:
+        return 0.0;
+    }
+}
+
+static inline double kernel_dshape(kernel_kind kind, double q)
+{
+    switch (kind) {
+    case KERNEL_CUBIC:
+        if (q < 1.0) return -3.0 * q + 2.25 * q * q;
+        if (q < 2.0) { double a = 2.0 - q; return -0.75 * a * a; }
+        return 0.0;
+    case KERNEL_QUINTIC: {
+        double d = 0.0, a;
+        if (q < 3.0) { a = 3.0 - q; d -= 5.0 * a * a * a * a; }
+        if (q < 2.0) { a = 2.0 - q; d += 30.0 * a * a * a * a; }
+        if (q < 1.0) { a = 1.0 - q; d -= 75.0 * a * a * a * a; }
+        return d;
+    }
+    case KERNEL_WENDLAND2:
+        if (q < 2.0) { double a = 1.0 - 0.5 * q; return -5.0 * q * a * a * a; }
+        return 0.0;
+    default:
+        return 0.0;
+    }
+}
+
+/* W(r, h). */
+static inline double kernel_w(const kernel *k, double r) { return k->norm * kernel_shape(k->kind, r * k->inv_h); }
+/* dW/dr (<= 0); grad_i W(x_i - x_j) = dW/dr * (x_i - x_j) / r. */
+static inline double kernel_dwdr(const kernel *k, double r) { return k->dnorm * kernel_dshape(k->kind, r * k->inv_h); }
+
+#endif
