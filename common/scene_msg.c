@@ -271,14 +271,137 @@ int lahar_node_join(lahar_link *l, int role, const char *engine, const char *ver
     return crc == 0 ? LAHAR_LINK_OK : LAHAR_LINK_ERROR;
 }
 
-int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t *st)
+int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t *st, const char *message)
 {
     st->run_id = lahar_link_run_id(l);
     st->step = step;
     st->role = role;
-    if (!st->message)
-        st->message = (char *)"";
+    snprintf((char *)st->message, sizeof st->message, "%s", message ? message : "");
     int rc;
     LAHAR_LINK_SEND(rc, l, LAHAR_FRAME_T_MSG_STATUS, lahar_status_t, step, st);
     return rc;
+}
+
+/* ---- per-step messages into reusable buffers --------------------------------------------- */
+
+/* grow *p to hold n elements of elem bytes (doubling); 0 or -1 */
+static int msg_grow(void **p, int32_t *cap, int32_t n, size_t elem)
+{
+    if (n <= *cap)
+        return 0;
+    int32_t c = *cap > 0 ? *cap : 16;
+    while (c < n)
+        c = c > INT32_MAX / 2 ? n : 2 * c;
+    void *q = realloc(*p, (size_t)c * elem);
+    if (!q)
+        return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+/* One field (or a run of n elements) with LCM's decoder of that primitive type. */
+#define MSG_DECODE(T, ptr, count)                                                                  \
+    do {                                                                                           \
+        int n_ = __##T##_decode_array(data, pos, size - pos, (ptr), (count));                      \
+        if (n_ < 0)                                                                                \
+            return -1;                                                                             \
+        pos += n_;                                                                                 \
+    } while (0)
+
+int lahar_body_state_decode(const void *data, int size, lahar_body_state_buf *b)
+{
+    int pos = 0;
+    int64_t hash;
+    MSG_DECODE(int64_t, &hash, 1);
+    if (hash != __lahar_body_state_t_get_hash())
+        return -1;
+    MSG_DECODE(int64_t, &b->run_id, 1);
+    MSG_DECODE(int64_t, &b->step, 1);
+    MSG_DECODE(double, &b->t, 1);
+    int32_t n;
+    MSG_DECODE(int32_t, &n, 1);
+    if (n < 0 || n > (size - pos) / 4)
+        return -1;
+    int32_t cap = b->cap, c1 = cap, c2 = cap, c3 = cap, c4 = cap;
+    if (msg_grow((void **)&b->id, &cap, n, sizeof *b->id) || msg_grow((void **)&b->x, &c1, n, sizeof *b->x) ||
+        msg_grow((void **)&b->q, &c2, n, sizeof *b->q) || msg_grow((void **)&b->v, &c3, n, sizeof *b->v) ||
+        msg_grow((void **)&b->w, &c4, n, sizeof *b->w))
+        return -1;
+    b->cap = cap;
+    b->n = n;
+    if (n > 0) {
+        /* rows of a [n][k] array follow each other on the wire: n * k values in a row */
+        MSG_DECODE(int32_t, b->id, n);
+        MSG_DECODE(double, &b->x[0][0], 3 * n);
+        MSG_DECODE(double, &b->q[0][0], 4 * n);
+        MSG_DECODE(double, &b->v[0][0], 3 * n);
+        MSG_DECODE(double, &b->w[0][0], 3 * n);
+    }
+    return 0;
+}
+
+void lahar_body_state_buf_free(lahar_body_state_buf *b)
+{
+    free(b->id);
+    free(b->x);
+    free(b->q);
+    free(b->v);
+    free(b->w);
+    memset(b, 0, sizeof *b);
+}
+
+int lahar_loads_decode(const void *data, int size, lahar_loads_buf *b)
+{
+    int pos = 0;
+    int64_t hash;
+    MSG_DECODE(int64_t, &hash, 1);
+    if (hash != __lahar_loads_t_get_hash())
+        return -1;
+    MSG_DECODE(int64_t, &b->run_id, 1);
+    MSG_DECODE(int64_t, &b->step, 1);
+    int32_t n;
+    MSG_DECODE(int32_t, &n, 1);
+    if (n < 0 || n > (size - pos) / 4)
+        return -1;
+    int32_t cap = b->cap_body, c1 = cap, c2 = cap, c3 = cap;
+    if (msg_grow((void **)&b->body_id, &cap, n, sizeof *b->body_id) ||
+        msg_grow((void **)&b->force, &c1, n, sizeof *b->force) || msg_grow((void **)&b->torque, &c2, n, sizeof *b->torque) ||
+        msg_grow((void **)&b->npoints, &c3, n, sizeof *b->npoints))
+        return -1;
+    b->cap_body = cap;
+    b->nbody = n;
+    if (n > 0) {
+        MSG_DECODE(int32_t, b->body_id, n);
+        MSG_DECODE(double, &b->force[0][0], 3 * n);
+        MSG_DECODE(double, &b->torque[0][0], 3 * n);
+        MSG_DECODE(int32_t, b->npoints, n);
+    }
+    int32_t np;
+    MSG_DECODE(int32_t, &np, 1);
+    if (np < 0 || np > (size - pos) / 8)
+        return -1;
+    cap = b->cap_points;
+    c1 = cap;
+    if (msg_grow((void **)&b->point_x, &cap, np, sizeof *b->point_x) ||
+        msg_grow((void **)&b->point_f, &c1, np, sizeof *b->point_f))
+        return -1;
+    b->cap_points = cap;
+    b->ntotal = np;
+    if (np > 0) {
+        MSG_DECODE(double, &b->point_x[0][0], 3 * np);
+        MSG_DECODE(double, &b->point_f[0][0], 3 * np);
+    }
+    return 0;
+}
+
+void lahar_loads_buf_free(lahar_loads_buf *b)
+{
+    free(b->body_id);
+    free(b->npoints);
+    free(b->force);
+    free(b->torque);
+    free(b->point_x);
+    free(b->point_f);
+    memset(b, 0, sizeof *b);
 }

@@ -35,9 +35,37 @@ typedef struct {
 int lahar_node_join(lahar_link *l, int role, const char *engine, const char *version, const char *const *caps,
                     int ncaps, double wait_s, lahar_node_scene *out, char *err, size_t errlen);
 
-/* Send status_t for step k (fills run_id, step and role). 0 or -1. */
+/* Send status_t for step k (fills run_id, step, role and the message, truncated to fit). 0 or -1. */
 #include "lahar_status_t.h"
-int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t *st);
+int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t *st, const char *message);
 
 #define LAHAR_NODE_COORDINATOR_SILENCE 5.0  /* s: a node gives up on a silent coordinator */
 #define LAHAR_HEARTBEAT_PERIOD 0.25         /* s */
+
+/* ---- per-step messages decoded into reusable buffers ------------------------------------------
+ * The generated lahar_*_decode allocate every variable-length array on every call; these decode
+ * the same LCM encoding (field by field with LCM's primitives, checking the type's fingerprint)
+ * into arrays kept between steps, grown by doubling only when a message is larger than any
+ * before. Return 0, or -1 on a malformed message or out of memory. */
+#include "lahar_body_state_t.h"
+#include "lahar_loads_t.h"
+
+typedef struct {
+    int64_t run_id, step;
+    double t;
+    int32_t n, cap;
+    int32_t *id;
+    double (*x)[3], (*q)[4], (*v)[3], (*w)[3];
+} lahar_body_state_buf;
+int lahar_body_state_decode(const void *data, int size, lahar_body_state_buf *b);
+void lahar_body_state_buf_free(lahar_body_state_buf *b);
+
+typedef struct {
+    int64_t run_id, step;
+    int32_t nbody, cap_body, ntotal, cap_points;
+    int32_t *body_id, *npoints;
+    double (*force)[3], (*torque)[3];
+    double (*point_x)[3], (*point_f)[3];
+} lahar_loads_buf;
+int lahar_loads_decode(const void *data, int size, lahar_loads_buf *b);
+void lahar_loads_buf_free(lahar_loads_buf *b);

@@ -46,7 +46,7 @@ typedef struct {
     int thread_status;
     int joined;
     /* from hello_t and status_t */
-    char engine[160], version[64], host[128], engine_desc[160];
+    char engine[160], version[64], host[128], engine_desc[512];
     int remote_pid;
     double compute_s, wait_s;
     int64_t substeps, last_step;
@@ -322,11 +322,13 @@ static int coord_collect_status(coord *co, int64_t k)
             return LAHAR_EXIT_RUN_ERROR;
         }
         int err = s.error;
+        s.message[sizeof s.message - 1] = 0;
+        const char *text = (const char *)s.message;
         if (err)
             snprintf(co->message, sizeof co->message, "the %s reports at step %lld: %s", lahar_link_role_name(r),
-                     (long long)k, s.message ? s.message : "(no message)");
+                     (long long)k, text[0] ? text : "(no message)");
         else if (k < 0)
-            snprintf(n->engine_desc, sizeof n->engine_desc, "%s", s.message ? s.message : "");
+            snprintf(n->engine_desc, sizeof n->engine_desc, "%s", text);
         n->compute_s += s.compute_s;
         n->wait_s += s.wait_s;
         n->substeps += s.nsubsteps;

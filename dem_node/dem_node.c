@@ -30,6 +30,7 @@ typedef struct {
     lahar_body_state *states;
     lahar_body_report *reports;
     lahar_body_load *loads;
+    lahar_loads_buf loads_msg; /* LOADS decoded in place, kept between steps */
     /* BODY_STATE of the moving bodies: LCM row pointers into preallocated rows */
     int nmoving;
     int32_t *moving_id;
@@ -45,6 +46,7 @@ static void dem_node_free(dem_node *d)
     free(d->states);
     free(d->reports);
     free(d->loads);
+    lahar_loads_buf_free(&d->loads_msg);
     free(d->moving_id);
     free(d->bx);
     free(d->bq);
@@ -115,26 +117,23 @@ static int dem_node_send_body_state(dem_node *d, int64_t k, double t)
 /* Loads of step k from the SPH node, one entry per body (zero for bodies not listed). */
 static int dem_node_read_loads(dem_node *d, const lahar_link_msg *msg, char *err, size_t errlen)
 {
-    lahar_loads_t lm;
-    if (lahar_loads_t_decode(msg->data, 0, msg->size, &lm) < 0) {
+    lahar_loads_buf *lm = &d->loads_msg;
+    if (lahar_loads_decode(msg->data, msg->size, lm) != 0) {
         snprintf(err, errlen, "undecodable LOADS(%lld)", (long long)msg->step);
         return -1;
     }
     memset(d->loads, 0, (size_t)d->ns.scene.nbody * sizeof *d->loads);
-    int rc = 0;
-    for (int i = 0; i < lm.nbody; i++) {
-        int b = lm.body_id[i];
+    for (int i = 0; i < lm->nbody; i++) {
+        int b = lm->body_id[i];
         if (b < 0 || b >= d->ns.scene.nbody) {
             snprintf(err, errlen, "LOADS(%lld) names body %d, the scene has %d", (long long)msg->step, b,
                      d->ns.scene.nbody);
-            rc = -1;
-            break;
+            return -1;
         }
-        memcpy(d->loads[b].force, lm.force[i], sizeof d->loads[b].force);
-        memcpy(d->loads[b].torque, lm.torque[i], sizeof d->loads[b].torque);
+        memcpy(d->loads[b].force, lm->force[i], sizeof d->loads[b].force);
+        memcpy(d->loads[b].torque, lm->torque[i], sizeof d->loads[b].torque);
     }
-    lahar_loads_t_decode_cleanup(&lm);
-    return rc;
+    return 0;
 }
 
 /* Wait for the coordinator to end the run after an error (the STATUS carried the message). */
@@ -206,8 +205,7 @@ static int dem_node_loop(dem_node *d)
         st.ncontacts = d->ops->ncontacts(d->engine);
         st.nsubsteps = nsub > 0 ? nsub : 0;
         st.kinetic_energy = d->ops->kinetic_energy(d->engine);
-        st.message = err;
-        lahar_node_send_status(d->link, ROLE, k, &st);
+        lahar_node_send_status(d->link, ROLE, k, &st, err);
         if (st.error) {
             fprintf(stderr, "lahar-dem: step %lld: %s\n", (long long)k, err);
             dem_node_wait_stop(d);
@@ -270,10 +268,9 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     if (d.ops)
         snprintf(engine_desc, sizeof engine_desc, "%s %s", d.ops->name, d.ops->version);
     st.error = err[0] != '\0';
-    st.message = st.error ? err : (d.ops ? engine_desc : (char *)"");
     st.dt_stable = d.engine ? d.ops->stable_dt(d.engine) : 0.0;
     st.kinetic_energy = d.engine ? d.ops->kinetic_energy(d.engine) : 0.0;
-    lahar_node_send_status(d.link, ROLE, -1, &st);
+    lahar_node_send_status(d.link, ROLE, -1, &st, st.error ? err : (d.ops ? engine_desc : ""));
     if (st.error) {
         fprintf(stderr, "lahar-dem: %s\n", err);
         dem_node_wait_stop(&d);

@@ -119,6 +119,7 @@ typedef struct {
     lahar_sph_particles p;
     lahar_particle_output *out;
     int nmoving;
+    lahar_body_state_buf bodies; /* moving bodies at t_k (BODY_STATE(k-1)), for the coupling */
 } sph_node;
 
 static int sph_node_snapshot(sph_node *s, int64_t step, double t)
@@ -173,6 +174,10 @@ static int sph_node_loop(sph_node *s)
                 return 0;
             if (rc == LAHAR_LINK_LOST)
                 return 3;
+            if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "undecodable BODY_STATE(%lld)", (long long)(k - 1));
+            }
         }
         c0 = lahar_now();
         if (has_dem) {
@@ -189,8 +194,7 @@ static int sph_node_loop(sph_node *s)
         compute += lahar_now() - c0;
         st.compute_s = compute;
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
-        st.message = err;
-        lahar_node_send_status(s->link, ROLE, k, &st);
+        lahar_node_send_status(s->link, ROLE, k, &st, err);
         if (st.error) {
             fprintf(stderr, "lahar-sph: step %lld: %s\n", (long long)k, err);
             sph_node_wait_stop(s);
@@ -264,10 +268,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     char desc[128];
     snprintf(desc, sizeof desc, "minimal (gravity only), %lld particles", (long long)s.p.n);
     st.error = err[0] != '\0';
-    st.message = st.error ? err : desc;
     st.dt_proposed = st.error ? 0.0 : lahar_sph_particles_dt(&s.p, c->gravity, c->sph_dx);
     st.dt_stable = st.dt_proposed;
-    lahar_node_send_status(s.link, ROLE, -1, &st);
+    lahar_node_send_status(s.link, ROLE, -1, &st, st.error ? err : desc);
     if (st.error) {
         fprintf(stderr, "lahar-sph: %s\n", err);
         sph_node_wait_stop(&s);
@@ -279,6 +282,7 @@ done:
     lahar_link_heartbeat_stop(s.link);
     lahar_particle_output_close(s.out);
     lahar_sph_particles_free(&s.p);
+    lahar_body_state_buf_free(&s.bodies);
     lahar_case_free(&s.ns.scene);
     lahar_link_destroy(s.link);
     lahar_transport_close(t);

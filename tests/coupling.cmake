@@ -11,6 +11,11 @@ target_link_libraries(test_coupling_link PRIVATE lahar_common)
 add_test(NAME coupling_link COMMAND test_coupling_link)
 set_tests_properties(coupling_link PROPERTIES LABELS "fast;coupling" TIMEOUT 60)
 
+add_executable(test_coupling_msg ${LAHAR_TEST_DIR}/test_coupling_msg.c)
+target_link_libraries(test_coupling_msg PRIVATE lahar_common)
+add_test(NAME coupling_msg COMMAND test_coupling_msg)
+set_tests_properties(coupling_msg PROPERTIES LABELS "fast;coupling")
+
 add_executable(test_sph_particles ${LAHAR_TEST_DIR}/test_sph_particles.c)
 target_link_libraries(test_sph_particles PRIVATE lahar_sph)
 add_test(NAME sph_particles COMMAND test_sph_particles)
