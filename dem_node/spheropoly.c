@@ -668,15 +668,18 @@ static void drift(lahar_dem_engine *e, double h)
     }
 }
 
+/* Non-finite or runaway states stop the run before they reach the grid (cell indices of a NaN or
+ * of 1e300 would overflow). */
 static int check_finite(const lahar_dem_engine *e, char *err, size_t errlen)
 {
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
         const sp_state *s = &e->st[i];
         double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
-        if (!isfinite(sum)) {
-            snprintf(err, errlen, "spheropoly: body %d '%s' has a non-finite state at substep %ld", i,
-                     e->names[i], e->step);
+        double far = fmax(fabs(s->x.x), fmax(fabs(s->x.y), fabs(s->x.z)));
+        if (!isfinite(sum) || far > 1e12) {
+            snprintf(err, errlen, "spheropoly: body %d '%s' has a %s state at substep %ld", i, e->names[i],
+                     isfinite(sum) ? "runaway (|x| > 1e12 m)" : "non-finite", e->step);
             return -1;
         }
     }
@@ -697,7 +700,7 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
         kick(e, 0.5 * h, loads);
         drift(e, h);
         e->step++;
-        if (compute_forces(e, h, err, errlen)) return -1;
+        if (check_finite(e, err, errlen) || compute_forces(e, h, err, errlen)) return -1;
         kick(e, 0.5 * h, loads);
         if (check_finite(e, err, errlen)) return -1;
         for (int i = 0; i < e->nbody; i++) {
@@ -1050,7 +1053,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         }
     }
     e->dt_stable = stable_dt_of(e, c);
-    if (compute_forces(e, 0.0, err, errlen)) goto fail;
+    if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;
     return e;
 fail:
     sp_destroy(e);
