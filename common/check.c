@@ -228,15 +228,21 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
     int nb = 0;
     double e_first = NAN, err_max = 0.0, u_imp_first = 0.0, u_reb_first = 0.0, t_first = 0.0, h_contact = 0.0,
            t_sep_first = 0.0;
-    int64_t p_first = 0;
+    int64_t p_first = 0, last_q = 0;
     for (int64_t k = 0; k + 1 < d->nsnap; k++) {
         if (!(U(k) < 0.0 && U(k + 1) > 0.0))
             continue;
+        /* the snapshots around the bounce must be in free flight (a snapshot taken during the
+         * contact is skipped, at most 3 each way); bounces that do not resolve that way (a ball
+         * settling, jitter at rest) are not measured */
         int64_t p = k, q = k + 1;
-        while (p >= 1 && !FREE(p - 1, p))
+        for (int tries = 0; tries < 3 && p >= 1 && !FREE(p - 1, p); tries++)
             p--;
-        while (q + 1 < d->nsnap && !FREE(q, q + 1) && U(q + 1) > 0.0)
+        for (int tries = 0; tries < 3 && q + 1 < d->nsnap && !FREE(q, q + 1) && U(q + 1) > 0.0; tries++)
             q++;
+        if (p < 1 || p < last_q || !FREE(p - 1, p) || q + 1 >= d->nsnap || !FREE(q, q + 1))
+            continue;
+        last_q = q;
         double tp = d->t[p], tq = d->t[q], up = U(p), uq = U(q), hp = H(p), hq = H(q);
         double beta = up - uq - g * (tq - tp);
         double alpha = hp - hq - up * tp + uq * tq + 0.5 * g * (tq - tp) * (tp + tq);
@@ -263,7 +269,9 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
         if (floor_j >= 0 && c->bodies[b].shape.nv == 1) {
             check_gap(c, floor_j, xp, c->bodies[b].shape.radius, &nrm);
             double hc = hp - gap_p;
-            if (-v3_dot(nrm, gh) > 0.999 && hp >= hc && hq >= hc) {
+            if (-v3_dot(nrm, gh) > 0.999) {
+                if (!(hp > hc && hq > hc))
+                    continue; /* a snapshot inside the contact: not free flight */
                 u_imp = sqrt(up * up + 2.0 * g * (hp - hc));
                 u_reb = sqrt(uq * uq + 2.0 * g * (hq - hc));
                 hi = hc;
