@@ -567,13 +567,18 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         if (strncmp(co.url, "udpm://", 7) == 0 && !strstr(co.url, "recv_buf_size"))
             fprintf(stderr, "lahar: warning: %s has no recv_buf_size; large messages may be lost "
                             "(add ?recv_buf_size=8388608)\n", co.url);
+    } else if (o->no_spawn) {
+        /* nodes started by hand cannot join a namespace made here; the network must be named */
+        fprintf(stderr, "lahar: --no-spawn needs --lcm-url URL (or $LCM_DEFAULT_URL), the same URL the nodes you "
+                        "start are given, e.g. '%s' inside a network namespace you made\n", LAHAR_NETNS_URL);
+        return LAHAR_EXIT_SETUP;
     } else {
         if (lahar_netns_enter(err, sizeof err) != 0) {
             fprintf(stderr, "lahar: %s\n", err);
             return LAHAR_EXIT_SETUP;
         }
         co.url = LAHAR_NETNS_URL;
-        co.mode = o->no_spawn ? "no-spawn" : "processes";
+        co.mode = "processes";
     }
     co.run_id = coord_random_run_id();
     co.progress = !o->quiet && isatty(STDERR_FILENO);

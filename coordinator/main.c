@@ -24,7 +24,7 @@ static void usage(FILE *f)
             "  --in-process       run the nodes as threads of this process over memq:// (no network;\n"
             "                     gives bitwise the same results as separate processes)\n"
             "  --no-spawn         do not start the nodes: start lahar-dem / lahar-sph yourself with the\n"
-            "                     same --lcm-url (e.g. on another host); implies no private namespace\n"
+            "                     same URL (e.g. on another host); needs --lcm-url, no private namespace\n"
             "  --lcm-url URL      use this LCM URL instead of a private network namespace (also taken\n"
             "                     from $LCM_DEFAULT_URL). Set ttl yourself (ttl=0: this host only) and\n"
             "                     recv_buf_size=8388608\n"

@@ -7,7 +7,7 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | coordinator_killed | concurrent |
-#         cross_host | no_namespace
+#         cross_host | no_namespace | engine_error
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -225,6 +225,32 @@ cross_host)
         wait \$dem" || fail "cross-host run failed"
     same_as_reference xhost
     [ "$(summary xhost "s['mode']")" = no-spawn ] || fail "mode is not no-spawn"
+    ;;
+engine_error)
+    # An engine failure (here: a DEM step far too large for a 6 m/s impact) stops the run with the
+    # engine's message (which bodies, which step), exit 1, and a last snapshot at the failed step.
+    write_case bad.yaml 0.3
+    sed -i 's/^time:.*/time: {end: 0.3, dt_max: 1e-2, output_interval: 0.05}\ndem: {engine: spheropoly, dt_safety: 1}/;
+            s/velocity: \[0, 0, -1\]/velocity: [0, 0, -6]/' bad.yaml
+    "$bin/lahar" run bad.yaml -o bad -q --in-process 2> stderr.txt
+    rc=$?
+    cat stderr.txt
+    [ "$rc" -eq 1 ] || fail "exit status $rc, expected 1"
+    grep -q "the DEM node reports at step [0-9]*: spheropoly" stderr.txt || fail "no engine message"
+    "$python" - bad <<'PY' || fail "summary or last snapshot wrong"
+import json, sys
+import h5py
+s = json.load(open(sys.argv[1] + "/summary.json"))
+assert s["status"] == "error" and s["exit_status"] == 1, s["status"]
+failed_step = s["steps"]  # steps completed before the failing one
+with h5py.File(sys.argv[1] + "/bodies.h5", "r") as f:
+    last = sorted(f["snapshots"])[-1]
+    g = f["snapshots"][last]
+    t = float(g.attrs["time"])
+# the last snapshot is the state at the end of the failed step k = steps: t_{k+1} = 0.01 (k + 1)
+assert abs(t - 0.01 * (failed_step + 1)) < 1e-12, (last, t, failed_step)
+print("engine_error: failed at step %d, last snapshot %s at t = %.3f s" % (failed_step, last, t))
+PY
     ;;
 no_namespace)
     # When no user namespace can be created (here: nested to the kernel's limit), lahar run exits 2
