@@ -20,6 +20,15 @@ URL_LINK='udpm://239.255.76.67:7667?ttl=1&recv_buf_size=8388608'
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
+# pid of the child of $1 whose command is $2 (from /proc: no procps needed)
+child_pid() {
+    local stat pid comm state ppid rest
+    for stat in /proc/[0-9]*/stat; do
+        read -r pid comm state ppid rest < "$stat" 2>/dev/null || continue
+        [ "$ppid" = "$1" ] && [ "$comm" = "($2)" ] && echo "$pid"
+    done
+}
+
 # A few spheres and a box falling on a fixed plate; collisions within the first 0.3 s.
 write_case() { # file t_end
     cat > "$1" <<YAML
@@ -145,7 +154,7 @@ node_killed)
     lahar_pid=$!
     dem_pid=""
     for _ in $(seq 100); do
-        dem_pid=$(pgrep -P "$lahar_pid" -x lahar-dem || true)
+        dem_pid=$(child_pid "$lahar_pid" lahar-dem)
         [ -n "$dem_pid" ] && [ -e killed/bodies.h5 ] && break
         sleep 0.05
     done
