@@ -25,6 +25,7 @@ typedef struct {
     vec3 xi;     /* tangential spring (world), kept across steps while the contact lasts */
     vec3 f;      /* force on b (a gets -f), world */
     vec3 cp;     /* contact point, world */
+    vec3 n;      /* unit normal from a to b */
     double delta;
 } sp_contact;
 
@@ -87,7 +88,7 @@ struct lahar_dem_engine {
     /* contacts: previous evaluation (history) and hash over it */
     sp_contact *prev, *cur;
     int nprev, contact_cap;
-    int *hash, hash_cap;
+    int *hash, *vhash, hash_cap; /* by full key; by (pair, touching vertex) */
     sp_thread *thr;
     int nthr;
     /* report accumulators over the substeps of one advance */
@@ -189,6 +190,40 @@ static const sp_contact *history_find(const lahar_dem_engine *e, int a, int b, i
     }
 }
 
+/* The vertex a contact hangs on (side 0: a vertex of body a, 1: of body b), -1 for edge-edge. */
+static int contact_vertex(int type, int fa, int fb, int *side)
+{
+    *side = (type == SP_FV || type == SP_EV) ? 1 : 0;
+    if (type == SP_EE) return -1;
+    return *side ? fb : fa;
+}
+
+/* When a vertex slides from one feature of the other body to the next (a rock rolling across the
+ * triangles of a terrain), the contact gets a new key. It inherits the spring of the previous
+ * contact of the same vertex and body pair if that one had about the same normal (within ~8 deg)
+ * and a nearby contact point, so that rolling/sticking does not restart at every mesh edge. */
+static const sp_contact *history_find_moved(const lahar_dem_engine *e, int a, int b, int type, int fa, int fb,
+                                            vec3 n, vec3 cp, double reach)
+{
+    int side, v = contact_vertex(type, fa, fb, &side);
+    if (e->nprev == 0 || v < 0) return NULL;
+    uint64_t m = (uint64_t)e->hash_cap - 1;
+    const sp_contact *best = NULL;
+    double bestd = reach * reach;
+    for (uint64_t h = contact_key_hash(a, b, 100 + side, v, -1) & m;; h = (h + 1) & m) {
+        int i = e->vhash[h];
+        if (i < 0) return best;
+        const sp_contact *c = &e->prev[i];
+        int cs, cv = contact_vertex(c->type, c->fa, c->fb, &cs);
+        if (c->a != a || c->b != b || cs != side || cv != v || v3_dot(c->n, n) < 0.99) continue;
+        double d2 = v3_norm2(v3_sub(c->cp, cp));
+        if (d2 < bestd) {
+            bestd = d2;
+            best = c;
+        }
+    }
+}
+
 static int history_rebuild(lahar_dem_engine *e)
 {
     int need = 16;
@@ -197,15 +232,24 @@ static int history_rebuild(lahar_dem_engine *e)
         int *h = realloc(e->hash, sizeof(int) * (size_t)need);
         if (!h) return -1;
         e->hash = h;
+        h = realloc(e->vhash, sizeof(int) * (size_t)need);
+        if (!h) return -1;
+        e->vhash = h;
         e->hash_cap = need;
     }
     memset(e->hash, 0xff, sizeof(int) * (size_t)e->hash_cap);
+    memset(e->vhash, 0xff, sizeof(int) * (size_t)e->hash_cap);
     uint64_t m = (uint64_t)e->hash_cap - 1;
     for (int i = 0; i < e->nprev; i++) {
         const sp_contact *c = &e->prev[i];
         uint64_t h = contact_key_hash(c->a, c->b, c->type, c->fa, c->fb) & m;
         while (e->hash[h] >= 0) h = (h + 1) & m;
         e->hash[h] = i;
+        int side, v = contact_vertex(c->type, c->fa, c->fb, &side);
+        if (v < 0) continue;
+        h = contact_key_hash(c->a, c->b, 100 + side, v, -1) & m;
+        while (e->vhash[h] >= 0) h = (h + 1) & m;
+        e->vhash[h] = i;
     }
     return 0;
 }
@@ -239,6 +283,7 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
     /* tangential spring from the last step, rotated onto the current tangent plane (magnitude kept) */
     vec3 xi = v3(0.0, 0.0, 0.0);
     const sp_contact *old = history_find(e, x->a, x->b, type, fa, fb);
+    if (!old) old = history_find_moved(e, x->a, x->b, type, fa, fb, n, cp, 0.5 * rsum);
     if (old) {
         double m0 = v3_norm(old->xi);
         xi = v3_axpy(-v3_dot(old->xi, n), n, old->xi);
@@ -261,6 +306,7 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
     o->xi = xi;
     o->f = v3_axpy(fn, n, ft);
     o->cp = cp;
+    o->n = n;
     o->delta = delta;
 }
 
@@ -761,6 +807,7 @@ static void sp_destroy(lahar_dem_engine *e)
     free(e->prev);
     free(e->cur);
     free(e->hash);
+    free(e->vhash);
     free(e->rep_f);
     free(e->rep_t);
     free(e->ncontact_body);

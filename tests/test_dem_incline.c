@@ -167,12 +167,17 @@ int main(void)
     dem_test_rel("sphere rolling on a tilted plane vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
     a = tilted_plane_accel(th, 0.1);
     dem_test_rel("sphere sliding on a tilted plane vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
-    /* the same on a fine terrain mesh (feature grid; contacts move across triangles/segments) */
+    /* the same on a fine terrain mesh (feature grid; contacts move across triangles/segments and
+     * keep their tangential spring, so the motion equals the one on a single plane) */
+    double a_plane = incline_accel(3, th, 0.5, &spin);
     a = incline_accel_on(3, th, 0.5, &spin, 1);
     dem_test_rel("sphere rolling on a 960-triangle terrain vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
+    dem_test_rel("sphere rolling on the terrain vs on a single plane", a, a_plane, 1e-6);
     a = incline_accel_on(3, th, 0.1, &spin, 1);
     dem_test_rel("sphere sliding on a 960-triangle terrain vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
+    a_plane = incline_accel(2, th, 0.5, &spin);
     a = incline_accel_on(2, th, 0.5, &spin, 1);
     dem_test_rel("disc rolling on a 100-segment polyline vs 2/3 g sin", a, 2.0 / 3.0 * g * sin(th), 0.01);
+    dem_test_rel("disc rolling on the polyline vs on a single segment", a, a_plane, 1e-6);
     return dem_test_failures ? 1 : 0;
 }
