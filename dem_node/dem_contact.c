@@ -97,7 +97,7 @@ double dem_damping_for_restitution(lahar_contact_model model, double e)
 }
 
 double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
-                        double rstar, double *k_secant, double *c_normal)
+                        double rstar, double damp_scale, double *k_secant, double *c_normal)
 {
     double f, k, c;
     if (law->model == LAHAR_CONTACT_HERTZ) {
@@ -106,12 +106,12 @@ double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot,
         double kh = 4.0 / 3.0 * law->estar * sqrt(rstar);
         double sd = sqrt(delta);
         k = kh * sd;
-        c = law->damp * sqrt(mstar * kh) * sqrt(sd);
+        c = damp_scale * law->damp * sqrt(mstar * kh) * sqrt(sd);
         f = k * delta + c * delta_dot;
     } else {
         /* linear spring-dashpot, c = 2 zeta sqrt(kn m*) (reference 06 sec. 6.2) */
         k = law->kn;
-        c = 2.0 * law->damp * sqrt(law->kn * mstar);
+        c = damp_scale * 2.0 * law->damp * sqrt(law->kn * mstar);
         f = k * delta + c * delta_dot;
     }
     *k_secant = k;

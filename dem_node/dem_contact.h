@@ -30,10 +30,10 @@ double dem_restitution_clipped(lahar_contact_model model, double damp);
 double dem_damping_for_restitution(lahar_contact_model model, double e);
 
 /* Normal force magnitude (>= 0, clipped) for overlap delta > 0 and overlap rate delta_dot
- * (> 0 approaching); also the current normal stiffness (secant for Hertz) and damping coefficient
- * used to build the tangential ones. */
+ * (> 0 approaching), the dashpot multiplied by damp_scale (1 for a single contact point); also the
+ * current normal stiffness (secant for Hertz) and damping coefficient used for the tangential ones. */
 double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
-                        double rstar, double *k_secant, double *c_normal);
+                        double rstar, double damp_scale, double *k_secant, double *c_normal);
 
 /* Elastic contact period of the pair: linear 2 pi sqrt(m* / kn), twice the contact duration; Hertz: the elastic
  * Hertz duration 2.868266 (m*^2/(R* E*^2 v))^(1/5) (reference 06 sec. 6.1) at impact speed v. */

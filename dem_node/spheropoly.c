@@ -27,6 +27,7 @@ typedef struct {
     vec3 cp;     /* contact point, world */
     vec3 n;      /* unit normal from a to b */
     double delta;
+    double rstar; /* effective curvature radius (Hertz) */
 } sp_contact;
 
 typedef struct {
@@ -255,7 +256,8 @@ static int history_rebuild(lahar_dem_engine *e)
 }
 
 /* A feature pair whose cores are at pa (on a) and pb (on b): a contact when the swept surfaces
- * overlap. ra_curv / rb_curv: curvature radius of each feature for Hertz (0 = flat face). */
+ * overlap. a_flat / b_flat: the feature is a face (infinite curvature radius for Hertz). Records
+ * the geometry and the spring carried over from the last step; pair_forces adds the forces. */
 static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3 pb, int a_flat, int b_flat,
                          vec3 fallback_n)
 {
@@ -267,19 +269,8 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
     if (d2 >= rsum * rsum) return;
     double d = sqrt(d2);
     vec3 n = d > 1e-12 * rsum ? v3_scale(dvec, 1.0 / d) : fallback_n;
-    double delta = rsum - d;
     /* contact point in the middle of the overlap */
     vec3 cp = v3_scale(v3_add(v3_axpy(ga->radius, n, pa), v3_axpy(-gb->radius, n, pb)), 0.5);
-    const sp_state *sa = &e->st[x->a], *sb = &e->st[x->b];
-    vec3 va = v3_add(sa->v, v3_cross(sa->w, v3_sub(cp, sa->x)));
-    vec3 vb = v3_add(sb->v, v3_cross(sb->w, v3_sub(cp, sb->x)));
-    vec3 vr = v3_sub(vb, va);
-    double vn = v3_dot(vr, n);
-    vec3 vt = v3_axpy(-vn, n, vr);
-    /* R*: sweep radius for a vertex or edge, infinite for a face (paper 003 eq. 16) */
-    double rstar = a_flat ? gb->radius : (b_flat ? ga->radius : ga->radius * gb->radius / rsum);
-    double k, c;
-    double fn = dem_normal_force(x->law, delta, -vn, x->mstar, rstar, &k, &c);
     /* tangential spring from the last step, rotated onto the current tangent plane (magnitude kept) */
     vec3 xi = v3(0.0, 0.0, 0.0);
     const sp_contact *old = history_find(e, x->a, x->b, type, fa, fb);
@@ -290,8 +281,6 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
         double m1 = v3_norm(xi);
         if (m1 > 0.0) xi = v3_scale(xi, m0 / m1);
     }
-    xi = v3_axpy(x->h, vt, xi);
-    vec3 ft = dem_tangential_force(x->law, &xi, vt, fn, k, c);
     sp_thread *t = x->t;
     if (t->n == t->cap && grow((void **)&t->c, &t->cap, t->n + 1, sizeof(sp_contact))) {
         t->oom = 1;
@@ -304,10 +293,37 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
     o->fa = fa;
     o->fb = fb;
     o->xi = xi;
-    o->f = v3_axpy(fn, n, ft);
+    o->f = v3(0.0, 0.0, 0.0);
     o->cp = cp;
     o->n = n;
-    o->delta = delta;
+    o->delta = rsum - d;
+    /* R*: sweep radius for a vertex or edge, infinite for a face (paper 003 eq. 16) */
+    o->rstar = a_flat ? gb->radius : (b_flat ? ga->radius : ga->radius * gb->radius / rsum);
+}
+
+/* Forces of the contacts c[0..n) of one body pair. Each point has the pair's spring and dashpot;
+ * k points pressing along the same normal (a face lying on a face: 4 corners) act in parallel as a
+ * spring k kn with dashpot k c, whose damping ratio would be sqrt(k) zeta. Dividing each dashpot by
+ * sqrt(k) keeps the requested restitution for flat impacts (README, "multi-point contacts"). */
+static void pair_forces(const sp_pair_ctx *x, sp_contact *c, int n)
+{
+    const lahar_dem_engine *e = x->e;
+    const sp_state *sa = &e->st[x->a], *sb = &e->st[x->b];
+    for (int i = 0; i < n; i++) {
+        sp_contact *o = &c[i];
+        int k = 0;
+        for (int j = 0; j < n; j++) k += v3_dot(o->n, c[j].n) > 0.9; /* within ~25 deg, itself included */
+        vec3 va = v3_add(sa->v, v3_cross(sa->w, v3_sub(o->cp, sa->x)));
+        vec3 vb = v3_add(sb->v, v3_cross(sb->w, v3_sub(o->cp, sb->x)));
+        vec3 vr = v3_sub(vb, va);
+        double vn = v3_dot(vr, o->n);
+        vec3 vt = v3_axpy(-vn, o->n, vr);
+        double ks, cn;
+        double fn = dem_normal_force(x->law, o->delta, -vn, x->mstar, o->rstar, 1.0 / sqrt((double)k), &ks, &cn);
+        o->xi = v3_axpy(x->h, vt, o->xi);
+        vec3 ft = dem_tangential_force(x->law, &o->xi, vt, fn, ks, cn);
+        o->f = v3_axpy(fn, o->n, ft);
+    }
 }
 
 /* Features of one side of a pair: all of them, or the candidates from its feature grid. */
@@ -485,7 +501,10 @@ static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread
      * touches B only if its core is within bound_B + R_A of B's centre */
     side_filter(e, &A, ga, e->st[b].x, gb->bound + ga->radius, t->keep[0]);
     side_filter(e, &B, gb, e->st[a].x, ga->bound + gb->radius, t->keep[1]);
-    if ((A.nv || A.ne || A.nf) && (B.nv || B.ne || B.nf)) pair_narrow(&x, &A, &B);
+    if (!(A.nv || A.ne || A.nf) || !(B.nv || B.ne || B.nf)) return;
+    int first = t->n;
+    pair_narrow(&x, &A, &B);
+    if (!t->oom) pair_forces(&x, t->c + first, t->n - first);
 }
 
 /* ---------------------------------------------------------------------------------------------- */
