@@ -7,7 +7,7 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | coordinator_killed | concurrent |
-#         cross_host | no_namespace | engine_error
+#         cross_host | no_namespace | engine_error | cli
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -260,6 +260,30 @@ with h5py.File(sys.argv[1] + "/bodies.h5", "r") as f:
 assert abs(t - 0.01 * (failed_step + 1)) < 1e-12, (last, t, failed_step)
 print("engine_error: failed at step %d, last snapshot %s at t = %.3f s" % (failed_step, last, t))
 PY
+    ;;
+cli)
+    # The user's commands: every program documents every option in --help; validate exits 0 / 2;
+    # `lahar check` on the bounce case runs (own namespace, processes) and its restitution metric
+    # passes against the analytic reference (cases/README.md), exit 0.
+    cases=$(cd "$tools/../cases" && pwd)
+    "$bin/lahar" --help > help.txt || fail "lahar --help failed"
+    for opt in --output --threads --in-process --no-spawn --lcm-url --wait --quiet; do
+        grep -q -- "$opt" help.txt || fail "lahar --help does not document $opt"
+    done
+    for prog in lahar-dem lahar-sph; do
+        "$bin/$prog" --help > help.txt || fail "$prog --help failed"
+        for opt in --lcm-url --run-id --threads --wait; do
+            grep -q -- "$opt" help.txt || fail "$prog --help does not document $opt"
+        done
+    done
+    "$bin/lahar" validate "$cases/dem_bounce_3d.yaml" || fail "validate rejects a good case"
+    "$bin/lahar" validate "$tools/../tests/bad_cases/dt_max_zero.yaml" 2> bad.txt
+    [ $? -eq 2 ] || fail "validate accepts a bad case"
+    "$bin/lahar" run "$tools/../tests/bad_cases/dt_max_zero.yaml" -o never -q 2> bad.txt
+    [ $? -eq 2 ] && [ ! -e never ] || fail "run of a bad case: not exit 2 before anything ran"
+    "$bin/lahar" check "$cases/dem_bounce_3d.yaml" -o bounce -q || fail "lahar check on dem_bounce_3d failed"
+    "$python" -c "import json; c = json.load(open('bounce/check.json')); assert c['pass'] is True, c" ||
+        fail "check.json does not say pass"
     ;;
 no_namespace)
     # When no user namespace can be created (here: nested to the kernel's limit), lahar run exits 2
