@@ -422,11 +422,13 @@ static int forces_flush(forces_stream *fs)
         hid_t id, mtype;
         int rank;
         const void *buf;
-    } ds[] = {{fs->t, H5T_NATIVE_DOUBLE, 1, fs->bt},
-              {fs->step, H5T_NATIVE_INT64, 1, fs->bstep},
+    } ds[] = {{fs->step, H5T_NATIVE_INT64, 1, fs->bstep},
               {fs->force, H5T_NATIVE_DOUBLE, 3, fs->bforce},
               {fs->torque, H5T_NATIVE_DOUBLE, 3, fs->btorque},
-              {fs->ncontacts, H5T_NATIVE_INT32, 2, fs->bncont}};
+              {fs->ncontacts, H5T_NATIVE_INT32, 2, fs->bncont},
+              {fs->t, H5T_NATIVE_DOUBLE, 1, fs->bt}};
+    /* /t is extended, written and flushed last: a SWMR reader that sees n rows in /t finds
+     * them in every other dataset */
     int rc = 0;
     for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
         hsize_t newd[3] = {start + rows, nb, 3}, off[3] = {start, 0, 0}, cnt[3] = {rows, nb, 3};
@@ -443,11 +445,9 @@ static int forces_flush(forces_stream *fs)
             rc = -1;
         H5Sclose(msp);
         H5Sclose(fsp);
-    }
-    /* /t last: a SWMR reader that sees n rows in /t finds them in every other dataset */
-    for (size_t k = 1; k <= sizeof ds / sizeof ds[0]; k++)
-        if (H5Dflush(ds[k % (sizeof ds / sizeof ds[0])].id) < 0)
+        if (H5Dflush(ds[k].id) < 0)
             rc = -1;
+    }
     fs->rows += fs->nbuf;
     fs->nbuf = 0;
     fs->last_flush = out_wall_seconds();
