@@ -43,7 +43,8 @@ def main():
     with f:
         names = names_of(f)
         t = f["t"][()]
-        force, torque, ncont = f["force"][()], f["torque"][()], f["ncontacts"][()]
+        n = len(t)  # /t grows last: the other datasets hold at least these rows
+        force, torque, ncont = f["force"][:n], f["torque"][:n], f["ncontacts"][:n]
         funit = f["force"].attrs.get("units", "N")
         tunit = f["torque"].attrs.get("units", "N m")
     funit = funit.decode() if isinstance(funit, bytes) else funit
