@@ -1,0 +1,99 @@
+/* SPH-DEM coupling through virtual particles (paper 000 section 4, eq. 12-21).
+ *
+ * For every SPH particle i within the kernel support kappa h of the swept surface of a DEM body:
+ *   c    closest point of the body's core (vertex, edge or face; geom_point_body_core)
+ *   n    unit normal from the core to the particle (eq. 12: n = (x_i - x_dem)/|...|, generalised
+ *        from a sphere's centre to the closest core point)
+ *   x_s  = c + R n, the virtual particle on the swept surface (eq. 12)
+ *   d    = |x_i - c| - R, signed distance to the surface (eq. 13; negative inside the sweep)
+ *   delta = eps - d, eps = dx/2 the halo (eq. 14)
+ *   F_n  = K_n delta n when delta > 0, K_n = 0.1 m_min / dt^2 (eq. 15)
+ *   u_rel = u_i - v_dem - w_dem x (x_s - x_dem) (eq. 16; the surface velocity of the body)
+ *   F_t  = m_i a_tau, the viscous force of the virtual particle (eq. 17-18, see sph_wall_viscous)
+ *   F on the particle = F_n + F_t (eq. 19), on the body -F (eq. 20) at x_s, torque
+ *   (x_s - x_dem) x (-F) (eq. 21, printed F x r: the usual r x F is used).
+ * A particle closer to the core than R, or inside a closed convex core, has crossed the body's
+ * surface: it is counted (crossings) and the first one is named.
+ * Body forces are summed serially in particle order after the parallel per-particle pass, so the
+ * result is bitwise the same for any thread count. */
+#ifndef LAHAR_SPH_COUPLING_H
+#define LAHAR_SPH_COUPLING_H
+#include <stdint.h>
+#include "kernel.h"
+#include "scene.h"
+#include "sph_particles.h"
+
+/* The wall viscous force (virtual particle term). */
+typedef enum {
+    /* Default. The Morris (1997) viscous operator integrated over the half-space behind the
+     * body's surface, with the no-slip ghost velocity extrapolated as in Morris et al. (1997):
+     * u_ghost - u_wall = -(s/d)(u_i - u_wall) at depth s behind the surface. Then
+     *   a_tau = (2 mu_i / rho_i) G(d) u_rel,  G(d) = int_{s > 0} (1 + s/d) W'(r)/r dV
+     * which is the "readjusted normalising constant" idea of eq. 18 made exact for a flat wall:
+     * the single virtual particle carries the whole missing neighbourhood. G is tabulated at setup
+     * over d in [eps/2, kappa h] (d is clamped to eps/2 below). */
+    SPH_WALL_VISCOUS_HALFSPACE = 0,
+    /* Eq. 17 as printed: a_tau = 4 m_i/(3 h^D) (2 mu_i)/(2 rho_i)^2 u_rel/d W'(d)/W(0, h). Its
+     * factor disagrees with eq. 18 (2/(3 h^D W(0,h))) and neither gives the wall shear of a
+     * Poiseuille flow (tests/test_sph_poiseuille.c reports its error): kept for comparison. */
+    SPH_WALL_VISCOUS_PAPER = 1,
+} sph_wall_viscous;
+
+/* One particle-body contact of the last evaluation: force ON THE BODY at the virtual particle. */
+typedef struct {
+    double xs[3];        /* virtual particle (surface point), world */
+    double force[3];     /* N (N/m in 2D), on the body: eq. 20 */
+    double delta;        /* halo overlap eps - d (m), <= 0 when only the viscous term acts */
+    int64_t particle_id; /* sph_particles.id */
+} sph_contact;
+
+#define SPH_COUPLING_MAX_PER_PARTICLE 4
+#define SPH_COUPLING_GTAB 512
+
+typedef struct {
+    int dim, nbody;
+    const lahar_body *bodies;  /* borrowed: shapes, motion */
+    double *bound;             /* per body: max |core vertex - x| (body frame) + R */
+    kernel k;
+    double eps;                /* halo thickness, dx/2 (eq. 14) */
+    double m_min;              /* eq. 15 */
+    double kn;                 /* K_n of the last evaluation */
+    double mu;                 /* fluid dynamic viscosity */
+    sph_wall_viscous viscous;
+    double gtab[SPH_COUPLING_GTAB + 1], gtab_d0, gtab_dd; /* G(d) on d = d0 + k dd */
+    /* per-particle slots of the parallel pass */
+    int64_t pcap;
+    int *slot_n;
+    int *slot_body;
+    sph_contact *slot;
+    /* results of the last evaluation, per body */
+    double (*force)[3], (*torque)[3];
+    int64_t *body_start;       /* nbody + 1: contacts of body b are contacts[body_start[b] ..) */
+    sph_contact *contacts;
+    int64_t ncontacts, contacts_cap;
+    int64_t *body_fill;
+    /* crossings in the last evaluation */
+    int64_t crossings;
+    int cross_body;            /* first crossing (lowest particle index): body, particle id, depth */
+    int64_t cross_particle_id;
+    double cross_depth;        /* how far inside the swept surface (m, > 0) */
+} sph_coupling;
+
+/* Set up the coupling with nbody bodies (borrowed; shapes must stay valid), halo eps = dx/2,
+ * m_min = min(particle mass m_sph, masses of free bodies) (eq. 15), dynamic viscosity mu, for
+ * particle_cap particles. Returns 0 or -1 (out of memory). */
+int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bodies, const kernel *k, double dx,
+                      double m_sph, double mu, sph_wall_viscous viscous, int64_t particle_cap);
+void sph_coupling_free(sph_coupling *c);
+
+/* Add the coupling forces (eq. 19) to the particle accelerations p->ax.. (divided by the
+ * particle mass) for a step of length dt (K_n = 0.1 m_min/dt^2), with the bodies at `states`
+ * (NULL: the poses and velocities stored in the bodies). Fills the per-body resultants, the
+ * contact list and the crossing count. Returns the number of crossings, or -1 when the contact
+ * list cannot grow (out of memory). */
+int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt);
+
+/* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
+double sph_coupling_halfspace_factor(const sph_coupling *c, double d);
+
+#endif

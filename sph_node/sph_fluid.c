@@ -1,0 +1,265 @@
+/* WCSPH solver core (sph_fluid.h). */
+#include "sph_fluid.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static void fluid_defaults(sph_params *p)
+{
+    if (!p->kernel)
+        p->kernel = "cubic";
+    if (p->h_over_dx <= 0.0)
+        p->h_over_dx = 1.3;
+    if (p->gamma <= 0.0)
+        p->gamma = 7.0;
+    if (p->cfl <= 0.0)
+        p->cfl = 0.25;
+    if (p->cfl_force <= 0.0)
+        p->cfl_force = 0.25;
+    if (p->cfl_visc <= 0.0)
+        p->cfl_visc = 0.125;
+}
+
+int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, int errlen)
+{
+    memset(f, 0, sizeof *f);
+    f->prm = *prm;
+    fluid_defaults(&f->prm);
+    sph_params *p = &f->prm;
+    if (!(p->dx > 0.0) || !(p->rho0 > 0.0) || !(p->c0 > 0.0) || p->mu < 0.0 || (p->dim != 2 && p->dim != 3)) {
+        snprintf(err, (size_t)errlen, "SPH parameters: need dim 2 or 3, dx > 0, rho0 > 0, c0 > 0, mu >= 0");
+        return -1;
+    }
+    if (kernel_init(&f->k, p->kernel, p->dim, p->h_over_dx * p->dx) != 0) {
+        snprintf(err, (size_t)errlen, "unknown kernel '%s' (cubic, quintic, wendland2)", p->kernel);
+        return -1;
+    }
+    if (sph_particles_init(&f->p, cap) != 0) {
+        snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)cap);
+        return -1;
+    }
+    if (sph_cells_init(&f->cells, p->dim, f->k.support, p->periodic, p->lo, p->hi, f->p.cap, err, errlen) != 0) {
+        sph_particles_free(&f->p);
+        return -1;
+    }
+    return 0;
+}
+
+int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
+{
+    double m_min = INFINITY;
+    for (int64_t i = 0; i < f->p.n; i++)
+        m_min = fmin(m_min, f->p.m[i]);
+    if (!(m_min < INFINITY))
+        m_min = f->prm.rho0 * pow(f->prm.dx, f->prm.dim);
+    if (f->has_bodies)
+        sph_coupling_free(&f->cpl);
+    f->has_bodies = 0;
+    if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
+                          f->prm.wall_viscous, f->p.cap) != 0)
+        return -1;
+    f->has_bodies = 1;
+    f->primed = 0;
+    return 0;
+}
+
+void sph_fluid_free(sph_fluid *f)
+{
+    if (f->has_bodies)
+        sph_coupling_free(&f->cpl);
+    sph_cells_free(&f->cells);
+    sph_particles_free(&f->p);
+    memset(f, 0, sizeof *f);
+}
+
+double sph_fluid_pressure(const sph_params *prm, double rho)
+{
+    if (prm->eos == SPH_EOS_TAIT) /* 003 eq. 19 */
+        return prm->rho0 * prm->c0 * prm->c0 / prm->gamma * (pow(rho / prm->rho0, prm->gamma) - 1.0);
+    return prm->c0 * prm->c0 * (rho - prm->rho0); /* 000 eq. 3 */
+}
+
+/* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
+ * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
+static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, int64_t i, double out[4])
+{
+    const sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
+    const sph_params *prm = &f->prm;
+    const double h = f->k.h, inv_h = f->k.inv_h, dnorm = f->k.dnorm, s2 = f->k.support * f->k.support;
+    const double eta2 = 0.01 * h * h;
+    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
+    const double rhoi = p->rho[i], pi_ = p->p[i], pri = pi_ / (rhoi * rhoi), mui = prm->mu;
+    const double c0 = prm->c0, alpha = prm->alpha, ddelta = 2.0 * prm->delta * h * c0;
+    const int64_t cell = c->cell_of[i];
+    const int cx = (int)(cell % c->nc[0]), cy = (int)((cell / c->nc[0]) % c->nc[1]),
+              cz = (int)(cell / ((int64_t)c->nc[0] * c->nc[1]));
+    const int zr = c->dim == 3 ? 1 : 0;
+    double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    for (int dz = -zr; dz <= zr; dz++) {
+        int jz = cz + dz;
+        double sz = 0.0;
+        if (jz < 0 || jz >= c->nc[2]) {
+            if (!c->periodic[2])
+                continue;
+            sz = jz < 0 ? -(c->hi[2] - c->lo[2]) : (c->hi[2] - c->lo[2]);
+            jz = jz < 0 ? jz + c->nc[2] : jz - c->nc[2];
+        }
+        for (int dy = -1; dy <= 1; dy++) {
+            int jy = cy + dy;
+            double sy = 0.0;
+            if (jy < 0 || jy >= c->nc[1]) {
+                if (!c->periodic[1])
+                    continue;
+                sy = jy < 0 ? -(c->hi[1] - c->lo[1]) : (c->hi[1] - c->lo[1]);
+                jy = jy < 0 ? jy + c->nc[1] : jy - c->nc[1];
+            }
+            for (int dxc = -1; dxc <= 1; dxc++) {
+                int jx = cx + dxc;
+                double sx = 0.0;
+                if (jx < 0 || jx >= c->nc[0]) {
+                    if (!c->periodic[0])
+                        continue;
+                    sx = jx < 0 ? -(c->hi[0] - c->lo[0]) : (c->hi[0] - c->lo[0]);
+                    jx = jx < 0 ? jx + c->nc[0] : jx - c->nc[0];
+                }
+                const int64_t nb = ((int64_t)jz * c->nc[1] + jy) * c->nc[0] + jx;
+                for (int64_t j = c->start[nb]; j < c->start[nb + 1]; j++) {
+                    /* x_ij with j's periodic image */
+                    double rx = xi - (p->x[j] + sx), ry = yi - (p->y[j] + sy), rz = zi - (p->z[j] + sz);
+                    double r2 = rx * rx + ry * ry + rz * rz;
+                    if (r2 >= s2 || j == i)
+                        continue;
+                    double r = sqrt(r2);
+                    double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
+                    double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
+                    double rhoj = p->rho[j], mj = p->m[j], vj = mj / rhoj;
+                    double vdotr = vx * rx + vy * ry + vz * rz;
+                    double rsoft = r2 / (r2 + eta2);
+                    /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
+                    drho += rhoi * vj * vdotr * fij + ddelta * vj * (rhoi - rhoj) * fij * rsoft;
+                    /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij */
+                    double pij = pri + p->p[j] / (rhoj * rhoj);
+                    if (alpha > 0.0 && vdotr < 0.0) /* Pi_ij = -alpha c0 mu_ij / rho_ij > 0 */
+                        pij -= alpha * c0 * (h * vdotr / (r2 + eta2)) / (0.5 * (rhoi + rhoj));
+                    double gp = -mj * pij * fij;
+                    /* laminar viscosity, Morris 1997 */
+                    double gv = mj * (mui + prm->mu) / (rhoi * rhoj) * fij * rsoft;
+                    ax += gp * rx + gv * vx;
+                    ay += gp * ry + gv * vy;
+                    az += gp * rz + gv * vz;
+                }
+            }
+        }
+    }
+    out[0] = drho;
+    out[1] = ax + prm->body_force[0];
+    out[2] = ay + prm->body_force[1];
+    out[3] = az + prm->body_force[2];
+}
+
+static void fluid_pass(sph_fluid *f)
+{
+    sph_particles *p = &f->p;
+    const int64_t n = p->n;
+    const kernel_kind kind = f->k.kind;
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; i++) {
+        double out[4];
+        switch (kind) {
+        case KERNEL_QUINTIC: fluid_particle(f, KERNEL_QUINTIC, i, out); break;
+        case KERNEL_WENDLAND2: fluid_particle(f, KERNEL_WENDLAND2, i, out); break;
+        default: fluid_particle(f, KERNEL_CUBIC, i, out); break;
+        }
+        p->drho[i] = out[0];
+        p->ax[i] = out[1];
+        p->ay[i] = out[2];
+        p->az[i] = out[3];
+    }
+}
+
+int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
+{
+    sph_particles *p = &f->p;
+    const int64_t n = p->n;
+    const sph_params prm = f->prm;
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; i++)
+        p->p[i] = sph_fluid_pressure(&prm, p->rho[i]);
+    fluid_pass(f);
+    int64_t cross = 0;
+    if (f->has_bodies) {
+        cross = sph_coupling_apply(&f->cpl, p, states, dt);
+        if (cross < 0)
+            return -1;
+    }
+    double vmax2 = 0.0, amax2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : vmax2, amax2)
+    for (int64_t i = 0; i < n; i++) {
+        double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i];
+        double a2 = p->ax[i] * p->ax[i] + p->ay[i] * p->ay[i] + p->az[i] * p->az[i];
+        vmax2 = v2 > vmax2 ? v2 : vmax2;
+        amax2 = a2 > amax2 ? a2 : amax2;
+    }
+    f->vmax = sqrt(vmax2);
+    f->amax = sqrt(amax2);
+    f->primed = 1;
+    return cross;
+}
+
+int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
+{
+    sph_particles *p = &f->p;
+    if (!f->primed) {
+        if (sph_cells_sort(&f->cells, p) != 0 || sph_fluid_rates(f, states, dt) < 0)
+            return -1;
+    }
+    const int64_t n = p->n;
+    const double hdt = 0.5 * dt;
+    const int d3 = f->prm.dim == 3;
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; i++) {
+        /* kick (half), drift, predict */
+        p->vhx[i] = p->vx[i] + hdt * p->ax[i];
+        p->vhy[i] = p->vy[i] + hdt * p->ay[i];
+        p->vhz[i] = d3 ? p->vz[i] + hdt * p->az[i] : 0.0;
+        p->rhoh[i] = p->rho[i] + hdt * p->drho[i];
+        p->x[i] += dt * p->vhx[i];
+        p->y[i] += dt * p->vhy[i];
+        p->z[i] += dt * p->vhz[i];
+        p->vx[i] = p->vhx[i] + hdt * p->ax[i];
+        p->vy[i] = p->vhy[i] + hdt * p->ay[i];
+        p->vz[i] = d3 ? p->vhz[i] + hdt * p->az[i] : 0.0;
+        p->rho[i] = p->rhoh[i] + hdt * p->drho[i];
+    }
+    if (sph_cells_sort(&f->cells, p) != 0)
+        return -1;
+    int64_t cross = sph_fluid_rates(f, states, dt);
+    if (cross < 0)
+        return -1;
+#pragma omp parallel for schedule(static)
+    for (int64_t i = 0; i < n; i++) {
+        /* kick (half) with the new rates */
+        p->vx[i] = p->vhx[i] + hdt * p->ax[i];
+        p->vy[i] = p->vhy[i] + hdt * p->ay[i];
+        p->vz[i] = d3 ? p->vhz[i] + hdt * p->az[i] : 0.0;
+        p->rho[i] = p->rhoh[i] + hdt * p->drho[i];
+    }
+    f->t += dt;
+    f->step++;
+    f->crossings = cross;
+    return cross;
+}
+
+double sph_fluid_dt(const sph_fluid *f)
+{
+    const sph_params *prm = &f->prm;
+    double h = f->k.h;
+    double dt = prm->cfl * h / (prm->c0 + f->vmax);
+    if (f->amax > 0.0)
+        dt = fmin(dt, prm->cfl_force * sqrt(h / f->amax));
+    if (prm->mu > 0.0)
+        dt = fmin(dt, prm->cfl_visc * h * h * prm->rho0 / prm->mu);
+    return dt;
+}

@@ -1,0 +1,99 @@
+/* Weakly compressible SPH water (paper 000 section 2.1, paper 003 section 3), the solver core the
+ * SPH node drives. Equations (x_ij = x_i - x_j, v_ij = v_i - v_j, r = |x_ij|, F_ij = W'(r)/r so
+ * that grad_i W_ij = F_ij x_ij, eta^2 = 0.01 h^2, V_j = m_j / rho_j):
+ *
+ *   continuity (000 eq. 1, first term; 003 eq. 9 in the rho_i V_j form):
+ *     drho_i/dt = rho_i sum_j V_j v_ij . grad_i W_ij
+ *   delta-SPH density diffusion (Molteni & Colagrossi 2009; 000 eq. 1, second term):
+ *     + 2 delta h c0 sum_j V_j (rho_i - rho_j) F_ij r^2 / (r^2 + eta^2)
+ *     000 prints (rho_j - rho_i) x_ij with eta^2 = 0.1 h^2; Molteni & Colagrossi write
+ *     (rho_j - rho_i) x_ji. With x_ij the sign must be (rho_i - rho_j) for the term to be
+ *     Brookshaw's Laplacian delta h c0 lap(rho), which diffuses a bump (test_sph_fluid.c checks
+ *     the rate of a sine mode against -delta h c0 k^2); eta^2 = 0.01 h^2 as 000's text says.
+ *   momentum (000 eq. 2, 003 eq. 10):
+ *     dv_i/dt = g - sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) grad_i W_ij         (symmetric)
+ *             + sum_j m_j (mu_i + mu_j)/(rho_i rho_j) F_ij r^2/(r^2 + eta^2) v_ij     (Morris 1997)
+ *             + (coupling forces of DEM bodies, sph_coupling.h) / m_i
+ *     000 eq. 2 prints the laminar term without x_ij . grad W / r^2; the complete Morris (1997)
+ *     form is used (equal to Lo & Shao's 4 (mu_i + mu_j)/(rho_i + rho_j)^2 at equal densities).
+ *     Pi_ij = -alpha c0 mu_ij / rho_ij, mu_ij = h v_ij.x_ij/(r^2 + eta^2) when v_ij.x_ij < 0
+ *     (Monaghan 1992), rho_ij the mean density; off when alpha = 0.
+ *   EOS: linear p = c0^2 (rho - rho0) (000 eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
+ *     (003 eq. 19). c0 is the constant numerical speed of sound.
+ *
+ * Time integration: kick-drift-kick leapfrog, second order, one neighbour pass per step:
+ *   v_h = v + dt/2 a;  rho_h = rho + dt/2 D;  x += dt v_h;
+ *   predict v = v_h + dt/2 a, rho = rho_h + dt/2 D;  sort;  evaluate a, D at (x, v, rho);
+ *   v = v_h + dt/2 a;  rho = rho_h + dt/2 D.
+ * Step proposal (003 eq. 20 split in its three parts, plus the viscous limit):
+ *   dt = min(C_cfl h/(c0 + |v|max), C_f sqrt(h/|a|max), C_v h^2/nu).
+ * Every loop over particles is an OpenMP loop in gather form (each particle sums over its own
+ * neighbours in cell order): no races, and bitwise the same result for any number of threads. */
+#ifndef LAHAR_SPH_FLUID_H
+#define LAHAR_SPH_FLUID_H
+#include <stdint.h>
+#include "kernel.h"
+#include "scene.h"
+#include "sph_coupling.h"
+#include "sph_particles.h"
+
+typedef enum { SPH_EOS_LINEAR = 0, SPH_EOS_TAIT = 1 } sph_eos;
+
+typedef struct {
+    int dim;
+    const char *kernel;     /* "cubic" (default when NULL), "quintic", "wendland2" */
+    double dx;              /* initial particle spacing */
+    double h_over_dx;       /* smoothing length h = h_over_dx dx (default 1.3 when 0) */
+    double rho0;            /* rest density */
+    double c0;              /* numerical speed of sound */
+    sph_eos eos;
+    double gamma;           /* Tait exponent (default 7 when 0) */
+    double mu;              /* dynamic viscosity, Pa s */
+    double alpha;           /* Monaghan artificial viscosity, 0 = off */
+    double delta;           /* delta-SPH coefficient, 0 = off (0.1 typical) */
+    double body_force[3];   /* m/s^2 (gravity plus any driving acceleration) */
+    double cfl, cfl_force, cfl_visc; /* defaults 0.25, 0.25, 0.125 when 0 */
+    int periodic[3];        /* 1: axis periodic with period [lo, hi) */
+    double lo[3], hi[3];
+    sph_wall_viscous wall_viscous;
+} sph_params;
+
+typedef struct {
+    sph_params prm;
+    kernel k;
+    sph_particles p;
+    sph_cells cells;
+    sph_coupling cpl;
+    int has_bodies;
+    int primed;             /* rates of the current state are in p.ax.. */
+    double t;
+    int64_t step;
+    double vmax, amax;      /* of the last evaluation */
+    int64_t crossings;      /* of the last step */
+} sph_fluid;
+
+/* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the
+ * first step). Returns 0, or -1 with a one-line reason in err. */
+int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, int errlen);
+/* Couple with DEM bodies (borrowed, must outlive f). Call after adding the particles (their
+ * smallest mass enters K_n, eq. 15). Returns 0 or -1 (out of memory). */
+int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies);
+void sph_fluid_free(sph_fluid *f);
+
+/* Pressure from density by the EOS of the parameters. */
+double sph_fluid_pressure(const sph_params *prm, double rho);
+
+/* Evaluate the rates (p.ax, ay, az, drho) at the current state: EOS, the particle-particle sums
+ * and, with bodies, the coupling for a step dt with bodies at `states` (NULL: their own fields).
+ * Particles must be sorted (sph_cells_sort). Returns crossings, or -1 (out of memory). */
+int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt);
+
+/* One step of length dt; bodies at `states` at the end of the step (NULL: their own fields).
+ * Returns the number of particles that crossed a body surface in this step (0 normally), or -1
+ * (out of memory). */
+int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states);
+
+/* The step this state allows (see above). Call after a step (or sph_fluid_rates). */
+double sph_fluid_dt(const sph_fluid *f);
+
+#endif

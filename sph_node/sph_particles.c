@@ -1,0 +1,257 @@
+/* SPH particle storage and cell lists (sph_particles.h). */
+#include "sph_particles.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SPH_NDOUBLE 17
+/* Every double array of a particle set, so that allocation, release and sorting treat all alike. */
+static void particle_doubles(sph_particles *p, double **a[SPH_NDOUBLE])
+{
+    double **list[SPH_NDOUBLE] = {&p->x,  &p->y,  &p->z,  &p->vx,  &p->vy,  &p->vz,  &p->rho, &p->p,   &p->m,
+                                  &p->ax, &p->ay, &p->az, &p->drho, &p->vhx, &p->vhy, &p->vhz, &p->rhoh};
+    memcpy(a, list, sizeof list);
+}
+
+int sph_particles_init(sph_particles *p, int64_t cap)
+{
+    memset(p, 0, sizeof *p);
+    if (cap < 1)
+        cap = 1;
+    double **a[SPH_NDOUBLE];
+    particle_doubles(p, a);
+    int ok = 1;
+    for (int k = 0; k < SPH_NDOUBLE; k++)
+        ok &= (*a[k] = calloc((size_t)cap, sizeof(double))) != NULL;
+    ok &= (p->scratch_d = calloc((size_t)cap, sizeof(double))) != NULL;
+    ok &= (p->id = calloc((size_t)cap, sizeof *p->id)) != NULL;
+    ok &= (p->scratch_i = calloc((size_t)cap, sizeof *p->scratch_i)) != NULL;
+    ok &= (p->phase = calloc((size_t)cap, sizeof *p->phase)) != NULL;
+    ok &= (p->scratch_p = calloc((size_t)cap, sizeof *p->scratch_p)) != NULL;
+    if (!ok) {
+        sph_particles_free(p);
+        return -1;
+    }
+    p->cap = cap;
+    return 0;
+}
+
+void sph_particles_free(sph_particles *p)
+{
+    double **a[SPH_NDOUBLE];
+    particle_doubles(p, a);
+    for (int k = 0; k < SPH_NDOUBLE; k++)
+        free(*a[k]);
+    free(p->scratch_d);
+    free(p->id);
+    free(p->scratch_i);
+    free(p->phase);
+    free(p->scratch_p);
+    memset(p, 0, sizeof *p);
+}
+
+int64_t sph_particles_add(sph_particles *p, const double x[3], const double v[3], double m, double rho,
+                          int32_t phase)
+{
+    if (p->n >= p->cap)
+        return -1;
+    int64_t i = p->n++;
+    p->x[i] = x[0], p->y[i] = x[1], p->z[i] = x[2];
+    p->vx[i] = v[0], p->vy[i] = v[1], p->vz[i] = v[2];
+    p->vhx[i] = v[0], p->vhy[i] = v[1], p->vhz[i] = v[2];
+    p->m[i] = m;
+    p->rho[i] = p->rhoh[i] = rho;
+    p->p[i] = 0.0;
+    p->ax[i] = p->ay[i] = p->az[i] = p->drho[i] = 0.0;
+    p->phase[i] = phase;
+    p->id[i] = i;
+    return i;
+}
+
+int64_t sph_particles_add_box(sph_particles *p, int dim, double dx, double rho, const double lo[3], const double hi[3],
+                              const double v[3])
+{
+    int64_t n[3];
+    for (int a = 0; a < 3; a++) {
+        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((hi[a] - lo[a]) / dx + 1e-9);
+        if (n[a] < 0)
+            n[a] = 0;
+    }
+    if (n[0] * n[1] * n[2] > p->cap - p->n)
+        return -1;
+    double m = rho * pow(dx, dim);
+    double v2[3] = {v[0], v[1], dim == 2 ? 0.0 : v[2]};
+    for (int64_t i = 0; i < n[0]; i++)
+        for (int64_t j = 0; j < n[1]; j++)
+            for (int64_t k = 0; k < n[2]; k++) {
+                double x[3] = {lo[0] + ((double)i + 0.5) * dx, lo[1] + ((double)j + 0.5) * dx,
+                               dim == 2 ? 0.0 : lo[2] + ((double)k + 0.5) * dx};
+                sph_particles_add(p, x, v2, m, rho, 0);
+            }
+    return n[0] * n[1] * n[2];
+}
+
+int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3], const double lo[3],
+                   const double hi[3], int64_t particle_cap, char *err, int errlen)
+{
+    memset(c, 0, sizeof *c);
+    c->dim = dim;
+    c->min_size = support;
+    if (!(support > 0.0)) {
+        snprintf(err, (size_t)errlen, "kernel support must be > 0");
+        return -1;
+    }
+    for (int a = 0; a < 3; a++) {
+        c->periodic[a] = periodic && periodic[a] && !(a == 2 && dim == 2);
+        c->lo[a] = lo ? lo[a] : 0.0;
+        c->hi[a] = hi ? hi[a] : 0.0;
+        c->size[a] = support;
+        c->nc[a] = 1;
+        if (c->periodic[a]) {
+            double len = c->hi[a] - c->lo[a];
+            int nc = (int)floor(len / support);
+            if (nc < 3) {
+                snprintf(err, (size_t)errlen,
+                         "periodic axis %c: period %g m holds %d cells of the kernel support %g m; it needs >= 3",
+                         "xyz"[a], len, nc, support);
+                return -1;
+            }
+            c->nc[a] = nc;
+            c->size[a] = len / nc;
+        }
+    }
+    c->pcap = particle_cap < 1 ? 1 : particle_cap;
+    c->ncell_cap = 1024;
+    c->start = calloc((size_t)c->ncell_cap + 1, sizeof *c->start);
+    c->count = calloc((size_t)c->ncell_cap, sizeof *c->count);
+    c->cell_of = calloc((size_t)c->pcap, sizeof *c->cell_of);
+    c->perm = calloc((size_t)c->pcap, sizeof *c->perm);
+    if (!c->start || !c->count || !c->cell_of || !c->perm) {
+        sph_cells_free(c);
+        snprintf(err, (size_t)errlen, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+void sph_cells_free(sph_cells *c)
+{
+    free(c->start);
+    free(c->count);
+    free(c->cell_of);
+    free(c->perm);
+    memset(c, 0, sizeof *c);
+}
+
+static void gather_d(double **a, double **scratch, const int64_t *perm, int64_t n)
+{
+    double *src = *a, *dst = *scratch;
+    for (int64_t k = 0; k < n; k++)
+        dst[k] = src[perm[k]];
+    *a = dst;
+    *scratch = src;
+}
+
+int sph_cells_sort(sph_cells *c, sph_particles *p)
+{
+    int64_t n = p->n;
+    if (n > c->pcap)
+        return -1;
+    double *pos[3] = {p->x, p->y, p->z};
+    /* grid: periodic axes wrap, the others follow the particles */
+    for (int a = 0; a < 3; a++) {
+        if (a == 2 && c->dim == 2) {
+            c->nc[2] = 1;
+            continue;
+        }
+        double *x = pos[a];
+        if (c->periodic[a]) {
+            double lo = c->lo[a], len = c->hi[a] - c->lo[a];
+            for (int64_t i = 0; i < n; i++) {
+                if (x[i] < lo || x[i] >= lo + len) {
+                    x[i] -= floor((x[i] - lo) / len) * len;
+                    if (x[i] >= lo + len) /* rounding of a value just below lo */
+                        x[i] = lo;
+                }
+            }
+            continue;
+        }
+        double mn = INFINITY, mx = -INFINITY;
+        for (int64_t i = 0; i < n; i++) {
+            mn = fmin(mn, x[i]);
+            mx = fmax(mx, x[i]);
+        }
+        if (!(mn <= mx)) /* no particles (or all NaN): one cell */
+            mn = mx = 0.0;
+        c->lo[a] = mn;
+        c->hi[a] = mx;
+        c->size[a] = c->min_size;
+        double nc = floor((mx - mn) / c->size[a]) + 1.0;
+        c->nc[a] = nc > 1e6 ? 1000000 : (int)nc;
+        c->size[a] = fmax(c->min_size, (mx - mn) / c->nc[a] * (1.0 + 1e-12));
+    }
+    /* a particle flying far away must not blow up the table: coarsen the non-periodic axes */
+    int64_t limit = 8 * c->pcap + 4096;
+    for (;;) {
+        int64_t ncell = (int64_t)c->nc[0] * c->nc[1] * c->nc[2];
+        if (ncell <= limit)
+            break;
+        for (int a = 0; a < c->dim; a++)
+            if (!c->periodic[a] && c->nc[a] > 1) {
+                c->nc[a] = (c->nc[a] + 1) / 2;
+                c->size[a] = fmax(c->min_size, (c->hi[a] - c->lo[a]) / c->nc[a] * (1.0 + 1e-12));
+            }
+    }
+    int64_t ncell = (int64_t)c->nc[0] * c->nc[1] * c->nc[2];
+    if (ncell > c->ncell_cap) {
+        int64_t cap = c->ncell_cap;
+        while (cap < ncell)
+            cap *= 2;
+        int64_t *s = realloc(c->start, (size_t)(cap + 1) * sizeof *s);
+        if (!s)
+            return -1;
+        c->start = s;
+        int64_t *cnt = realloc(c->count, (size_t)cap * sizeof *cnt);
+        if (!cnt)
+            return -1;
+        c->count = cnt;
+        c->ncell_cap = cap;
+    }
+    c->ncell = ncell;
+    memset(c->count, 0, (size_t)ncell * sizeof *c->count);
+    for (int64_t i = 0; i < n; i++) {
+        int ix = sph_cells_coord(c, 0, p->x[i]), iy = sph_cells_coord(c, 1, p->y[i]);
+        int iz = c->dim == 3 ? sph_cells_coord(c, 2, p->z[i]) : 0;
+        int64_t cell = ((int64_t)iz * c->nc[1] + iy) * c->nc[0] + ix;
+        c->cell_of[i] = cell;
+        c->count[cell]++;
+    }
+    c->start[0] = 0;
+    for (int64_t k = 0; k < ncell; k++) {
+        c->start[k + 1] = c->start[k] + c->count[k];
+        c->count[k] = c->start[k]; /* now the insertion cursor */
+    }
+    for (int64_t i = 0; i < n; i++)
+        c->perm[c->count[c->cell_of[i]]++] = i;
+    /* permute every particle array */
+    double **a[SPH_NDOUBLE];
+    particle_doubles(p, a);
+    for (int k = 0; k < SPH_NDOUBLE; k++)
+        gather_d(a[k], &p->scratch_d, c->perm, n);
+    for (int64_t k = 0; k < n; k++)
+        p->scratch_i[k] = p->id[c->perm[k]];
+    int64_t *ti = p->id;
+    p->id = p->scratch_i;
+    p->scratch_i = ti;
+    for (int64_t k = 0; k < n; k++)
+        p->scratch_p[k] = p->phase[c->perm[k]];
+    int32_t *tp = p->phase;
+    p->phase = p->scratch_p;
+    p->scratch_p = tp;
+    /* cell_of in the new order */
+    for (int64_t k = 0; k < ncell; k++)
+        for (int64_t i = c->start[k]; i < c->start[k + 1]; i++)
+            c->cell_of[i] = k;
+    return 0;
+}

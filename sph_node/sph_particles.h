@@ -1,0 +1,73 @@
+/* SPH particles of the solver core as a structure of arrays, and their cell lists.
+ *
+ * Particles are kept sorted by cell (counting sort of the cell index, all arrays permuted, ids kept)
+ * so that the neighbours of a particle are contiguous runs of memory. Cells are cubes of side >= the
+ * kernel support; periodic axes use the domain box exactly (positions wrapped into [lo, hi)), the
+ * other axes follow the particles (bounding box recomputed at every sort). All storage is allocated
+ * at setup; the cell table grows by doubling on the rare sort that needs more cells. */
+#ifndef LAHAR_SPH_PARTICLES_H
+#define LAHAR_SPH_PARTICLES_H
+#include <stdint.h>
+
+typedef struct {
+    int64_t n, cap;
+    /* state */
+    double *x, *y, *z, *vx, *vy, *vz, *rho, *p, *m;
+    /* rates (filled by sph_fluid_rates) */
+    double *ax, *ay, *az, *drho;
+    /* half-step state of the integrator */
+    double *vhx, *vhy, *vhz, *rhoh;
+    int32_t *phase; /* 0 = water */
+    int64_t *id;    /* stable across sorts */
+    /* sort scratch */
+    double *scratch_d;
+    int64_t *scratch_i;
+    int32_t *scratch_p;
+} sph_particles;
+
+/* Allocate room for cap particles (n = 0). Returns 0 or -1 (out of memory; nothing allocated). */
+int sph_particles_init(sph_particles *p, int64_t cap);
+void sph_particles_free(sph_particles *p);
+/* Append one particle at rest density rho with mass m; returns its index, or -1 when full. */
+int64_t sph_particles_add(sph_particles *p, const double x[3], const double v[3], double m, double rho,
+                          int32_t phase);
+/* Append the lattice of spacing dx filling [lo, hi): centres lo + (i + 1/2) dx, floor((hi - lo)/dx)
+ * per axis (z = 0 and one layer in 2D), mass rho dx^D, velocity v. Returns the number added or -1
+ * when it does not fit (nothing added). */
+int64_t sph_particles_add_box(sph_particles *p, int dim, double dx, double rho, const double lo[3], const double hi[3],
+                              const double v[3]);
+
+/* Cell lists. */
+typedef struct {
+    int dim;
+    int periodic[3];
+    double lo[3], hi[3];   /* domain: exact on periodic axes, particle bounds elsewhere */
+    double size[3];        /* cell side per axis (>= min_size) */
+    double min_size;       /* kernel support */
+    int nc[3];             /* cells per axis */
+    int64_t ncell, ncell_cap;
+    int64_t *start;        /* ncell + 1: particles of cell c are start[c] .. start[c+1] - 1 */
+    int64_t *count;        /* ncell_cap counters for the counting sort */
+    int64_t *cell_of;      /* per particle (cap) */
+    int64_t *perm;         /* per particle (cap) */
+    int64_t pcap;
+} sph_cells;
+
+/* Cells of side >= support. Periodic axes: periodic[a] = 1 with [lo[a], hi[a]) the period, which
+ * must hold >= 3 cells. Returns 0, or -1 (bad arguments, message in err, or out of memory). */
+int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3], const double lo[3],
+                   const double hi[3], int64_t particle_cap, char *err, int errlen);
+void sph_cells_free(sph_cells *c);
+/* Wrap positions on periodic axes, bin the particles and permute every particle array into cell
+ * order (stable: particles of a cell keep their relative order). Returns 0, or -1 when the cell
+ * table cannot grow (out of memory). */
+int sph_cells_sort(sph_cells *c, sph_particles *p);
+/* Cell coordinate of a position along axis a (clamped into the grid). */
+static inline int sph_cells_coord(const sph_cells *c, int a, double x)
+{
+    double t = (x - c->lo[a]) / c->size[a];
+    int i = t >= 0.0 ? (t < (double)c->nc[a] ? (int)t : c->nc[a] - 1) : 0; /* NaN -> 0 */
+    return i >= c->nc[a] ? c->nc[a] - 1 : i;
+}
+
+#endif
