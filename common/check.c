@@ -21,12 +21,16 @@ extern char **environ;
 
 /* ---------------------------------------------------------------- loading --------------- */
 
-static int check_read(hid_t loc, const char *name, hid_t type, void *buf)
+/* Read a whole dataset of exactly `count` elements into buf (a different size is an error, not
+ * an overflow). */
+static int check_read(hid_t loc, const char *name, hid_t type, hssize_t count, void *buf)
 {
     hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT);
     if (ds < 0)
         return -1;
-    herr_t rc = H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    hid_t sp = H5Dget_space(ds);
+    herr_t rc = H5Sget_simple_extent_npoints(sp) == count ? H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) : -1;
+    H5Sclose(sp);
     H5Dclose(ds);
     return rc < 0 ? -1 : 0;
 }
@@ -83,7 +87,7 @@ static int check_load_forces(const char *outdir, lahar_check_data *d)
         d->nrow = (int64_t)n;
         d->ft = malloc((n ? n : 1) * sizeof *d->ft);
         d->ncontacts = malloc((n ? n : 1) * (size_t)(d->nbody ? d->nbody : 1) * sizeof *d->ncontacts);
-        if (d->ft && d->ncontacts && (n == 0 || (!check_read(f, "t", H5T_NATIVE_DOUBLE, d->ft) &&
+        if (d->ft && d->ncontacts && (n == 0 || (!check_read(f, "t", H5T_NATIVE_DOUBLE, (hssize_t)n, d->ft) &&
                                                  (d->nbody == 0 || !check_read_rows(f, "ncontacts", n, d->nbody,
                                                                                     d->ncontacts)))))
             rc = 0;
@@ -139,9 +143,9 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
         hid_t s = H5Gopen2(g, name, H5P_DEFAULT);
         if (s < 0 || check_read_attr(s, "time", H5T_NATIVE_DOUBLE, &d->t[k]) ||
             check_read_attr(s, "step", H5T_NATIVE_INT64, &d->step[k]) ||
-            (nbody > 0 && (check_read(s, "position", H5T_NATIVE_DOUBLE, d->x + k * nb3) ||
-                           check_read(s, "velocity", H5T_NATIVE_DOUBLE, d->v + k * nb3) ||
-                           check_read(s, "angular_velocity", H5T_NATIVE_DOUBLE, d->w + k * nb3))))
+            (nbody > 0 && (check_read(s, "position", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->x + k * nb3) ||
+                           check_read(s, "velocity", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->v + k * nb3) ||
+                           check_read(s, "angular_velocity", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->w + k * nb3))))
             rc = -1;
         if (s >= 0)
             H5Gclose(s);
@@ -622,6 +626,12 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
     lahar_check_data d;
     if (lahar_check_data_load(outdir, &d, msg, sizeof msg))
         return check_fail(outdir, ref->name, msg);
+    if (d.nbody != c->nbody) {
+        snprintf(msg, sizeof msg, "%s/bodies.h5 has %d bodies, the case %s has %d: output of another case?", outdir,
+                 d.nbody, c->path, c->nbody);
+        lahar_check_data_free(&d);
+        return check_fail(outdir, ref->name, msg);
+    }
     lahar_check_result *r = calloc(1, sizeof *r);
     double *series = malloc(3 * LAHAR_CHECK_MAX_SERIES * sizeof *series);
     if (!r || !series) {
