@@ -238,6 +238,9 @@ int main(int argc, char **argv)
     run_incline(dir, 2.0 / 3.0 * g * sin(th), 0, &c);
     rc = lahar_check_evaluate(&c, dir);
     CHECK(rc == 0, "incline 2/3 g sin(theta): status %d", rc);
+    char other[1200];
+    snprintf(other, sizeof other, "%s/bounce_fail", base);
+    CHECK(lahar_check_evaluate(&c, other) == 2, "output of another case (3 bodies, case has 2) must give status 2");
     CHECK(read_json(dir, "accel_rel_error", &pass, &v) == 0 && pass && v < 1e-9, "incline pass: %d %g", pass, v);
     free_bodies(2);
 
