@@ -199,7 +199,7 @@ static int out_write_mesh_set(hid_t g, const lahar_body_output *o, const lahar_c
     return rc;
 }
 
-static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_case *c)
+static int out_write_header(hid_t f, const lahar_case *c)
 {
     int rc = 0, nb = c->nbody, nm = c->nmaterial;
     hid_t h = out_group(f, "header");
@@ -283,7 +283,6 @@ static int out_write_header(hid_t f, const lahar_body_output *o, const lahar_cas
         H5Gclose(mg);
     }
     free(names), free(iv), free(dv);
-    (void)o;
     H5Gclose(h);
     return rc ? -1 : 0;
 }
@@ -534,7 +533,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
         lahar_body_output_close(o);
         return NULL;
     }
-    int rc = out_write_header(f, o, c);
+    int rc = out_write_header(f, c);
     rc |= out_write_geometry(f, o, c);
     hid_t sg = out_group(f, "snapshots");
     if (sg < 0)
