@@ -616,7 +616,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     lahar_link_set_step(co.link, -1);
     if (lahar_link_heartbeat_start(co.link, LAHAR_HEARTBEAT_PERIOD) != 0) {
         snprintf(co.message, sizeof co.message, "cannot start the heartbeat thread");
-        goto out;
+        goto stop;
     }
     status = coord_hello(&co);
     if (status != LAHAR_EXIT_OK)
@@ -670,9 +670,18 @@ out:
     if (!o->quiet) {
         printf("lahar: %s: %lld steps to t = %.6g s in %.2f s wall; output in %s\n", co.status, (long long)co.steps,
                co.sim_time, lahar_now() - co.wall0, co.outdir);
-        printf("  look at it: paraview %s/lahar.xmf   |   h5dump -H %s/bodies.h5   |   python3 %s/plot_forces.py %s\n"
-               "  run summary: %s/summary.json\n",
-               co.outdir, co.outdir, LAHAR_TOOLS_DIR, co.outdir, co.outdir);
+        printf("  look at it: paraview %s/lahar.xmf (bodies and particles over time)\n", co.outdir);
+        static const char *const files[] = {"bodies.h5", "forces.h5", "particles.h5"};
+        for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+            char path[PATH_MAX + 32];
+            snprintf(path, sizeof path, "%s/%s", co.outdir, files[i]);
+            if (access(path, R_OK) == 0)
+                printf("              h5dump -H %s\n", path);
+        }
+        if (co.node[LAHAR_ROLE_DEM].needed)
+            printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
+                   LAHAR_TOOLS_DIR, co.outdir);
+        printf("  run summary: %s/summary.json\n", co.outdir);
     }
     lahar_link_destroy(co.link);
     lahar_transport_close(co.t);

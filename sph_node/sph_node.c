@@ -87,7 +87,9 @@ void lahar_sph_particles_free(lahar_sph_particles *p)
 void lahar_sph_particles_advance(lahar_sph_particles *p, const double g[3], double dt)
 {
     const int64_t n = p->n;
-#pragma omp parallel for schedule(static)
+    /* below a few thousand particles a parallel region (and its barrier, on a loaded machine)
+     * costs more than the loop itself */
+#pragma omp parallel for schedule(static) if (n > 8192)
     for (int64_t i = 0; i < n; i++) {
         p->vx[i] += g[0] * dt;
         p->vy[i] += g[1] * dt;
@@ -103,7 +105,7 @@ double lahar_sph_particles_dt(const lahar_sph_particles *p, const double g[3], d
     double vmax2 = 0.0;
     const int64_t n = p->n;
     /* max is exact whatever the order of the reduction, so this stays deterministic */
-#pragma omp parallel for reduction(max : vmax2) schedule(static)
+#pragma omp parallel for reduction(max : vmax2) schedule(static) if (n > 8192)
     for (int64_t i = 0; i < n; i++) {
         double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i];
         if (v2 > vmax2)
