@@ -16,6 +16,11 @@ target_link_libraries(test_coupling_msg PRIVATE lahar_common)
 add_test(NAME coupling_msg COMMAND test_coupling_msg)
 set_tests_properties(coupling_msg PROPERTIES LABELS "fast;coupling")
 
+add_executable(test_coupling_scene ${LAHAR_TEST_DIR}/test_coupling_scene.c)
+target_link_libraries(test_coupling_scene PRIVATE lahar_common)
+add_test(NAME coupling_scene COMMAND test_coupling_scene ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR})
+set_tests_properties(coupling_scene PROPERTIES LABELS "fast;coupling")
+
 add_executable(test_sph_particles ${LAHAR_TEST_DIR}/test_sph_particles.c)
 target_link_libraries(test_sph_particles PRIVATE lahar_sph)
 add_test(NAME sph_particles COMMAND test_sph_particles)
