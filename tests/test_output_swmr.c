@@ -108,7 +108,6 @@ int main(int argc, char **argv)
     hid_t ds = H5Dopen2(f, "t", H5P_DEFAULT), dsf = H5Dopen2(f, "force", H5P_DEFAULT);
     int growth = 0, status = 0, done = 0;
     hsize_t last = 0;
-    double worst_lag = 0.0;
     while (!done) {
         done = waitpid(pid, &status, WNOHANG) == pid;
         H5Drefresh(ds);
@@ -125,8 +124,6 @@ int main(int argc, char **argv)
             fprintf(stderr, "FAIL: at %.2f s the reader sees %d rows, at least %d were due\n", tau, (int)nrow, must);
             failures++;
         }
-        if (tau > 0)
-            worst_lag = fmax(worst_lag, (double)(must - (int)nrow) * ROW_PERIOD);
         if (nrow > last) {
             if (!done)
                 growth++;
@@ -170,7 +167,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "FAIL: the reader saw the dataset grow only %d times while the writer ran\n", growth);
         failures++;
     }
-    printf("test_output_swmr: saw %d increments while writing, worst lag behind the 0.75 s bound %.2f s, %s\n",
-           growth, worst_lag, failures ? "FAIL" : "ok");
+    printf("test_output_swmr: saw %d increments while writing, never more than 0.75 s behind: %s\n", growth,
+           failures ? "FAIL" : "ok");
     return failures ? 1 : 0;
 }
