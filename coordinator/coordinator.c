@@ -303,10 +303,14 @@ static int coord_collect_status(coord *co, int64_t k)
             coord_node *ln = &co->node[lost];
             int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
                                                                                  : lahar_link_peer_step(co->link, lost);
+            char how[96] = "died or hangs";
+            if (ln->pid > 0 && coord_node_ended(ln))
+                snprintf(how, sizeof how, "%s %d", ln->exit_status > 128 ? "killed by signal" : "exited with status",
+                         ln->exit_status > 128 ? ln->exit_status - 128 : ln->exit_status);
             snprintf(co->message, sizeof co->message,
-                     "lost the %s (%s, pid %d on %s): silent for %.1f s (died or hangs); last completed step %lld "
+                     "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
                      "(t = %.9g s); stopping the run",
-                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE,
+                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE, how,
                      (long long)last, co->sim_time);
             co->status = "node lost";
             return LAHAR_EXIT_NODE_LOST;
