@@ -142,7 +142,11 @@ int main(void)
         c.bodies[placed].v[2] = urand(&seed) - 0.5;
         placed++;
     }
+    omp_set_num_threads(1);
+    lahar_dem_engine *e1 = dem_test_engine(&c, &ops);
+    omp_set_num_threads(2);
     lahar_dem_engine *e = dem_test_engine(&c, &ops);
+    omp_set_num_threads(maxthr);
     int brute = count_overlaps(nsph, (const double(*)[3])x, r);
     dem_test_check(ops->ncontacts(e) == brute && brute > 100, "3000 spheres at start: grid finds %d contacts, brute force %d",
                    ops->ncontacts(e), brute);
@@ -158,6 +162,11 @@ int main(void)
         nsub += n;
     }
     double t1 = omp_get_wtime();
+    /* >= 512 pairs: the narrow phase really ran on a thread team here */
+    for (int k = 0; k < 20; k++)
+        if (ops->advance(e1, ops->stable_dt(e1), NULL, err, sizeof err) < 0) break;
+    dem_test_check(same_states(ops, e, e1), "3000 spheres, 20 substeps: 1 thread == 2 threads, bit for bit");
+    ops->destroy(e1);
     for (int i = 0; i < nsph; i++) {
         lahar_body_state st;
         ops->get_state(e, i, &st);
