@@ -33,6 +33,7 @@
 #define COORD_NODE_SILENCE 2.0   /* s without a frame from a node: node lost */
 #define COORD_HELLO_PERIOD_MS 100
 #define COORD_STOP_WAIT 3.0      /* s the nodes get to exit after STOP */
+#define COORD_STEP_RESEND_MS 250 /* re-publish STEP(k) while STATUS(k) is missing */
 
 typedef struct {
     int role;
@@ -297,7 +298,14 @@ static int coord_collect_status(coord *co, int64_t k)
         if (!n->needed)
             continue;
         lahar_link_msg m;
-        int rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, -1, &m);
+        int rc;
+        /* Requests are idempotent: besides the NACKs of both sides, STEP(k) goes out again every
+         * 250 ms until STATUS(k) is in (a node that has it already drops the duplicate, and its
+         * kept STATUS(k) answers the coordinator's NACK). */
+        while ((rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, COORD_STEP_RESEND_MS, &m)) ==
+               LAHAR_LINK_TIMEOUT)
+            if (k >= 0)
+                lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
         if (rc == LAHAR_LINK_LOST) {
             int lost = lahar_link_lost_role(co->link);
             coord_node *ln = &co->node[lost];
