@@ -359,7 +359,7 @@ static int edge_face_owns(const lahar_dem_engine *e, const sp_geo *g, int j, vec
     return 0;
 }
 
-/* vertex i of body gv (side index sv: 0 = a, 1 = b) against face f of body gf */
+/* vertex i of body gv against face f of body gf; v_is_a: the vertex belongs to body a */
 static void test_vertex_face(sp_pair_ctx *x, const sp_geo *gv, int i, const sp_geo *gf, int f, int v_is_a)
 {
     const lahar_dem_engine *e = x->e;
@@ -504,7 +504,21 @@ static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread
     if (!(A.nv || A.ne || A.nf) || !(B.nv || B.ne || B.nf)) return;
     int first = t->n;
     pair_narrow(&x, &A, &B);
-    if (!t->oom) pair_forces(&x, t->c + first, t->n - first);
+    if (t->oom) return;
+    /* Faces and edges own their boundaries inclusively, so a vertex exactly over a shared mesh edge
+     * or vertex (a rock rolling along a grid line of a terrain) is found once per face: keep the
+     * first of contacts at the same point with the same normal. */
+    int n = first;
+    for (int i = first; i < t->n; i++) {
+        const sp_contact *c = &t->c[i];
+        double tol2 = 1e-12 * (ga->radius + gb->radius) * (ga->radius + gb->radius);
+        int dup = 0;
+        for (int j = first; j < n && !dup; j++)
+            dup = v3_norm2(v3_sub(t->c[j].cp, c->cp)) < tol2 && v3_dot(t->c[j].n, c->n) > 0.999999;
+        if (!dup) t->c[n++] = *c;
+    }
+    t->n = n;
+    pair_forces(&x, t->c + first, t->n - first);
 }
 
 /* ---------------------------------------------------------------------------------------------- */

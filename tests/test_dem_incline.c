@@ -58,7 +58,7 @@ static void add_terrain(lahar_case *c, int mat, double rp)
     }
 }
 
-static double incline_accel_on(int dim, double theta, double mu, double *spin_ratio, int terrain)
+static double incline_accel_on(int dim, double theta, double mu, double *spin_ratio, int terrain, double y0)
 {
     const double g = 9.81, R = 0.05, rp = 0.01, kn = 1e6;
     double gv[3] = {g * sin(theta), 0, 0};
@@ -75,7 +75,7 @@ static double incline_accel_on(int dim, double theta, double mu, double *spin_ra
         const double a[3] = {-1, 0, 0}, b[3] = {9, 0, 0};
         dem_test_segment(&c, "slope", m, a, b, rp);
     }
-    double x[3] = {0, 0.0371, 0}; /* off the mesh lines */
+    double x[3] = {0, y0, 0};
     int s = dem_test_sphere(&c, "ball", m, R, x, LAHAR_MOTION_FREE);
     /* start at the static overlap so that the normal transient is small */
     c.bodies[s].x[dim == 3 ? 2 : 1] = R + rp - c.bodies[s].mass * g * cos(theta) / kn;
@@ -105,7 +105,7 @@ static double incline_accel_on(int dim, double theta, double mu, double *spin_ra
 
 static double incline_accel(int dim, double theta, double mu, double *spin_ratio)
 {
-    return incline_accel_on(dim, theta, mu, spin_ratio, 0);
+    return incline_accel_on(dim, theta, mu, spin_ratio, 0, 0.0371);
 }
 
 /* The same with a really tilted plane (normal (-sin, 0, cos)) and vertical gravity: the
@@ -170,13 +170,16 @@ int main(void)
     /* the same on a fine terrain mesh (feature grid; contacts move across triangles/segments and
      * keep their tangential spring, so the motion equals the one on a single plane) */
     double a_plane = incline_accel(3, th, 0.5, &spin);
-    a = incline_accel_on(3, th, 0.5, &spin, 1);
+    a = incline_accel_on(3, th, 0.5, &spin, 1, 0.0371); /* off the mesh lines */
     dem_test_rel("sphere rolling on a 960-triangle terrain vs 5/7 g sin", a, 5.0 / 7.0 * g * sin(th), 0.01);
     dem_test_rel("sphere rolling on the terrain vs on a single plane", a, a_plane, 1e-6);
-    a = incline_accel_on(3, th, 0.1, &spin, 1);
+    a = incline_accel_on(3, th, 0.1, &spin, 1, 0.0371);
     dem_test_rel("sphere sliding on a 960-triangle terrain vs g (sin - mu cos)", a, g * (sin(th) - 0.1 * cos(th)), 0.01);
+    /* along a grid line of the mesh (y = 0): the contact point sits on shared edges and vertices */
+    a = incline_accel_on(3, th, 0.5, &spin, 1, 0.0);
+    dem_test_rel("sphere rolling along a mesh line vs on a single plane", a, a_plane, 1e-6);
     a_plane = incline_accel(2, th, 0.5, &spin);
-    a = incline_accel_on(2, th, 0.5, &spin, 1);
+    a = incline_accel_on(2, th, 0.5, &spin, 1, 0.0);
     dem_test_rel("disc rolling on a 100-segment polyline vs 2/3 g sin", a, 2.0 / 3.0 * g * sin(th), 0.01);
     dem_test_rel("disc rolling on the polyline vs on a single segment", a, a_plane, 1e-6);
     return dem_test_failures ? 1 : 0;
