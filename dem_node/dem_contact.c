@@ -8,24 +8,25 @@ static double harmonic_mean(double a, double b) { return (a > 0.0 && b > 0.0) ? 
 int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair_law *out,
                       char *err, size_t errlen)
 {
-    /* Hertz when either material asks for it and both give E (E* needs both sides); a Hertz
-     * material meeting a linear one without E falls back to the linear law (needs kn on both). */
-    int hertz = a->model == LAHAR_CONTACT_HERTZ || b->model == LAHAR_CONTACT_HERTZ;
-    if (hertz && !(a->young > 0.0 && b->young > 0.0) && a->kn > 0.0 && b->kn > 0.0) hertz = 0;
-    out->model = hertz ? LAHAR_CONTACT_HERTZ : LAHAR_CONTACT_LINEAR;
-    out->kn = harmonic_mean(a->kn, b->kn);
-    out->estar = 0.0;
-    if (a->young > 0.0 && b->young > 0.0)
-        out->estar = 1.0 / ((1.0 - a->poisson * a->poisson) / a->young + (1.0 - b->poisson * b->poisson) / b->young);
+    /* Hertz when either material asks for it. A material without E (a linear one, as the case
+     * loader fills it) counts as rigid in 1/E*; a linear pair uses the kn of the side that has one
+     * when the other has none. So rocks with Hertz can meet walls with the linear law. */
+    out->model = (a->model == LAHAR_CONTACT_HERTZ || b->model == LAHAR_CONTACT_HERTZ) ? LAHAR_CONTACT_HERTZ
+                                                                                     : LAHAR_CONTACT_LINEAR;
+    out->kn = (a->kn > 0.0 && b->kn > 0.0) ? harmonic_mean(a->kn, b->kn) : (a->kn > 0.0 ? a->kn : b->kn);
+    double inv = 0.0;
+    if (a->young > 0.0) inv += (1.0 - a->poisson * a->poisson) / a->young;
+    if (b->young > 0.0) inv += (1.0 - b->poisson * b->poisson) / b->young;
+    out->estar = inv > 0.0 ? 1.0 / inv : 0.0;
     out->kt_ratio = 0.5 * (a->kt_ratio + b->kt_ratio);
     out->e = a->restitution < b->restitution ? a->restitution : b->restitution;
     out->mu = a->friction < b->friction ? a->friction : b->friction;
     if (out->model == LAHAR_CONTACT_HERTZ && !(out->estar > 0.0)) {
-        snprintf(err, errlen, "materials '%s'/'%s': Hertz contact needs young > 0 for both (or kn > 0 for both to fall back to linear)", a->name, b->name);
+        snprintf(err, errlen, "materials '%s'/'%s': Hertz contact needs young > 0 on at least one side", a->name, b->name);
         return -1;
     }
     if (out->model == LAHAR_CONTACT_LINEAR && !(out->kn > 0.0)) {
-        snprintf(err, errlen, "materials '%s'/'%s': linear contact needs kn > 0 for both", a->name, b->name);
+        snprintf(err, errlen, "materials '%s'/'%s': linear contact needs kn > 0 on at least one side", a->name, b->name);
         return -1;
     }
     if (!(out->e > 0.0 && out->e <= 1.0)) {

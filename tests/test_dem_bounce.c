@@ -3,6 +3,7 @@
  * contact duration and maximum overlap match reference 06 sec. 6.1/6.3 within 2 % / 1 %. */
 #include <math.h>
 #include <stdio.h>
+#include "dem_contact.h"
 #include "dem_test_util.h"
 
 typedef struct {
@@ -53,8 +54,41 @@ static bounce_result bounce(lahar_contact_model model, double e, double v0, doub
     return r;
 }
 
+/* How two materials combine (dem_node/README.md). */
+static void material_pairs(void)
+{
+    lahar_material lin1 = {.name = "a", .kn = 1e6, .kt_ratio = 0.2, .restitution = 0.6, .friction = 0.4,
+                           .model = LAHAR_CONTACT_LINEAR};
+    lahar_material lin2 = {.name = "b", .kn = 3e6, .kt_ratio = 0.4, .restitution = 0.3, .friction = 0.7,
+                           .model = LAHAR_CONTACT_LINEAR};
+    lahar_material hz = {.name = "c", .young = 1e9, .poisson = 0.3, .kt_ratio = 0.3, .restitution = 0.8,
+                         .friction = 0.2, .model = LAHAR_CONTACT_HERTZ};
+    lahar_material hz2 = {.name = "d", .young = 3e9, .poisson = 0.2, .kt_ratio = 0.3, .restitution = 0.8,
+                          .friction = 0.2, .model = LAHAR_CONTACT_HERTZ};
+    dem_pair_law law;
+    char err[256];
+    dem_test_check(dem_pair_law_make(&lin1, &lin2, &law, err, sizeof err) == 0 && law.model == LAHAR_CONTACT_LINEAR,
+                   "linear + linear -> linear");
+    dem_test_rel("kn = harmonic mean 2 ka kb/(ka + kb)", law.kn, 1.5e6, 1e-15);
+    dem_test_check(law.e == 0.3 && law.mu == 0.4, "e = min (%g), mu = min (%g)", law.e, law.mu);
+    dem_test_rel("kt_ratio = mean", law.kt_ratio, 0.3, 1e-15);
+    dem_test_check(dem_pair_law_make(&hz, &hz2, &law, err, sizeof err) == 0 && law.model == LAHAR_CONTACT_HERTZ,
+                   "hertz + hertz -> hertz");
+    dem_test_rel("1/E* = (1-nu_a^2)/E_a + (1-nu_b^2)/E_b", law.estar, 1.0 / (0.91 / 1e9 + 0.96 / 3e9), 1e-15);
+    dem_test_check(dem_pair_law_make(&hz, &lin1, &law, err, sizeof err) == 0 && law.model == LAHAR_CONTACT_HERTZ,
+                   "hertz + linear -> hertz");
+    dem_test_rel("hertz + linear: the side without E counts as rigid", law.estar, 1e9 / 0.91, 1e-15);
+    /* the calibrated damping reproduces the closed forms where clipping does not matter (e -> 1) */
+    double z = -log(0.99) / sqrt(M_PI * M_PI + log(0.99) * log(0.99));
+    dem_test_rel("linear damping for e = 0.99 vs closed form", dem_damping_for_restitution(LAHAR_CONTACT_LINEAR, 0.99),
+                 z, 0.01);
+    dem_test_rel("hertz damping for e = 0.99 vs sqrt(5) x closed form (06 sec. 6.3)",
+                 dem_damping_for_restitution(LAHAR_CONTACT_HERTZ, 0.99), sqrt(5.0) * z, 0.01);
+}
+
 int main(void)
 {
+    material_pairs();
     const double es[] = {0.1, 0.3, 0.5, 0.7, 0.9, 0.95};
     const double v0 = 1.0;
     double m, rstar;
