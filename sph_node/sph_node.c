@@ -21,70 +21,34 @@
 
 #define ROLE LAHAR_ROLE_SPH
 
-static int64_t sph_lattice_count(int dim, double dx, const double lo[3], const double hi[3], int64_t n[3])
+/* Particles a block holds (the lattice of sph_particles_add_box), to size the arrays once. */
+static int64_t sph_node_block_count(int dim, double dx, const lahar_particle_block *b)
 {
-    for (int a = 0; a < 3; a++)
-        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((hi[a] - lo[a]) / dx + 1e-9);
-    for (int a = 0; a < 3; a++)
-        if (n[a] < 0)
-            n[a] = 0;
-    return n[0] * n[1] * n[2];
+    int64_t count = 1;
+    for (int a = 0; a < (dim == 2 ? 2 : 3); a++) {
+        int64_t n = (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
+        count *= n > 0 ? n : 0;
+    }
+    return count;
 }
 
-int64_t lahar_sph_particles_create(lahar_sph_particles *p, int dim, double dx, double rest_density, int nblock,
-                                   const double (*lo)[3], const double (*hi)[3], const double (*v)[3])
+int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
+                            const lahar_particle_block *blocks)
 {
-    memset(p, 0, sizeof *p);
-    int64_t total = 0, n[3];
+    int64_t total = 0;
     for (int b = 0; b < nblock; b++)
-        total += sph_lattice_count(dim, dx, lo[b], hi[b], n);
-    size_t cap = (size_t)(total > 0 ? total : 1);
-    double **arrays[] = {&p->x, &p->y, &p->z, &p->vx, &p->vy, &p->vz, &p->density, &p->pressure};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        if (!(*arrays[i] = calloc(cap, sizeof(double)))) {
-            lahar_sph_particles_free(p);
+        total += sph_node_block_count(dim, dx, &blocks[b]);
+    if (sph_particles_init(p, total > 0 ? total : 1) != 0)
+        return -1;
+    for (int b = 0; b < nblock; b++)
+        if (sph_particles_add_box(p, dim, dx, rest_density, blocks[b].lo, blocks[b].hi, blocks[b].v) < 0) {
+            sph_particles_free(p);
             return -1;
         }
-    if (!(p->id = calloc(cap, sizeof *p->id)) || !(p->phase = calloc(cap, sizeof *p->phase))) {
-        lahar_sph_particles_free(p);
-        return -1;
-    }
-    int64_t k = 0;
-    for (int b = 0; b < nblock; b++) {
-        sph_lattice_count(dim, dx, lo[b], hi[b], n);
-        for (int64_t i = 0; i < n[0]; i++)
-            for (int64_t j = 0; j < n[1]; j++)
-                for (int64_t l = 0; l < n[2]; l++, k++) {
-                    p->x[k] = lo[b][0] + ((double)i + 0.5) * dx;
-                    p->y[k] = lo[b][1] + ((double)j + 0.5) * dx;
-                    p->z[k] = dim == 2 ? 0.0 : lo[b][2] + ((double)l + 0.5) * dx;
-                    p->vx[k] = v[b][0];
-                    p->vy[k] = v[b][1];
-                    p->vz[k] = dim == 2 ? 0.0 : v[b][2];
-                    p->density[k] = rest_density;
-                    p->id[k] = k;
-                }
-    }
-    p->n = total;
-    return total;
+    return p->n;
 }
 
-void lahar_sph_particles_free(lahar_sph_particles *p)
-{
-    free(p->x);
-    free(p->y);
-    free(p->z);
-    free(p->vx);
-    free(p->vy);
-    free(p->vz);
-    free(p->density);
-    free(p->pressure);
-    free(p->id);
-    free(p->phase);
-    memset(p, 0, sizeof *p);
-}
-
-void lahar_sph_particles_advance(lahar_sph_particles *p, const double g[3], double dt)
+void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt)
 {
     const int64_t n = p->n;
     /* below a few thousand particles a parallel region (and its barrier, on a loaded machine)
@@ -100,7 +64,7 @@ void lahar_sph_particles_advance(lahar_sph_particles *p, const double g[3], doub
     }
 }
 
-double lahar_sph_particles_dt(const lahar_sph_particles *p, const double g[3], double dx)
+double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double dx)
 {
     double vmax2 = 0.0;
     const int64_t n = p->n;
@@ -118,7 +82,7 @@ double lahar_sph_particles_dt(const lahar_sph_particles *p, const double g[3], d
 typedef struct {
     lahar_link *link;
     lahar_node_scene ns;
-    lahar_sph_particles p;
+    sph_particles p;
     lahar_particle_output *out;
     int nmoving;
     lahar_body_state_buf bodies; /* moving bodies at t_k (BODY_STATE(k-1)), for the coupling */
@@ -128,7 +92,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
 {
     lahar_particles_view v = {
         .n = s->p.n, .x = s->p.x, .y = s->p.y, .z = s->p.z, .vx = s->p.vx, .vy = s->p.vy, .vz = s->p.vz,
-        .density = s->p.density, .pressure = s->p.pressure, .phase = s->p.phase, .id = s->p.id,
+        .density = s->p.rho, .pressure = s->p.p, .phase = s->p.phase, .id = s->p.id,
     };
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }
@@ -186,12 +150,12 @@ static int sph_node_loop(sph_node *s)
             lahar_loads_t loads = {.run_id = lahar_link_run_id(s->link), .step = k};
             LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &loads);
         }
-        lahar_sph_particles_advance(&s->p, c->gravity, step.dt);
+        lahar_sph_node_fall(&s->p, c->gravity, step.dt);
         if (step.write_output && sph_node_snapshot(s, k + 1, step.t_next) != 0) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
         }
-        st.dt_proposed = lahar_sph_particles_dt(&s->p, c->gravity, c->sph_dx);
+        st.dt_proposed = lahar_sph_node_fall_dt(&s->p, c->gravity, c->sph_dx);
         st.dt_stable = st.dt_proposed;
         compute += lahar_now() - c0;
         st.compute_s = compute;
@@ -243,34 +207,18 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         s.nmoving += c->bodies[i].motion != LAHAR_MOTION_FIXED;
     lahar_status_t st = {0};
     err[0] = '\0';
-    double(*lo)[3] = malloc((size_t)(c->nblock + 1) * sizeof *lo);
-    double(*hi)[3] = malloc((size_t)(c->nblock + 1) * sizeof *hi);
-    double(*v)[3] = malloc((size_t)(c->nblock + 1) * sizeof *v);
-    if (!lo || !hi || !v)
-        snprintf(err, sizeof err, "out of memory");
-    else {
-        for (int b = 0; b < c->nblock; b++) {
-            memcpy(lo[b], c->blocks[b].lo, sizeof lo[b]);
-            memcpy(hi[b], c->blocks[b].hi, sizeof hi[b]);
-            memcpy(v[b], c->blocks[b].v, sizeof v[b]);
-        }
-        if (!(c->sph_dx > 0.0))
-            snprintf(err, sizeof err, "the particle spacing sph.dx must be > 0 (got %g)", c->sph_dx);
-        else if (lahar_sph_particles_create(&s.p, c->dim, c->sph_dx, c->sph_density, c->nblock,
-                                            (const double(*)[3])lo, (const double(*)[3])hi, (const double(*)[3])v) < 0)
-            snprintf(err, sizeof err, "out of memory for the particles");
-        else if (!(s.out = lahar_particle_output_open(s.ns.output_dir, c, c->output_fields, err, sizeof err)))
-            ;
-        else if (sph_node_snapshot(&s, 0, 0.0) != 0)
-            snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
-    }
-    free(lo);
-    free(hi);
-    free(v);
+    if (!(c->sph_dx > 0.0))
+        snprintf(err, sizeof err, "the particle spacing sph.dx must be > 0 (got %g)", c->sph_dx);
+    else if (lahar_sph_node_fill(&s.p, c->dim, c->sph_dx, c->sph_density, c->nblock, c->blocks) < 0)
+        snprintf(err, sizeof err, "out of memory for the particles");
+    else if (!(s.out = lahar_particle_output_open(s.ns.output_dir, c, c->output_fields, err, sizeof err)))
+        ;
+    else if (sph_node_snapshot(&s, 0, 0.0) != 0)
+        snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
     char desc[128];
     snprintf(desc, sizeof desc, "minimal (gravity only), %lld particles", (long long)s.p.n);
     st.error = err[0] != '\0';
-    st.dt_proposed = st.error ? 0.0 : lahar_sph_particles_dt(&s.p, c->gravity, c->sph_dx);
+    st.dt_proposed = st.error ? 0.0 : lahar_sph_node_fall_dt(&s.p, c->gravity, c->sph_dx);
     st.dt_stable = st.dt_proposed;
     lahar_node_send_status(s.link, ROLE, -1, &st, st.error ? err : desc);
     if (st.error) {
@@ -283,7 +231,7 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
 done:
     lahar_link_heartbeat_stop(s.link);
     lahar_particle_output_close(s.out);
-    lahar_sph_particles_free(&s.p);
+    sph_particles_free(&s.p);
     lahar_body_state_buf_free(&s.bodies);
     lahar_case_free(&s.ns.scene);
     lahar_link_destroy(s.link);

@@ -4,6 +4,7 @@
 #ifndef LAHAR_SPH_NODE_H
 #define LAHAR_SPH_NODE_H
 #include <stdint.h>
+#include "scene.h"
 
 typedef struct {
     const char *lcm_url; /* udpm://... or memq:// */
@@ -12,24 +13,19 @@ typedef struct {
     double join_wait_s;  /* how long to wait for the coordinator's HELLO */
 } lahar_sph_node_options;
 
-/* Particles as structure of arrays. */
-typedef struct {
-    int64_t n;
-    double *x, *y, *z, *vx, *vy, *vz, *density, *pressure;
-    int32_t *phase; /* 0 = fluid for now */
-    int64_t *id;
-} lahar_sph_particles;
+/* Particles: the solver core's structure of arrays (sph_particles.h). Until the node steps them
+ * with the WCSPH core, they only fall under gravity. */
+#include "sph_particles.h"
 
-/* Fill particles on the lattice of spacing dx in every block: centres at lo + (i + 1/2) dx for
- * i < floor((hi - lo) / dx + 1e-9) per axis (one layer at z = 0 in 2D). Returns the count, or -1
- * when out of memory. Release with lahar_sph_particles_free. */
-int64_t lahar_sph_particles_create(lahar_sph_particles *p, int dim, double dx, double rest_density, int nblock,
-                                   const double (*lo)[3], const double (*hi)[3], const double (*v)[3]);
-void lahar_sph_particles_free(lahar_sph_particles *p);
-/* Semi-implicit Euler under gravity: v += g dt, then x += v dt. */
-void lahar_sph_particles_advance(lahar_sph_particles *p, const double g[3], double dt);
-/* CFL-like step: 0.25 dx / (|v|max + sqrt(|g| dx)). */
-double lahar_sph_particles_dt(const lahar_sph_particles *p, const double g[3], double dx);
+/* Allocate and fill the lattice of spacing dx in every block (sph_particles_add_box: centres at
+ * lo + (i + 1/2) dx, floor((hi - lo)/dx) per axis, one layer at z = 0 in 2D). Returns the number
+ * of particles, or -1 when out of memory. */
+int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
+                            const lahar_particle_block *blocks);
+/* Semi-implicit Euler under gravity only: v += g dt, then x += v dt. */
+void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt);
+/* CFL-like step of a free fall: 0.25 dx / (|v|max + sqrt(|g| dx)). */
+double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double dx);
 
 int lahar_sph_node_run(const lahar_sph_node_options *o);
 
