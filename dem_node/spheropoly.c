@@ -523,7 +523,7 @@ static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Broad phase: free bodies binned by centre in a hashed uniform grid of cell >= the largest
- * bounding diameter (so neighbours are within the 27 surrounding cells); fixed and prescribed
+ * bounding diameter (so neighbours are within the 27 surrounding cells, half of them visited); fixed and prescribed
  * bodies (few, possibly huge) are tested against every free body by box. O(N) per step. */
 
 static uint32_t cell_hash(long long x, long long y, long long z)
@@ -565,19 +565,23 @@ static int broad_phase(lahar_dem_engine *e)
         }
         for (int i = nb; i > 0; i--) e->bucket_start[i] = e->bucket_start[i - 1];
         e->bucket_start[0] = 0;
+        /* half shell: the own cell (partners j > i) and the 13 (2D: 4) neighbours that come after
+         * it in (z, y, x) order (all partners), so that each pair is met once */
         int zr = e->dim == 3 ? 1 : 0;
         for (int k = 0; k < e->nfree; k++) {
             int i = e->free_ids[k];
             const sp_state *si = &e->st[i];
-            for (int dz = -zr; dz <= zr; dz++)
-                for (int dy = -1; dy <= 1; dy++)
-                    for (int dx = -1; dx <= 1; dx++) {
+            for (int dz = 0; dz <= zr; dz++)
+                for (int dy = dz > 0 ? -1 : 0; dy <= 1; dy++)
+                    for (int dx = (dz > 0 || dy > 0) ? -1 : 0; dx <= 1; dx++) {
+                        int own = dz == 0 && dy == 0 && dx == 0;
                         long long cx = e->cellc[k][0] + dx, cy = e->cellc[k][1] + dy, cz = e->cellc[k][2] + dz;
                         uint32_t h = cell_hash(cx, cy, cz) & (uint32_t)(nb - 1);
                         for (int m = e->bucket_start[h]; m < e->bucket_start[h + 1]; m++) {
                             int l = e->bucket_items[m];
                             int j = e->free_ids[l];
-                            if (j <= i || e->cellc[l][0] != cx || e->cellc[l][1] != cy || e->cellc[l][2] != cz) continue;
+                            if ((own && j <= i) || e->cellc[l][0] != cx || e->cellc[l][1] != cy || e->cellc[l][2] != cz)
+                                continue;
                             double r = e->geo[i].bound + e->geo[j].bound;
                             if (v3_norm2(v3_sub(e->st[j].x, si->x)) < r * r && add_pair(e, i, j)) return -1;
                         }

@@ -180,6 +180,36 @@ int main(void)
     free(x);
     free(r);
 
+    /* the same in 2D (9-cell neighbourhood): 2000 discs */
+    const int ndisc = 2000;
+    dem_test_case_init(&c, 2, g0, ndisc);
+    m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, 1e6, 0, 0, 0.5, 0.3);
+    x = malloc(sizeof(double[3]) * ndisc);
+    r = malloc(sizeof(double) * ndisc);
+    placed = 0;
+    while (placed < ndisc) {
+        double p[3] = {4.0 * urand(&seed), 4.0 * urand(&seed), 0.0}, rad = 0.03 + 0.03 * urand(&seed);
+        int ok = 1;
+        for (int j = 0; j < placed && ok; j++) {
+            double dx = p[0] - x[j][0], dy = p[1] - x[j][1];
+            double lim = rad + r[j] - 0.2 * fmin(rad, r[j]);
+            if (dx * dx + dy * dy < lim * lim) ok = 0;
+        }
+        if (!ok) continue;
+        memcpy(x[placed], p, sizeof p);
+        r[placed] = rad;
+        dem_test_sphere(&c, "d", m, rad, p, LAHAR_MOTION_FREE);
+        placed++;
+    }
+    e = dem_test_engine(&c, &ops);
+    brute = count_overlaps(ndisc, (const double(*)[3])x, r);
+    dem_test_check(ops->ncontacts(e) == brute && brute > 100, "2000 discs (2D): grid finds %d contacts, brute force %d",
+                   ops->ncontacts(e), brute);
+    ops->destroy(e);
+    dem_test_case_free(&c);
+    free(x);
+    free(r);
+
     /* instability */
     dem_test_case_init(&c, 3, g0, 2);
     m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, 1e6, 0, 0, 0.5, 0.3);
