@@ -42,6 +42,7 @@ typedef struct {
     int material;
     lahar_motion motion;
     double mass, inertia[3];
+    int isotropic; /* equal principal moments (spheres, cubes): free rotation is a plain rotation */
     vec3 aabb_lo, aabb_hi; /* world box of non-free bodies (vertices +- radius) */
 } sp_geo;
 
@@ -150,6 +151,10 @@ static void body_update_omega(lahar_dem_engine *e, int i)
     sp_state *s = &e->st[i];
     if (e->dim == 2) {
         s->w = v3(0.0, 0.0, s->L.z / g->inertia[2]);
+        return;
+    }
+    if (g->isotropic) {
+        s->w = v3_scale(s->L, 1.0 / g->inertia[0]);
         return;
     }
     vec3 pb = q_rotate_inv(s->q, s->L);
@@ -735,6 +740,10 @@ static void drift(lahar_dem_engine *e, double h)
             if (wn > 0.0) s->q = q_normalize(q_mul(q_axis_angle(v3_scale(s->w, 1.0 / wn), wn * h), s->q));
         } else if (e->dim == 2) {
             s->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * s->L.z / g->inertia[2]), s->q));
+        } else if (g->isotropic) {
+            /* equal moments: w = L / I is constant, the free motion is one rotation by |w| h */
+            double wn = v3_norm(s->L) / g->inertia[0];
+            if (wn > 0.0) s->q = q_normalize(q_mul(q_axis_angle(v3_scale(s->L, 1.0 / v3_norm(s->L)), wn * h), s->q));
         } else {
             /* symmetric splitting X(h/2) Y(h/2) Z(h) Y(h/2) X(h/2) of the free rigid body, each an
              * exact rotation: Dullweber, Leimkuhler & McLachlan, J. Chem. Phys. 107 (1997) 5840 */
@@ -1037,6 +1046,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         g->motion = b->motion;
         g->mass = b->mass;
         memcpy(g->inertia, b->inertia, sizeof g->inertia);
+        g->isotropic = g->inertia[0] == g->inertia[1] && g->inertia[1] == g->inertia[2];
         g->grid = -1;
         double rb = 0.0;
         for (int k = 0; k < s->nv; k++) {
