@@ -5,6 +5,7 @@
  * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
 #include "spheropoly.h"
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <stdint.h>
@@ -52,6 +53,14 @@ typedef struct {
     vec3 fc, tc;     /* contact force / torque of the last evaluation */
 } sp_state;
 
+/* A free body in the broad-phase grid (64 bytes: one cache line). */
+typedef struct {
+    long long c[3]; /* cell */
+    vec3 x;
+    double bound;
+    int id;
+} sp_bin;
+
 typedef struct {
     sp_contact *c;
     int n, cap;
@@ -84,7 +93,9 @@ struct lahar_dem_engine {
     int nfree, *free_ids, nlarge, *large_ids;
     double cell;
     long long (*cellc)[3];
-    int *bucket_start, *bucket_items, nbucket;
+    int *bucket_of, *bucket_start, nbucket, bucket_cap, nhash, dense;
+    long long dlo[3], dn[3];  /* dense grid: first cell and cells per axis */
+    sp_bin *bins;             /* free bodies sorted by bucket */
     int (*pairs)[2];
     int npair, pair_cap;
     /* contacts: previous evaluation (history) and hash over it */
@@ -540,6 +551,17 @@ static uint32_t cell_hash(long long x, long long y, long long z)
     return (uint32_t)h;
 }
 
+/* Bucket of a cell: dense index inside the bodies' box, -1 outside it; hashed otherwise. */
+static inline int bucket_of_cell(const lahar_dem_engine *e, long long x, long long y, long long z)
+{
+    if (!e->dense) return (int)(cell_hash(x, y, z) & (uint32_t)(e->nhash - 1));
+    x -= e->dlo[0];
+    y -= e->dlo[1];
+    z -= e->dlo[2];
+    if (x < 0 || y < 0 || z < 0 || x >= e->dn[0] || y >= e->dn[1] || z >= e->dn[2]) return -1;
+    return (int)((z * e->dn[1] + y) * e->dn[0] + x);
+}
+
 static int add_pair(lahar_dem_engine *e, int a, int b)
 {
     if (e->npair == e->pair_cap && grow((void **)&e->pairs, &e->pair_cap, e->npair + 1, sizeof(int[2]))) return -1;
@@ -552,43 +574,68 @@ static int add_pair(lahar_dem_engine *e, int a, int b)
 static int broad_phase(lahar_dem_engine *e)
 {
     e->npair = 0;
-    int nb = e->nbucket;
     if (e->nfree > 0) {
         double inv = 1.0 / e->cell;
-        memset(e->bucket_start, 0, sizeof(int) * (size_t)(nb + 1));
+        long long lo[3] = {LLONG_MAX, LLONG_MAX, LLONG_MAX}, hi[3] = {LLONG_MIN, LLONG_MIN, LLONG_MIN};
         for (int k = 0; k < e->nfree; k++) {
             const sp_state *s = &e->st[e->free_ids[k]];
             e->cellc[k][0] = (long long)floor(s->x.x * inv);
             e->cellc[k][1] = (long long)floor(s->x.y * inv);
             e->cellc[k][2] = e->dim == 3 ? (long long)floor(s->x.z * inv) : 0;
-            e->bucket_start[(cell_hash(e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]) & (uint32_t)(nb - 1)) + 1]++;
+            for (int d = 0; d < 3; d++) {
+                lo[d] = e->cellc[k][d] < lo[d] ? e->cellc[k][d] : lo[d];
+                hi[d] = e->cellc[k][d] > hi[d] ? e->cellc[k][d] : hi[d];
+            }
+        }
+        /* a dense grid over the bodies' box when it is small enough (cache-friendly: bodies sorted
+         * by cell, neighbours adjacent in memory), else the hashed grid (any extent) */
+        double ncell = (double)(hi[0] - lo[0] + 1) * (double)(hi[1] - lo[1] + 1) * (double)(hi[2] - lo[2] + 1);
+        e->dense = ncell <= 8.0 * e->nfree + 1024.0;
+        int nb = e->dense ? (int)ncell : e->nhash;
+        for (int d = 0; d < 3; d++) {
+            e->dlo[d] = lo[d];
+            e->dn[d] = hi[d] - lo[d] + 1;
+        }
+        if (nb + 1 > e->bucket_cap) {
+            int cap = e->bucket_cap;
+            if (grow((void **)&e->bucket_start, &cap, nb + 1, sizeof(int))) return -1;
+            e->bucket_cap = cap;
+        }
+        e->nbucket = nb;
+        memset(e->bucket_start, 0, sizeof(int) * (size_t)(nb + 1));
+        for (int k = 0; k < e->nfree; k++) {
+            e->bucket_of[k] = bucket_of_cell(e, e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]);
+            e->bucket_start[e->bucket_of[k] + 1]++;
         }
         for (int i = 0; i < nb; i++) e->bucket_start[i + 1] += e->bucket_start[i];
+        /* counting sort into one cache line per body, so that a bucket is read contiguously */
         for (int k = 0; k < e->nfree; k++) {
-            uint32_t h = cell_hash(e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]) & (uint32_t)(nb - 1);
-            e->bucket_items[e->bucket_start[h]++] = k;
+            int i = e->free_ids[k];
+            sp_bin *bn = &e->bins[e->bucket_start[e->bucket_of[k]]++];
+            memcpy(bn->c, e->cellc[k], sizeof bn->c);
+            bn->x = e->st[i].x;
+            bn->bound = e->geo[i].bound;
+            bn->id = i;
         }
         for (int i = nb; i > 0; i--) e->bucket_start[i] = e->bucket_start[i - 1];
         e->bucket_start[0] = 0;
         /* half shell: the own cell (partners j > i) and the 13 (2D: 4) neighbours that come after
          * it in (z, y, x) order (all partners), so that each pair is met once */
         int zr = e->dim == 3 ? 1 : 0;
-        for (int k = 0; k < e->nfree; k++) {
-            int i = e->free_ids[k];
-            const sp_state *si = &e->st[i];
+        for (int mk = 0; mk < e->nfree; mk++) {
+            const sp_bin bi = e->bins[mk];
             for (int dz = 0; dz <= zr; dz++)
                 for (int dy = dz > 0 ? -1 : 0; dy <= 1; dy++)
                     for (int dx = (dz > 0 || dy > 0) ? -1 : 0; dx <= 1; dx++) {
                         int own = dz == 0 && dy == 0 && dx == 0;
-                        long long cx = e->cellc[k][0] + dx, cy = e->cellc[k][1] + dy, cz = e->cellc[k][2] + dz;
-                        uint32_t h = cell_hash(cx, cy, cz) & (uint32_t)(nb - 1);
+                        long long cx = bi.c[0] + dx, cy = bi.c[1] + dy, cz = bi.c[2] + dz;
+                        int h = bucket_of_cell(e, cx, cy, cz);
+                        if (h < 0) continue;
                         for (int m = e->bucket_start[h]; m < e->bucket_start[h + 1]; m++) {
-                            int l = e->bucket_items[m];
-                            int j = e->free_ids[l];
-                            if ((own && j <= i) || e->cellc[l][0] != cx || e->cellc[l][1] != cy || e->cellc[l][2] != cz)
-                                continue;
-                            double r = e->geo[i].bound + e->geo[j].bound;
-                            if (v3_norm2(v3_sub(e->st[j].x, si->x)) < r * r && add_pair(e, i, j)) return -1;
+                            const sp_bin *bj = &e->bins[m];
+                            if ((own && bj->id <= bi.id) || bj->c[0] != cx || bj->c[1] != cy || bj->c[2] != cz) continue;
+                            double r = bi.bound + bj->bound;
+                            if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
                         }
                     }
         }
@@ -848,7 +895,8 @@ static void sp_destroy(lahar_dem_engine *e)
     free(e->large_ids);
     free(e->cellc);
     free(e->bucket_start);
-    free(e->bucket_items);
+    free(e->bucket_of);
+    free(e->bins);
     free(e->pairs);
     free(e->prev);
     free(e->cur);
@@ -1115,14 +1163,16 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         body_update_world(e, i);
     }
     e->cell *= 1.0 + 1e-9;
-    e->nbucket = 16;
-    while (e->nbucket < 2 * e->nfree) e->nbucket *= 2;
-    e->bucket_start = xcalloc((size_t)e->nbucket + 1, sizeof(int));
-    e->bucket_items = xcalloc((size_t)nb, sizeof(int));
+    e->nhash = 16;
+    while (e->nhash < 2 * e->nfree) e->nhash *= 2;
+    e->bucket_cap = 8 * e->nfree + 1026 > e->nhash + 1 ? 8 * e->nfree + 1026 : e->nhash + 1;
+    e->bucket_start = xcalloc((size_t)e->bucket_cap, sizeof(int));
+    e->bucket_of = xcalloc((size_t)nb, sizeof(int));
+    e->bins = xcalloc((size_t)nb, sizeof(sp_bin));
     e->nthr = omp_get_max_threads();
     if (e->nthr < 1) e->nthr = 1;
     e->thr = xcalloc((size_t)e->nthr, sizeof(sp_thread));
-    if (!e->bucket_start || !e->bucket_items || !e->thr) {
+    if (!e->bucket_start || !e->bucket_of || !e->bins || !e->thr) {
         snprintf(err, errlen, "spheropoly: out of memory");
         goto fail;
     }
