@@ -1,6 +1,6 @@
 /* The "spheropoly" DEM engine: rigid sphero-polyhedra (Galindo-Torres 2009-2013 as used in paper
  * 000 sec. 3) with linear or Hertz normal contacts, a tangential spring with Coulomb limit, a
- * hashed uniform grid broad phase, per-body feature grids for big surfaces, kick-drift-kick
+ * uniform grid broad phase (dense or hashed), per-body feature grids for big surfaces, kick-drift-kick
  * leap-frog for translation and an exactly rotating splitting (NO_SQUISH / Dullweber-Leimkuhler-
  * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
 #include "spheropoly.h"
