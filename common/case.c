@@ -16,6 +16,7 @@
 #include <yaml.h>
 
 #include "geometry.h"
+#include "kernel.h"
 #include "vec.h"
 
 #ifndef M_PI
@@ -837,7 +838,7 @@ static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
 static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cache *mc)
 {
     static const char *const common_keys[] = {"name", "shape", "material", "motion", "position", "orientation",
-                                              "velocity", "angular_velocity", "radius"};
+                                              "velocity", "angular_velocity", "radius", "record_contacts"};
     static const char *const extra[SH_N][3] = {
         [SH_SPHERE] = {NULL},
         [SH_DISC] = {NULL},
@@ -884,6 +885,7 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
         return;
     }
     b->motion = (lahar_motion)rmap_enum(&m, "motion", motion_names, 0, LAHAR_MOTION_FREE);
+    b->record_contacts = rmap_bool(&m, "record_contacts", 0);
     const char *mat = rmap_str(&m, "material", 1, NULL, c->nmaterial ? c->materials[0].name : "rock");
     if (r->failed)
         return;
@@ -1053,11 +1055,369 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
     free(ctr);
 }
 
+/* --- sph: the fluid, its particle blocks and the coupling ------------------------------------ */
+
+/* The solver core does not have these yet (sph_node/sph_fluid.h): a case asking for them is
+ * rejected instead of silently running without them. Flip when the solver grows them. */
+#define LAHAR_SPH_HAVE_SHEPARD 0
+#define LAHAR_SPH_HAVE_SPS 0
+
+/* Edges of a closed surface are shared by exactly two triangles. Returns 0, or the number of
+ * edges that are not (first one in *bad_a, *bad_b), or -1 out of memory. */
+static int edge_pair_cmp(const void *x, const void *y)
+{
+    const int *a = x, *b = y;
+    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+static int mesh_open_edges(const int (*tri)[3], int ntri, int *bad_a, int *bad_b)
+{
+    int ne = 3 * ntri;
+    int (*e)[2] = malloc((size_t)(ne ? ne : 1) * sizeof *e);
+    if (!e)
+        return -1;
+    for (int t = 0; t < ntri; t++)
+        for (int k = 0; k < 3; k++) {
+            int a = tri[t][k], b = tri[t][(k + 1) % 3];
+            e[3 * t + k][0] = a < b ? a : b;
+            e[3 * t + k][1] = a < b ? b : a;
+        }
+    qsort(e, (size_t)ne, sizeof *e, edge_pair_cmp);
+    int bad = 0;
+    for (int i = 0; i < ne;) {
+        int j = i;
+        while (j < ne && e[j][0] == e[i][0] && e[j][1] == e[i][1])
+            j++;
+        if (j - i != 2) {
+            if (!bad) {
+                *bad_a = e[i][0];
+                *bad_b = e[i][1];
+            }
+            bad++;
+        }
+        i = j;
+    }
+    free(e);
+    return bad;
+}
+
+/* Segments p0-p1 and q0-q1 (2D) properly intersect or touch. */
+static int seg2_intersect(const double *p0, const double *p1, const double *q0, const double *q1)
+{
+    double d1 = (q1[0] - q0[0]) * (p0[1] - q0[1]) - (q1[1] - q0[1]) * (p0[0] - q0[0]);
+    double d2 = (q1[0] - q0[0]) * (p1[1] - q0[1]) - (q1[1] - q0[1]) * (p1[0] - q0[0]);
+    double d3 = (p1[0] - p0[0]) * (q0[1] - p0[1]) - (p1[1] - p0[1]) * (q0[0] - p0[0]);
+    double d4 = (p1[0] - p0[0]) * (q1[1] - p0[1]) - (p1[1] - p0[1]) * (q1[0] - p0[0]);
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+        return 1;
+    return 0;
+}
+
+static void read_block_polygon(reader *r, rmap *bm, yaml_node_t *pn, const char *prefix, lahar_particle_block *pb)
+{
+    char key[KEY_MAX];
+    key_join(prefix, "polygon", key);
+    if (r->dim != 2) {
+        rd_fail(r, pn, key, "polygon blocks are 2D; in 3D use box or stl (a closed triangulated surface)");
+        return;
+    }
+    int np = 0;
+    double (*p)[3] = read_points(r, pn, key, 2, &np);
+    if (!p)
+        return;
+    pb->kind = LAHAR_BLOCK_POLYGON;
+    pb->vert = p;
+    pb->nvert = np;
+    if (np < 3) {
+        rd_fail(r, pn, key, "a polygon needs at least 3 vertices (got %d)", np);
+        return;
+    }
+    double area = 0;
+    for (int i = 0, j = np - 1; i < np; j = i++)
+        area += p[j][0] * p[i][1] - p[i][0] * p[j][1];
+    area *= 0.5;
+    for (int i = 0; i < np && !r->failed; i++)
+        for (int j = i + 1; j < np && !r->failed; j++) {
+            int i1 = (i + 1) % np, j1 = (j + 1) % np;
+            if (j == i1 || i == j1)
+                continue; /* neighbouring edges share a vertex */
+            if (seg2_intersect(p[i], p[i1], p[j], p[j1]))
+                rd_fail(r, pn, key, "edges %d-%d and %d-%d cross each other; a polygon block must be simple (list "
+                        "the vertices in order around the region)", i, i1, j, j1);
+        }
+    if (!r->failed && !(fabs(area) > 0))
+        rd_fail(r, pn, key, "the polygon has zero area");
+    (void)bm;
+    lahar_particle_block_bounds(pb, 2);
+}
+
+static void read_block_stl(reader *r, yaml_node_t *sn, const char *prefix, lahar_particle_block *pb)
+{
+    static const char *const keys[] = {"file", "scale", "position", NULL};
+    char key[KEY_MAX];
+    key_join(prefix, "stl", key);
+    if (r->dim != 3) {
+        rd_fail(r, sn, key, "stl blocks are 3D; in 2D use box or polygon");
+        return;
+    }
+    rmap m;
+    if (rmap_open(r, sn, key, &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    const char *file = rmap_str(&m, "file", 1, NULL, "reservoir.stl");
+    double scale = rmap_num(&m, "scale", 0, 1.0, "0.001");
+    double pos[3] = {0, 0, 0};
+    rmap_vec(&m, "position", 3, pos, 0, "");
+    if (r->failed)
+        return;
+    if (!(scale > 0)) {
+        rmap_fail(&m, "scale", "must be > 0 (got %g); it multiplies the STL coordinates, e.g. 0.001 for mm", scale);
+        return;
+    }
+    if (strlen(file) >= sizeof pb->source) {
+        rmap_fail(&m, "file", "path longer than %d characters", (int)sizeof pb->source - 1);
+        return;
+    }
+    snprintf(pb->source, sizeof pb->source, "%s", file);
+    char full[2048], err[512] = "";
+    if (file[0] == '/')
+        snprintf(full, sizeof full, "%s", file);
+    else
+        snprintf(full, sizeof full, "%s%s", r->dir, file);
+    lahar_shape s;
+    if (lahar_shape_read_stl(&s, full, 1.0, err, sizeof err) != 0) {
+        rmap_fail(&m, "file", "%s; STL paths are relative to the case file's directory", err[0] ? err : "out of memory");
+        return;
+    }
+    lahar_shape_transform(&s, NULL, NULL, scale);
+    lahar_shape_transform(&s, NULL, pos, 1.0);
+    pb->kind = LAHAR_BLOCK_MESH;
+    pb->nvert = s.nv;
+    pb->ntri = s.nf;
+    pb->vert = malloc((size_t)s.nv * sizeof *pb->vert);
+    pb->tri = malloc((size_t)(s.nf ? s.nf : 1) * sizeof *pb->tri);
+    if (!pb->vert || !pb->tri) {
+        lahar_shape_free(&s);
+        rmap_fail(&m, "file", "out of memory");
+        return;
+    }
+    memcpy(pb->vert, s.v, (size_t)s.nv * sizeof *pb->vert);
+    for (int f = 0; f < s.nf; f++)
+        for (int k = 0; k < 3; k++)
+            pb->tri[f][k] = s.face_v[s.face_start[f] + k];
+    lahar_shape_free(&s);
+    int ea = 0, eb = 0;
+    int open = mesh_open_edges((const int(*)[3])pb->tri, pb->ntri, &ea, &eb);
+    if (open < 0)
+        rmap_fail(&m, "file", "out of memory");
+    else if (open > 0)
+        rmap_fail(&m, "file", "'%s' is not a closed surface: %d edges are not shared by exactly two triangles "
+                  "(first: between [%g, %g, %g] and [%g, %g, %g]); a fluid region must be watertight", file, open,
+                  pb->vert[ea][0], pb->vert[ea][1], pb->vert[ea][2], pb->vert[eb][0], pb->vert[eb][1], pb->vert[eb][2]);
+    lahar_particle_block_bounds(pb, 3);
+}
+
+static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
+{
+    static const char *const bkeys[] = {"name", "box", "polygon", "stl", "velocity", NULL};
+    static const char *const boxkeys[] = {"lo", "hi", NULL};
+    const int dim = r->dim;
+    lahar_particle_block *pb = &c->blocks[i];
+    char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+    snprintf(prefix, sizeof prefix, "sph.blocks[%d]", i);
+    snprintf(def, sizeof def, "block%d", i);
+    rmap bm, xm;
+    if (rmap_open(r, n, prefix, &bm) != 0)
+        return;
+    rmap_check_keys(&bm, bkeys);
+    rmap_name(&bm, "name", 0, def, pb->name);
+    for (int j = 0; j < i && !r->failed; j++)
+        if (strcmp(c->blocks[j].name, pb->name) == 0)
+            rmap_fail(&bm, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
+    rmap_vec(&bm, "velocity", dim, pb->v, 0, "");
+    yaml_node_t *bx = rmap_get(&bm, "box"), *pg = rmap_get(&bm, "polygon"), *st = rmap_get(&bm, "stl");
+    if (r->failed)
+        return;
+    if (!!bx + !!pg + !!st != 1) {
+        if (!bx && !pg && !st)
+            rmap_missing(&bm, "box", dim == 3 ? "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}  (or polygon: / stl:)"
+                                              : "{lo: [0, 0], hi: [0.1, 0.1]}  (or polygon: [[x, y], ...])");
+        else
+            rd_fail(r, n, prefix, "give exactly one of box, polygon (2D) or stl (3D) per block");
+        return;
+    }
+    if (pg) {
+        read_block_polygon(r, &bm, pg, prefix, pb);
+        return;
+    }
+    if (st) {
+        read_block_stl(r, st, prefix, pb);
+        return;
+    }
+    char bp[KEY_MAX];
+    key_join(prefix, "box", bp);
+    if (rmap_open(r, bx, bp, &xm) != 0)
+        return;
+    rmap_check_keys(&xm, boxkeys);
+    pb->kind = LAHAR_BLOCK_BOX;
+    rmap_vec(&xm, "lo", dim, pb->lo, 1, dim == 3 ? "[0, 0, 0]" : "[0, 0]");
+    rmap_vec(&xm, "hi", dim, pb->hi, 1, dim == 3 ? "[0.1, 0.1, 0.1]" : "[0.1, 0.1]");
+    for (int k = 0; k < dim && !r->failed; k++)
+        if (!(pb->hi[k] > pb->lo[k]))
+            rmap_fail(&xm, "hi", "must be > lo in every component (component %d: %g <= %g)", k, pb->hi[k], pb->lo[k]);
+}
+
+/* periodic: {x: [lo, hi], ...} */
+static void read_periodic(reader *r, yaml_node_t *n, lahar_sph_options *o)
+{
+    static const char *const keys3[] = {"x", "y", "z", NULL};
+    static const char *const keys2[] = {"x", "y", NULL};
+    rmap m;
+    if (rmap_open(r, n, "sph.periodic", &m) != 0)
+        return;
+    rmap_check_keys(&m, r->dim == 3 ? keys3 : keys2);
+    for (int a = 0; a < r->dim && !r->failed; a++) {
+        double iv[2];
+        if (!rmap_vec(&m, keys3[a], 2, iv, 0, ""))
+            continue;
+        if (!(iv[1] > iv[0])) {
+            rmap_fail(&m, keys3[a], "the period [lo, hi] must have hi > lo (got [%g, %g])", iv[0], iv[1]);
+            return;
+        }
+        o->periodic[a] = 1;
+        o->lo[a] = iv[0];
+        o->hi[a] = iv[1];
+    }
+}
+
+/* Characteristic speed for the default c0: the free-fall speed over the fluid's height under
+ * gravity + body force, or the fastest initial velocity. */
+static double sph_reference_speed(const lahar_case *c)
+{
+    double g = 0, vmax = 0, lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < 3; k++)
+        g += (c->gravity[k] + c->sph.body_force[k]) * (c->gravity[k] + c->sph.body_force[k]);
+    g = sqrt(g);
+    for (int i = 0; i < c->nblock; i++) {
+        const lahar_particle_block *b = &c->blocks[i];
+        vmax = fmax(vmax, sqrt(b->v[0] * b->v[0] + b->v[1] * b->v[1] + b->v[2] * b->v[2]));
+        /* height: extent along the vertical axis (y in 2D, z in 3D) */
+        lo = fmin(lo, b->lo[c->dim - 1]);
+        hi = fmax(hi, b->hi[c->dim - 1]);
+    }
+    double H = hi > lo ? hi - lo : 0.0;
+    return fmax(sqrt(2.0 * g * H), vmax);
+}
+
+/* Even-odd test of x against the closed 2D ring of a body's core vertices (in ring order). */
+static int point_in_ring2d(const lahar_body *bd, vec3 x)
+{
+    int inside = 0, nv = bd->shape.nv;
+    for (int i = 0, j = nv - 1; i < nv; j = i++) {
+        vec3 a = geom_world_vertex(&bd->shape, bd->x, bd->q, i), c = geom_world_vertex(&bd->shape, bd->x, bd->q, j);
+        if ((a.y > x.y) != (c.y > x.y) && x.x < a.x + (x.y - a.y) * (c.x - a.x) / (c.y - a.y))
+            inside = !inside;
+    }
+    return inside;
+}
+
+/* Lattice points of the blocks inside bodies (the swept solid) at t = 0 would start as crossed
+ * particles; points of two blocks at the same place would double the mass. */
+static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
+{
+    const int dim = c->dim;
+    const double dx = c->sph_dx;
+    for (int i = 0; i < c->nblock && !r->failed; i++) {
+        const lahar_particle_block *b = &c->blocks[i];
+        char key[KEY_MAX];
+        snprintf(key, sizeof key, "sph.blocks[%d]", i);
+        yaml_node_t *bn = seq_item(r, bl, i);
+        int64_t np = lahar_particle_block_lattice(b, dim, dx, NULL, 0);
+        if (np == 0) {
+            rd_fail(r, bn, key, "'%s' holds no particle at dx = %g (its region is smaller than one lattice cell or "
+                    "misses every lattice point lo + (i + 1/2) dx); enlarge it or lower sph.dx", b->name, dx);
+            return;
+        }
+        for (int a = 0; a < dim; a++)
+            if (c->sph.periodic[a] && (b->lo[a] < c->sph.lo[a] - 1e-9 * dx || b->hi[a] > c->sph.hi[a] + 1e-9 * dx)) {
+                rd_fail(r, bn, key, "'%s' reaches outside the period [%g, %g] of axis %c (block [%g, %g]); keep "
+                        "blocks inside sph.periodic", b->name, c->sph.lo[a], c->sph.hi[a], "xyz"[a], b->lo[a], b->hi[a]);
+                return;
+            }
+        for (int j = 0; j < i; j++) {
+            const lahar_particle_block *o = &c->blocks[j];
+            if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX)
+                continue;
+            int overlap = 1;
+            for (int a = 0; a < dim; a++)
+                overlap = overlap && b->lo[a] < o->hi[a] - 1e-9 * dx && o->lo[a] < b->hi[a] - 1e-9 * dx;
+            if (overlap) {
+                rd_fail(r, bn, key, "'%s' overlaps block '%s' (sph.blocks[%d]); particles would be created twice "
+                        "there: make the boxes meet without overlapping", b->name, o->name, j);
+                return;
+            }
+        }
+        if (c->nbody == 0)
+            continue;
+        double (*pts)[3] = malloc((size_t)np * sizeof *pts);
+        if (!pts) {
+            rd_fail(r, bn, key, "out of memory");
+            return;
+        }
+        lahar_particle_block_lattice(b, dim, dx, pts, np);
+        for (int k = 0; k < c->nbody && !r->failed; k++) {
+            const lahar_body *bd = &c->bodies[k];
+            /* bounding sphere of the body about its position */
+            double reach = 0;
+            for (int v = 0; v < bd->shape.nv; v++)
+                reach = fmax(reach, v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
+            reach += bd->shape.radius;
+            int64_t inside = 0, first = -1;
+            for (int64_t p = 0; p < np; p++) {
+                vec3 x = v3_load(pts[p]);
+                if (v3_norm(v3_sub(x, v3_load(bd->x))) > reach)
+                    continue;
+                vec3 cp;
+                int feat;
+                double d = geom_point_body_core(&bd->shape, bd->x, bd->q, x, &cp, &feat);
+                /* closed convex cores: a point inside the core has distance 0 to no feature, so
+                 * test the point against the solid with the core faces too */
+                int in = d < bd->shape.radius * (1.0 - 1e-9);
+                if (!in && dim == 2 && bd->shape.nv >= 3 && bd->shape.ne == bd->shape.nv)
+                    in = point_in_ring2d(bd, x);
+                if (!in && dim == 3 && bd->convex && bd->shape.nf > 0) {
+                    in = 1;
+                    for (int f = 0; f < bd->shape.nf && in; f++) {
+                        vec3 nf = q_rotate(q_load(bd->q), geom_face_normal(&bd->shape, f));
+                        vec3 p0 = geom_world_vertex(&bd->shape, bd->x, bd->q, bd->shape.face_v[bd->shape.face_start[f]]);
+                        in = v3_dot(v3_sub(x, p0), nf) < 0;
+                    }
+                }
+                if (in) {
+                    if (first < 0)
+                        first = p;
+                    inside++;
+                }
+            }
+            if (inside > 0)
+                rd_fail(r, bn, key, "%lld particles of '%s' would start inside body '%s' (first at [%g, %g, %g]); "
+                        "particles must start outside bodies: shrink the block or shape it with polygon:/stl:",
+                        (long long)inside, b->name, bd->name, pts[first][0], pts[first][1], pts[first][2]);
+        }
+        free(pts);
+    }
+}
+
 static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const keys[] = {"dx", "density", "blocks", NULL};
-    static const char *const bkeys[] = {"name", "box", "velocity", NULL};
-    static const char *const boxkeys[] = {"lo", "hi", NULL};
+    static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
+                                       "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
+                                       "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
+                                       "blocks", NULL};
+    static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
+    static const char *const eos_names[] = {"linear", "tait", NULL};
+    static const char *const wall_names[] = {"halfspace", "paper", NULL};
+    lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
         return;
@@ -1078,6 +1438,90 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_fail(&m, "density", "must be > 0 kg/m^3 (got %g)", c->sph_density);
         return;
     }
+    const double dx = c->sph_dx;
+    int kind = rmap_enum(&m, "kernel", kernels, 0, 0);
+    snprintf(o->kernel, sizeof o->kernel, "%s", kernels[kind]);
+    const kernel_def *kd = kernel_find(o->kernel);
+    o->h_over_dx = rmap_num(&m, "h_over_dx", 0, 1.3, "1.3");
+    o->eos = (lahar_sph_eos)rmap_enum(&m, "eos", eos_names, 0, LAHAR_SPH_EOS_LINEAR);
+    o->gamma = rmap_num(&m, "gamma", 0, 7.0, "7");
+    o->mu = rmap_num(&m, "viscosity", 0, 1e-3, "1e-3");
+    o->alpha = rmap_num(&m, "alpha", 0, 0.0, "0.02");
+    o->delta = rmap_num(&m, "delta", 0, 0.1, "0.1");
+    o->cfl = rmap_num(&m, "cfl", 0, 0.25, "0.25");
+    o->cfl_force = rmap_num(&m, "cfl_force", 0, 0.25, "0.25");
+    o->cfl_visc = rmap_num(&m, "cfl_visc", 0, 0.125, "0.125");
+    rmap_vec(&m, "body_force", dim, o->body_force, 0, "");
+    double shep = rmap_num(&m, "shepard_interval", 0, 0.0, "30");
+    o->sps = rmap_bool(&m, "sps", 0);
+    o->sps_cs = rmap_num(&m, "sps_cs", 0, 0.12, "0.12");
+    o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
+    o->kappa = rmap_num(&m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
+    o->wall_viscous = (lahar_sph_wall_viscous)rmap_enum(&m, "wall_viscous", wall_names, 0, LAHAR_SPH_WALL_HALFSPACE);
+    yaml_node_t *pn = rmap_get(&m, "periodic");
+    if (pn)
+        read_periodic(r, pn, o);
+    if (r->failed)
+        return;
+    const double h = o->h_over_dx * dx;
+    if (!kd)
+        rmap_fail(&m, "kernel", "the kernel table (common/kernel.h) has no '%s'", o->kernel);
+    else if (!(o->h_over_dx >= 0.5 && o->h_over_dx <= 4.0))
+        rmap_fail(&m, "h_over_dx", "must be in [0.5, 4] (got %g); h = h_over_dx dx, 1.0-1.5 is usual", o->h_over_dx);
+    else if (!(o->gamma >= 1))
+        rmap_fail(&m, "gamma", "must be >= 1 (got %g); 7 for water", o->gamma);
+    else if (rmap_get(&m, "gamma") && o->eos != LAHAR_SPH_EOS_TAIT)
+        rmap_fail(&m, "gamma", "is the exponent of eos: tait, but the case uses eos: linear; remove gamma or set "
+                  "eos: tait");
+    else if (!(o->mu >= 0))
+        rmap_fail(&m, "viscosity", "must be >= 0 Pa s (got %g); water is 1e-3", o->mu);
+    else if (!(o->alpha >= 0 && o->alpha <= 1))
+        rmap_fail(&m, "alpha", "must be in [0, 1] (got %g); 0.01-0.1 is usual, 0 = off", o->alpha);
+    else if (!(o->delta >= 0 && o->delta <= 1))
+        rmap_fail(&m, "delta", "must be in [0, 1] (got %g); 0.1 is usual, 0 = off", o->delta);
+    else if (!(o->cfl > 0 && o->cfl <= 1))
+        rmap_fail(&m, "cfl", "must be in (0, 1] (got %g)", o->cfl);
+    else if (!(o->cfl_force > 0 && o->cfl_force <= 1))
+        rmap_fail(&m, "cfl_force", "must be in (0, 1] (got %g)", o->cfl_force);
+    else if (!(o->cfl_visc > 0 && o->cfl_visc <= 1))
+        rmap_fail(&m, "cfl_visc", "must be in (0, 1] (got %g)", o->cfl_visc);
+    else if (!(shep >= 0 && shep == floor(shep) && shep <= 1e6))
+        rmap_fail(&m, "shepard_interval", "must be a whole number of steps >= 0 (got %g); 0 = off", shep);
+    else if (shep > 0 && !LAHAR_SPH_HAVE_SHEPARD)
+        rmap_fail(&m, "shepard_interval", "the Shepard filter is not implemented yet; remove the key or set 0");
+    else if (o->sps && !LAHAR_SPH_HAVE_SPS)
+        rmap_fail(&m, "sps", "SPS turbulence is not implemented yet; remove the key or set false");
+    else if (!(o->sps_cs > 0 && o->sps_cs < 1))
+        rmap_fail(&m, "sps_cs", "must be in (0, 1) (got %g); 0.12 is usual", o->sps_cs);
+    else if (rmap_get(&m, "sps_cs") && !o->sps)
+        rmap_fail(&m, "sps_cs", "is the Smagorinsky constant of sps: true, but sps is off; remove it or set sps: true");
+    else if (!(o->kappa > 0 && o->kappa <= 4))
+        rmap_fail(&m, "kappa", "must be in (0, 4] (got %g); the coupling acts within kappa h of a body, the kernel's "
+                  "support radius (%g for %s) by default", o->kappa, kd->kappa, o->kernel);
+    else if (!(o->halo > 0 && o->halo < o->kappa * h))
+        rmap_fail(&m, "halo", "must be in (0, kappa h = %g) m (got %g); dx/2 = %g is usual", o->kappa * h, o->halo,
+                  0.5 * dx);
+    if (r->failed)
+        return;
+    o->shepard_interval = (int)shep;
+    for (int a = 0; a < dim && !r->failed; a++) {
+        if (!o->periodic[a])
+            continue;
+        double L = o->hi[a] - o->lo[a], cells = L / dx;
+        char ax[2] = {"xyz"[a], 0};
+        char pk[KEY_MAX];
+        snprintf(pk, sizeof pk, "sph.periodic.%s", ax);
+        /* the cell lists need 3 cells of the kernel support per period (sph_particles.h) */
+        if (L < 3.0 * kd->kappa * h)
+            rd_fail(r, pn, pk, "the period %g m is shorter than 3 kernel supports (3 x %g m); enlarge it or lower dx",
+                    L, kd->kappa * h);
+        else if (fabs(cells - floor(cells + 0.5)) > 1e-6 * cells)
+            rd_fail(r, pn, pk, "the period %g m is not a whole number of particle spacings (%.6g dx): particles "
+                    "would bunch or gap at the seam; make it a multiple of dx = %g", L, cells, dx);
+    }
+    if (r->failed)
+        return;
+
     yaml_node_t *bl = rmap_get(&m, "blocks");
     if (!bl) {
         rmap_missing(&m, "blocks", "[{name: water, box: {lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}}]");
@@ -1094,33 +1538,39 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     }
     for (int i = 0; i < nb && !r->failed; i++) {
-        lahar_particle_block *pb = &c->blocks[i];
         c->nblock = i + 1;
-        char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
-        snprintf(prefix, sizeof prefix, "sph.blocks[%d]", i);
-        snprintf(def, sizeof def, "block%d", i);
-        rmap bm, xm;
-        if (rmap_open(r, seq_item(r, bl, i), prefix, &bm) != 0)
-            return;
-        rmap_check_keys(&bm, bkeys);
-        rmap_name(&bm, "name", 0, def, pb->name);
-        rmap_vec(&bm, "velocity", dim, pb->v, 0, "");
-        yaml_node_t *bx = rmap_get(&bm, "box");
-        if (!bx) {
-            rmap_missing(&bm, "box", "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}");
-            return;
-        }
-        char bp[KEY_MAX];
-        key_join(prefix, "box", bp);
-        if (rmap_open(r, bx, bp, &xm) != 0)
-            return;
-        rmap_check_keys(&xm, boxkeys);
-        rmap_vec(&xm, "lo", dim, pb->lo, 1, dim == 3 ? "[0, 0, 0]" : "[0, 0]");
-        rmap_vec(&xm, "hi", dim, pb->hi, 1, dim == 3 ? "[0.1, 0.1, 0.1]" : "[0.1, 0.1]");
-        for (int k = 0; k < dim && !r->failed; k++)
-            if (!(pb->hi[k] > pb->lo[k]))
-                rmap_fail(&xm, "hi", "must be > lo in every component (component %d: %g <= %g)", k, pb->hi[k], pb->lo[k]);
+        read_block(r, seq_item(r, bl, i), i, c);
     }
+    if (r->failed)
+        return;
+
+    double uref = sph_reference_speed(c);
+    o->c0 = rmap_num(&m, "c0", 0, 10.0 * uref, "20");
+    if (r->failed)
+        return;
+    if (!rmap_get(&m, "c0") && !(uref > 0)) {
+        rmap_missing(&m, "c0", "1.0  (the fluid starts at rest without gravity or body force, so the default "
+                     "c0 = 10 x the fall speed over the fluid's height is 0: give the numerical speed of sound, "
+                     "about 10 x the largest expected speed)");
+        return;
+    }
+    if (!(o->c0 > 0)) {
+        rmap_fail(&m, "c0", "must be > 0 m/s (got %g); about 10 x the largest expected flow speed", o->c0);
+        return;
+    }
+    /* the smallest step this fluid will ask for must stay above time.dt_min */
+    double dt_c = o->cfl * h / o->c0, nu = o->mu / c->sph_density;
+    double dt_v = nu > 0 ? o->cfl_visc * h * h / nu : INFINITY;
+    if (fmin(dt_c, dt_v) < c->dt_min) {
+        if (dt_c <= dt_v)
+            rmap_fail(&m, "c0", "the acoustic step cfl h / c0 = %g s is below time.dt_min = %g s; lower c0 or dt_min",
+                      dt_c, c->dt_min);
+        else
+            rmap_fail(&m, "viscosity", "the viscous step cfl_visc h^2 / nu = %g s is below time.dt_min = %g s; "
+                      "lower the viscosity or dt_min, or raise dx", dt_v, c->dt_min);
+        return;
+    }
+    check_blocks_placement(r, bl, c);
 }
 
 static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
@@ -1336,6 +1786,9 @@ void lahar_case_free(lahar_case *c)
             lahar_shape_free(&c->bodies[i].shape);
     free(c->bodies);
     free(c->materials);
+    if (c->blocks)
+        for (int i = 0; i < c->nblock; i++)
+            lahar_particle_block_free(&c->blocks[i]);
     free(c->blocks);
     memset(c, 0, sizeof *c);
 }

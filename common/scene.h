@@ -52,14 +52,60 @@ typedef struct {
     double q[4];          /* orientation (w, x, y, z): body frame -> world */
     double v[3];          /* linear velocity (prescribed bodies keep it) */
     double w[3];          /* angular velocity, world frame (prescribed bodies keep it) */
+    int record_contacts;  /* 1: write every fluid contact point and its force for this body
+                             (pressure along a wall); case key record_contacts, default 0 */
 } lahar_body;
 
-/* A block of SPH particles created on a lattice of spacing dx (SPH issue extends this). */
+/* A region of SPH particles created on a lattice of spacing dx (sph.dx). The lattice of a block
+ * has its points at lo + (i + 1/2) dx, i = 0 .. floor((hi - lo)/dx) - 1 per axis (z = 0, one
+ * layer in 2D); a point becomes a particle when it lies inside the region
+ * (lahar_particle_block_contains, common/shape_build.h). For a box the region is [lo, hi); for a
+ * polygon or a closed mesh lo/hi are its bounding box (the loader computes them). */
+typedef enum {
+    LAHAR_BLOCK_BOX = 0,     /* axis-aligned box [lo, hi), 2D or 3D */
+    LAHAR_BLOCK_POLYGON = 1, /* 2D simple polygon vert[0..nvert), either orientation, may be non-convex */
+    LAHAR_BLOCK_MESH = 2,    /* 3D closed triangulated surface (from an STL file): vert + tri */
+} lahar_block_kind;
+
 typedef struct {
     char name[LAHAR_NAME_MAX];
-    double lo[3], hi[3];  /* axis-aligned box filled with particles */
+    lahar_block_kind kind;
+    double lo[3], hi[3];  /* box, or the bounding box of the polygon / mesh */
     double v[3];          /* initial velocity */
+    int nvert;            /* polygon / mesh vertices, world frame (z = 0 in 2D) */
+    double (*vert)[3];
+    int ntri;             /* mesh triangles (vertex indices, outward orientation not required) */
+    int (*tri)[3];
+    char source[256];     /* mesh: the STL file as written in the case, for messages */
 } lahar_particle_block;
+
+/* Weakly compressible SPH and the SPH-DEM coupling (section sph: of a case; every key is
+ * documented in cases/dam_break_2d.yaml). Together with lahar_case.sph_dx (particle spacing) and
+ * lahar_case.sph_density (rest density) this is everything the SPH node needs (sph_params of
+ * sph_node/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
+typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
+typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
+
+typedef struct {
+    char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
+    double h_over_dx;      /* smoothing length h = h_over_dx dx (default 1.3) */
+    double c0;             /* m/s, numerical speed of sound (default 10 U_ref, see the example) */
+    lahar_sph_eos eos;     /* default linear (paper 000 eq. 3); tait: paper 003 eq. 19 */
+    double gamma;          /* Tait exponent (default 7) */
+    double mu;             /* Pa s, dynamic viscosity (default 1e-3, water) */
+    double alpha;          /* Monaghan artificial viscosity (default 0 = off) */
+    double delta;          /* delta-SPH coefficient (default 0.1; 0 = off) */
+    double cfl, cfl_force, cfl_visc; /* step factors (defaults 0.25, 0.25, 0.125) */
+    double body_force[3];  /* m/s^2 acting on the fluid only, added to gravity (default 0) */
+    int periodic[3];       /* 1: axis periodic with period [lo[a], hi[a]) */
+    double lo[3], hi[3];   /* the periods (only meaningful on periodic axes) */
+    int shepard_interval;  /* steps between Shepard density filters, 0 = off (default) */
+    int sps;               /* 1: Smagorinsky SPS turbulence (003); default 0 */
+    double sps_cs;         /* Smagorinsky constant (default 0.12) */
+    double halo;           /* m, coupling halo eps (paper 000 eq. 14; default dx/2) */
+    double kappa;          /* coupling range in units of h (default: the kernel's support radius) */
+    lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/sph_coupling.h) */
+} lahar_sph_options;
 
 typedef struct {
     int enabled;           /* 1 if the case has a check: section */
@@ -86,9 +132,10 @@ typedef struct {
     int nbody;
     lahar_body *bodies;
 
-    /* SPH (issue 3 grows this) */
+    /* SPH */
     double sph_dx;         /* particle spacing, m */
     double sph_density;    /* rest density, kg/m^3 */
+    lahar_sph_options sph; /* everything else about the fluid and the coupling */
     int nblock;
     lahar_particle_block *blocks;
 

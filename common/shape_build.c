@@ -1176,3 +1176,136 @@ void lahar_shape_to_principal(lahar_shape *s, const lahar_mass_props *mp)
             s->v[i][k] = mp->axes[0][k] * d[0] + mp->axes[1][k] * d[1] + mp->axes[2][k] * d[2];
     }
 }
+
+/* ---- SPH particle regions ------------------------------------------------------------------ */
+
+/* Even-odd rule (crossings of the ray +x from p with the polygon's edges; Franklin's half-open
+ * vertex rule so a ray through a vertex counts once). */
+static int block_polygon_contains(const lahar_particle_block *b, const double x[3])
+{
+    int inside = 0;
+    for (int i = 0, j = b->nvert - 1; i < b->nvert; j = i++) {
+        const double *a = b->vert[i], *c = b->vert[j];
+        if ((a[1] > x[1]) != (c[1] > x[1])) {
+            double xc = a[0] + (x[1] - a[1]) * (c[0] - a[0]) / (c[1] - a[1]);
+            if (x[0] < xc)
+                inside = !inside;
+        }
+    }
+    return inside;
+}
+
+/* Parity of the crossings of the ray x + t d (t > 0) with the triangles (Moller-Trumbore). The
+ * direction is skew to every axis and to the diagonals so that rays from lattice points miss
+ * the edges and vertices of meshes built on round coordinates. */
+static int block_mesh_contains(const lahar_particle_block *b, const double x[3])
+{
+    const vec3 d = v3_normalize(v3(1.0, 0.3183098861837907, 0.2078795763507619));
+    const vec3 o = v3_load(x);
+    int crossings = 0;
+    for (int t = 0; t < b->ntri; t++) {
+        vec3 p0 = v3_load(b->vert[b->tri[t][0]]), p1 = v3_load(b->vert[b->tri[t][1]]), p2 = v3_load(b->vert[b->tri[t][2]]);
+        vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+        vec3 pv = v3_cross(d, e2);
+        double det = v3_dot(e1, pv);
+        if (det == 0.0)
+            continue; /* ray parallel to the triangle's plane */
+        double inv = 1.0 / det;
+        vec3 tv = v3_sub(o, p0);
+        double u = v3_dot(tv, pv) * inv;
+        if (u < 0.0 || u > 1.0)
+            continue;
+        vec3 qv = v3_cross(tv, e1);
+        double v = v3_dot(d, qv) * inv;
+        if (v < 0.0 || u + v > 1.0)
+            continue;
+        if (v3_dot(e2, qv) * inv > 0.0)
+            crossings++;
+    }
+    return crossings & 1;
+}
+
+int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const double x[3])
+{
+    for (int a = 0; a < dim; a++)
+        if (!(x[a] >= b->lo[a] && x[a] < b->hi[a]))
+            return 0;
+    switch (b->kind) {
+    case LAHAR_BLOCK_BOX: return 1;
+    case LAHAR_BLOCK_POLYGON: return b->nvert >= 3 && block_polygon_contains(b, x);
+    case LAHAR_BLOCK_MESH: return dim == 3 && b->ntri > 0 && block_mesh_contains(b, x);
+    default: return 0;
+    }
+}
+
+int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap)
+{
+    int64_t n[3];
+    for (int a = 0; a < 3; a++) {
+        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
+        if (n[a] < 0)
+            n[a] = 0;
+    }
+    int64_t count = 0;
+    for (int64_t i = 0; i < n[0]; i++)
+        for (int64_t j = 0; j < n[1]; j++)
+            for (int64_t k = 0; k < n[2]; k++) {
+                double x[3] = {b->lo[0] + ((double)i + 0.5) * dx, b->lo[1] + ((double)j + 0.5) * dx,
+                               dim == 2 ? 0.0 : b->lo[2] + ((double)k + 0.5) * dx};
+                /* the lattice point of a box is inside by construction (the +1e-9 above may put
+                 * the last one a hair past hi) */
+                if (b->kind != LAHAR_BLOCK_BOX && !lahar_particle_block_contains(b, dim, x))
+                    continue;
+                if (out && count < cap)
+                    memcpy(out[count], x, sizeof x);
+                count++;
+            }
+    return count;
+}
+
+void lahar_particle_block_bounds(lahar_particle_block *b, int dim)
+{
+    for (int a = 0; a < 3; a++) {
+        b->lo[a] = b->nvert > 0 ? INFINITY : 0.0;
+        b->hi[a] = b->nvert > 0 ? -INFINITY : 0.0;
+    }
+    for (int i = 0; i < b->nvert; i++)
+        for (int a = 0; a < 3; a++) {
+            b->lo[a] = fmin(b->lo[a], b->vert[i][a]);
+            b->hi[a] = fmax(b->hi[a], b->vert[i][a]);
+        }
+    if (dim == 2)
+        b->lo[2] = b->hi[2] = 0.0;
+}
+
+int lahar_particle_block_copy(lahar_particle_block *dst, const lahar_particle_block *src)
+{
+    *dst = *src;
+    dst->vert = NULL;
+    dst->tri = NULL;
+    if (src->nvert > 0) {
+        dst->vert = malloc((size_t)src->nvert * sizeof *dst->vert);
+        if (!dst->vert)
+            goto fail;
+        memcpy(dst->vert, src->vert, (size_t)src->nvert * sizeof *dst->vert);
+    }
+    if (src->ntri > 0) {
+        dst->tri = malloc((size_t)src->ntri * sizeof *dst->tri);
+        if (!dst->tri)
+            goto fail;
+        memcpy(dst->tri, src->tri, (size_t)src->ntri * sizeof *dst->tri);
+    }
+    return 0;
+fail:
+    lahar_particle_block_free(dst);
+    return -1;
+}
+
+void lahar_particle_block_free(lahar_particle_block *b)
+{
+    free(b->vert);
+    free(b->tri);
+    b->vert = NULL;
+    b->tri = NULL;
+    b->nvert = b->ntri = 0;
+}

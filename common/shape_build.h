@@ -85,4 +85,29 @@ void lahar_shape_to_principal(lahar_shape *s, const lahar_mass_props *mp);
  * V = identity, so symmetric shapes keep the axes the user wrote. Deterministic. */
 void lahar_sym3_eigen(const double a[3][3], double d[3], double V[3][3]);
 
+/* ---- SPH particle regions (lahar_particle_block, scene.h) ------------------------------------
+ * The SPH node fills a block with the lattice points that lie inside it; the loader uses the same
+ * functions to check a case (particles inside bodies, empty blocks) before a run. */
+#include <stdint.h>
+
+/* 1 if x lies inside block b: box [lo, hi); polygon (2D): even-odd rule against the polygon's
+ * edges (simple polygons, either orientation, convex or not); mesh (3D, closed surface):
+ * parity of the crossings of a ray from x in a fixed skew direction (no lattice point lies on
+ * a face for an axis-aligned grid of faces). Points outside [lo, hi] are outside. */
+int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const double x[3]);
+
+/* The lattice points of block b at spacing dx (lo + (i + 1/2) dx, floor((hi - lo)/dx + 1e-9)
+ * per axis, z = 0 in 2D; the order of sph_particles_add_box: x outermost, z innermost) that lie
+ * inside it. Writes the first `cap` of them to out (out may be NULL to count) and returns how
+ * many lie inside (which may exceed cap). */
+int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap);
+
+/* lo/hi of a polygon or mesh block from its vertices (z = 0 .. 0 in 2D). */
+void lahar_particle_block_bounds(lahar_particle_block *b, int dim);
+
+/* Deep copy (dst is overwritten) and release of the arrays a block owns (vert, tri). Copy
+ * returns 0 or -1 (out of memory; dst left without arrays). */
+int lahar_particle_block_copy(lahar_particle_block *dst, const lahar_particle_block *src);
+void lahar_particle_block_free(lahar_particle_block *b);
+
 #endif
