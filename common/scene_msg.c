@@ -5,6 +5,64 @@
 #include <string.h>
 #include "case.h"
 
+static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
+{
+    snprintf(dst, LAHAR_NAME_MAX, "%s", src ? src : "");
+}
+
+/* The kernel string points into o (keep o alive while m is used). */
+static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
+{
+    m->kernel = (char *)o->kernel;
+    m->h_over_dx = o->h_over_dx;
+    m->c0 = o->c0;
+    m->eos = (int8_t)o->eos;
+    m->gamma = o->gamma;
+    m->mu = o->mu;
+    m->alpha = o->alpha;
+    m->delta = o->delta;
+    m->cfl = o->cfl;
+    m->cfl_force = o->cfl_force;
+    m->cfl_visc = o->cfl_visc;
+    memcpy(m->body_force, o->body_force, sizeof m->body_force);
+    for (int a = 0; a < 3; a++)
+        m->periodic[a] = (int8_t)(o->periodic[a] != 0);
+    memcpy(m->lo, o->lo, sizeof m->lo);
+    memcpy(m->hi, o->hi, sizeof m->hi);
+    m->shepard_interval = o->shepard_interval;
+    m->sps = (int8_t)(o->sps != 0);
+    m->sps_cs = o->sps_cs;
+    m->halo = o->halo;
+    m->kappa = o->kappa;
+    m->wall_viscous = (int8_t)o->wall_viscous;
+}
+
+static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *o)
+{
+    scene_copy_name(o->kernel, m->kernel);
+    o->h_over_dx = m->h_over_dx;
+    o->c0 = m->c0;
+    o->eos = (lahar_sph_eos)m->eos;
+    o->gamma = m->gamma;
+    o->mu = m->mu;
+    o->alpha = m->alpha;
+    o->delta = m->delta;
+    o->cfl = m->cfl;
+    o->cfl_force = m->cfl_force;
+    o->cfl_visc = m->cfl_visc;
+    memcpy(o->body_force, m->body_force, sizeof o->body_force);
+    for (int a = 0; a < 3; a++)
+        o->periodic[a] = m->periodic[a] != 0;
+    memcpy(o->lo, m->lo, sizeof o->lo);
+    memcpy(o->hi, m->hi, sizeof o->hi);
+    o->shepard_interval = m->shepard_interval;
+    o->sps = m->sps != 0;
+    o->sps_cs = m->sps_cs;
+    o->halo = m->halo;
+    o->kappa = m->kappa;
+    o->wall_viscous = (lahar_sph_wall_viscous)m->wall_viscous;
+}
+
 int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
                               int64_t run_id, lahar_scene_t *m)
 {
@@ -28,18 +86,16 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->dem_dt_safety = c->dem_dt_safety;
     m->sph_dx = c->sph_dx;
     m->sph_density = c->sph_density;
+    scene_sph_to_msg(&c->sph, &m->sph);
 
     m->nmaterial = c->nmaterial;
     m->materials = calloc((size_t)(c->nmaterial > 0 ? c->nmaterial : 1), sizeof *m->materials);
     m->nbody = c->nbody;
     m->bodies = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *m->bodies);
+    m->body_record_contacts = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *m->body_record_contacts);
     m->nblock = c->nblock;
-    size_t nbl = (size_t)(c->nblock > 0 ? c->nblock : 1);
-    m->block_lo = calloc(nbl, sizeof *m->block_lo);
-    m->block_hi = calloc(nbl, sizeof *m->block_hi);
-    m->block_v = calloc(nbl, sizeof *m->block_v);
-    m->block_name = calloc(nbl, sizeof *m->block_name);
-    if (!m->materials || !m->bodies || !m->block_lo || !m->block_hi || !m->block_v || !m->block_name)
+    m->blocks = calloc((size_t)(c->nblock > 0 ? c->nblock : 1), sizeof *m->blocks);
+    if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks)
         goto fail;
     for (int i = 0; i < c->nmaterial; i++) {
         const lahar_material *a = &c->materials[i];
@@ -89,12 +145,27 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         memcpy(b->q, a->q, sizeof b->q);
         memcpy(b->vel, a->v, sizeof b->vel);
         memcpy(b->w, a->w, sizeof b->w);
+        m->body_record_contacts[i] = (int8_t)(a->record_contacts != 0);
     }
     for (int i = 0; i < c->nblock; i++) {
-        m->block_name[i] = (char *)c->blocks[i].name;
-        m->block_lo[i] = (double *)c->blocks[i].lo;
-        m->block_hi[i] = (double *)c->blocks[i].hi;
-        m->block_v[i] = (double *)c->blocks[i].v;
+        const lahar_particle_block *a = &c->blocks[i];
+        lahar_particle_block_t *b = &m->blocks[i];
+        b->name = (char *)a->name;
+        b->kind = (int8_t)a->kind;
+        memcpy(b->lo, a->lo, sizeof b->lo);
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        memcpy(b->v, a->v, sizeof b->v);
+        b->source = (char *)a->source;
+        b->nvert = a->nvert;
+        b->ntri = a->ntri;
+        b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
+        b->tri = calloc((size_t)(a->ntri > 0 ? a->ntri : 1), sizeof *b->tri);
+        if (!b->vert || !b->tri)
+            goto fail;
+        for (int k = 0; k < a->nvert; k++)
+            b->vert[k] = (double *)a->vert[k];
+        for (int k = 0; k < a->ntri; k++)
+            b->tri[k] = (int32_t *)a->tri[k];
     }
     return 0;
 fail:
@@ -111,19 +182,18 @@ void lahar_scene_msg_release(lahar_scene_t *m)
             free(m->bodies[i].face_start);
             free(m->bodies[i].face_nv);
         }
+    if (m->blocks)
+        for (int i = 0; i < m->nblock; i++) {
+            free(m->blocks[i].vert);
+            free(m->blocks[i].tri);
+        }
     free(m->materials);
     free(m->bodies);
-    free(m->block_lo);
-    free(m->block_hi);
-    free(m->block_v);
-    free(m->block_name);
+    free(m->body_record_contacts);
+    free(m->blocks);
     memset(m, 0, sizeof *m);
 }
 
-static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
-{
-    snprintf(dst, LAHAR_NAME_MAX, "%s", src ? src : "");
-}
 
 int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
 {
@@ -146,6 +216,7 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
     c->dem_dt_safety = m->dem_dt_safety;
     c->sph_dx = m->sph_dx;
     c->sph_density = m->sph_density;
+    scene_sph_from_msg(&m->sph, &c->sph);
 
     c->materials = calloc((size_t)(m->nmaterial > 0 ? m->nmaterial : 1), sizeof *c->materials);
     c->bodies = calloc((size_t)(m->nbody > 0 ? m->nbody : 1), sizeof *c->bodies);
@@ -207,13 +278,41 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         memcpy(b->q, a->q, sizeof b->q);
         memcpy(b->v, a->vel, sizeof b->v);
         memcpy(b->w, a->w, sizeof b->w);
+        b->record_contacts = m->body_record_contacts[i] != 0;
     }
-    c->nblock = m->nblock;
     for (int i = 0; i < m->nblock; i++) {
-        scene_copy_name(c->blocks[i].name, m->block_name[i]);
-        memcpy(c->blocks[i].lo, m->block_lo[i], sizeof c->blocks[i].lo);
-        memcpy(c->blocks[i].hi, m->block_hi[i], sizeof c->blocks[i].hi);
-        memcpy(c->blocks[i].v, m->block_v[i], sizeof c->blocks[i].v);
+        const lahar_particle_block_t *a = &m->blocks[i];
+        lahar_particle_block *b = &c->blocks[i];
+        c->nblock = i + 1;
+        if (a->nvert < 0 || a->ntri < 0 || a->kind < LAHAR_BLOCK_BOX || a->kind > LAHAR_BLOCK_MESH) {
+            snprintf(err, errlen, "malformed scene message (particle block %d)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        for (int t = 0; t < a->ntri; t++)
+            for (int k = 0; k < 3; k++)
+                if (a->tri[t][k] < 0 || a->tri[t][k] >= a->nvert) {
+                    snprintf(err, errlen, "malformed scene message (particle block %d, triangle %d)", i, t);
+                    lahar_case_free(c);
+                    return -1;
+                }
+        scene_copy_name(b->name, a->name);
+        b->kind = (lahar_block_kind)a->kind;
+        memcpy(b->lo, a->lo, sizeof b->lo);
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        memcpy(b->v, a->v, sizeof b->v);
+        snprintf(b->source, sizeof b->source, "%s", a->source ? a->source : "");
+        if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
+            goto oom;
+        b->nvert = a->nvert;
+        if (a->ntri > 0 && !(b->tri = malloc((size_t)a->ntri * sizeof *b->tri)))
+            goto oom;
+        b->ntri = a->ntri;
+        for (int k = 0; k < a->nvert; k++)
+            memcpy(b->vert[k], a->vert[k], sizeof b->vert[k]);
+        for (int k = 0; k < a->ntri; k++)
+            for (int j = 0; j < 3; j++)
+                b->tri[k][j] = a->tri[k][j];
     }
     return 0;
 oom:
@@ -392,6 +491,8 @@ int lahar_loads_decode(const void *data, int size, lahar_loads_buf *b)
         MSG_DECODE(double, &b->point_x[0][0], 3 * np);
         MSG_DECODE(double, &b->point_f[0][0], 3 * np);
     }
+    MSG_DECODE(double, b->reach_lo, 3);
+    MSG_DECODE(double, b->reach_hi, 3);
     return 0;
 }
 
