@@ -2,7 +2,10 @@
  * Everything here works on cores (the polytope before sweeping); callers subtract the sweep radii. */
 #include "geometry.h"
 #include <float.h>
+#include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
 double geom_point_segment_param(vec3 p, vec3 a, vec3 b, vec3 *c, double *t)
 {
@@ -243,5 +246,229 @@ double geom_body_core_distance(const lahar_shape *a, const double xa[3], const d
         }
     }
     if (edges_vs_faces(a, xa, qa, b, xb, qb) == 0.0 || edges_vs_faces(b, xb, qb, a, xa, qa) == 0.0) best = 0.0;
+    return best;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Feature grid                                                                                    */
+
+static void feature_box(const lahar_shape *s, int type, int i, double lo[3], double hi[3])
+{
+    int nvtx = 1, base = 0;
+    const int *ids = &i;
+    int pair[2];
+    if (type == GEOM_FEATURE_EDGE) {
+        pair[0] = s->e[i][0];
+        pair[1] = s->e[i][1];
+        ids = pair;
+        nvtx = 2;
+    } else if (type == GEOM_FEATURE_FACE) {
+        base = s->face_start[i];
+        nvtx = s->face_start[i + 1] - base;
+        ids = s->face_v + base;
+    }
+    for (int k = 0; k < 3; k++) {
+        lo[k] = DBL_MAX;
+        hi[k] = -DBL_MAX;
+    }
+    for (int j = 0; j < nvtx; j++)
+        for (int k = 0; k < 3; k++) {
+            double x = s->v[ids[j]][k];
+            if (x < lo[k]) lo[k] = x;
+            if (x > hi[k]) hi[k] = x;
+        }
+    for (int k = 0; k < 3; k++) {
+        lo[k] -= s->radius;
+        hi[k] += s->radius;
+    }
+}
+
+static int clampi(int x, int lo, int hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+static void cell_range(const geom_feature_grid *g, const double lo[3], const double hi[3], int c0[3], int c1[3])
+{
+    for (int k = 0; k < 3; k++) {
+        c0[k] = clampi((int)floor((lo[k] - g->lo[k]) / g->h), 0, g->n[k] - 1);
+        c1[k] = clampi((int)floor((hi[k] - g->lo[k]) / g->h), 0, g->n[k] - 1);
+    }
+}
+
+int geom_feature_grid_build(geom_feature_grid *g, const lahar_shape *s)
+{
+    memset(g, 0, sizeof *g);
+    int count[3] = {s->nv, s->ne, s->nf};
+    double blo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, bhi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    double size_sum = 0.0;
+    int nfeat = 0;
+    for (int t = 0; t < 3; t++)
+        for (int i = 0; i < count[t]; i++) {
+            double lo[3], hi[3], m = 0.0;
+            feature_box(s, t, i, lo, hi);
+            for (int k = 0; k < 3; k++) {
+                if (lo[k] < blo[k]) blo[k] = lo[k];
+                if (hi[k] > bhi[k]) bhi[k] = hi[k];
+                if (hi[k] - lo[k] > m) m = hi[k] - lo[k];
+            }
+            if (t != GEOM_FEATURE_VERTEX) { /* vertices are points; edges/faces set the scale */
+                size_sum += m;
+                nfeat++;
+            }
+        }
+    /* cell about the mean feature size, so that a feature touches a few cells; grown until the
+     * grid has at most ~8 cells per feature */
+    double h = nfeat > 0 ? size_sum / nfeat : 2.0 * s->radius;
+    if (!(h > 0.0)) h = 1.0;
+    long ncell;
+    int total = s->nv + s->ne + s->nf;
+    for (;;) {
+        ncell = 1;
+        for (int k = 0; k < 3; k++) {
+            g->n[k] = (int)ceil((bhi[k] - blo[k]) / h);
+            if (g->n[k] < 1) g->n[k] = 1;
+            ncell *= g->n[k];
+        }
+        if (ncell <= 8L * total + 64) break;
+        h *= 1.5;
+    }
+    g->h = h;
+    for (int k = 0; k < 3; k++) g->lo[k] = blo[k];
+    for (int t = 0; t < 3; t++) {
+        g->nitem[t] = count[t];
+        g->start[t] = calloc((size_t)ncell + 1, sizeof(int));
+        if (!g->start[t]) return -1;
+        for (int pass = 0; pass < 2; pass++) {
+            for (int i = 0; i < count[t]; i++) {
+                double lo[3], hi[3];
+                int c0[3], c1[3];
+                feature_box(s, t, i, lo, hi);
+                cell_range(g, lo, hi, c0, c1);
+                for (int z = c0[2]; z <= c1[2]; z++)
+                    for (int y = c0[1]; y <= c1[1]; y++)
+                        for (int x = c0[0]; x <= c1[0]; x++) {
+                            long c = ((long)z * g->n[1] + y) * g->n[0] + x;
+                            if (pass == 0) g->start[t][c + 1]++;
+                            else g->items[t][g->start[t][c]++] = i;
+                        }
+            }
+            if (pass == 0) {
+                for (long c = 0; c < ncell; c++) g->start[t][c + 1] += g->start[t][c];
+                g->items[t] = malloc(sizeof(int) * (size_t)(g->start[t][ncell] > 0 ? g->start[t][ncell] : 1));
+                if (!g->items[t]) return -1;
+            } else {
+                /* the fill advanced each start to the next cell's start: shift back */
+                for (long c = ncell; c > 0; c--) g->start[t][c] = g->start[t][c - 1];
+                g->start[t][0] = 0;
+            }
+        }
+    }
+    return 0;
+}
+
+void geom_feature_grid_free(geom_feature_grid *g)
+{
+    for (int t = 0; t < 3; t++) {
+        free(g->start[t]);
+        free(g->items[t]);
+        g->start[t] = g->items[t] = NULL;
+    }
+}
+
+int geom_feature_query_init(geom_feature_query *q, int nv, int ne, int nf)
+{
+    memset(q, 0, sizeof *q);
+    int n[3] = {nv, ne, nf};
+    for (int t = 0; t < 3; t++) {
+        q->cap[t] = n[t] > 0 ? n[t] : 1;
+        q->stamp[t] = calloc((size_t)q->cap[t], sizeof(int));
+        q->out[t] = malloc(sizeof(int) * (size_t)q->cap[t]);
+        if (!q->stamp[t] || !q->out[t]) return -1;
+    }
+    return 0;
+}
+
+void geom_feature_query_free(geom_feature_query *q)
+{
+    for (int t = 0; t < 3; t++) {
+        free(q->stamp[t]);
+        free(q->out[t]);
+        q->stamp[t] = q->out[t] = NULL;
+    }
+}
+
+void geom_feature_grid_query(const geom_feature_grid *g, vec3 c, double r, geom_feature_query *q)
+{
+    double lo[3] = {c.x - r, c.y - r, c.z - r}, hi[3] = {c.x + r, c.y + r, c.z + r};
+    q->query++;
+    if (q->query == 0x7fffffff) { /* wrap: clear the stamps (once per 2^31 queries) */
+        for (int t = 0; t < 3; t++) memset(q->stamp[t], 0, sizeof(int) * (size_t)q->cap[t]);
+        q->query = 1;
+    }
+    for (int t = 0; t < 3; t++) q->nout[t] = 0;
+    for (int k = 0; k < 3; k++)
+        if (hi[k] < g->lo[k] || lo[k] > g->lo[k] + g->n[k] * g->h) return;
+    int c0[3], c1[3];
+    cell_range(g, lo, hi, c0, c1);
+    for (int z = c0[2]; z <= c1[2]; z++)
+        for (int y = c0[1]; y <= c1[1]; y++)
+            for (int x = c0[0]; x <= c1[0]; x++) {
+                long cell = ((long)z * g->n[1] + y) * g->n[0] + x;
+                for (int t = 0; t < 3; t++)
+                    for (int k = g->start[t][cell]; k < g->start[t][cell + 1]; k++) {
+                        int i = g->items[t][k];
+                        if (q->stamp[t][i] != q->query) {
+                            q->stamp[t][i] = q->query;
+                            q->out[t][q->nout[t]++] = i;
+                        }
+                    }
+            }
+}
+
+double geom_point_body_core_near(const geom_feature_grid *g, const lahar_shape *s, const double x[3],
+                                 const double q[4], vec3 p, double max_dist, vec3 *c, int *feature)
+{
+    /* work in the shape's frame, where the grid and the vertices live */
+    quat qq = q_load(q);
+    vec3 pb = q_rotate_inv(qq, v3_sub(p, v3_load(x)));
+    double lo[3] = {pb.x - max_dist, pb.y - max_dist, pb.z - max_dist};
+    double hi[3] = {pb.x + max_dist, pb.y + max_dist, pb.z + max_dist};
+    for (int k = 0; k < 3; k++)
+        if (hi[k] < g->lo[k] || lo[k] > g->lo[k] + g->n[k] * g->h) return DBL_MAX;
+    int c0[3], c1[3];
+    cell_range(g, lo, hi, c0, c1);
+    double best = DBL_MAX;
+    vec3 bc = pb;
+    int bf = -1;
+    vec3 poly[GEOM_FACE_MAX];
+    /* a feature may be listed in several cells: evaluating it twice does not change the minimum */
+    for (int z = c0[2]; z <= c1[2]; z++)
+        for (int y = c0[1]; y <= c1[1]; y++)
+            for (int xx = c0[0]; xx <= c1[0]; xx++) {
+                long cell = ((long)z * g->n[1] + y) * g->n[0] + xx;
+                for (int k = g->start[GEOM_FEATURE_VERTEX][cell]; k < g->start[GEOM_FEATURE_VERTEX][cell + 1]; k++) {
+                    vec3 v = v3_load(s->v[g->items[GEOM_FEATURE_VERTEX][k]]);
+                    double d = v3_norm(v3_sub(pb, v));
+                    if (d < best) { best = d; bc = v; bf = 0; }
+                }
+                for (int k = g->start[GEOM_FEATURE_EDGE][cell]; k < g->start[GEOM_FEATURE_EDGE][cell + 1]; k++) {
+                    int i = g->items[GEOM_FEATURE_EDGE][k];
+                    vec3 cc;
+                    double t;
+                    double d = geom_point_segment_param(pb, v3_load(s->v[s->e[i][0]]), v3_load(s->v[s->e[i][1]]), &cc, &t);
+                    if (d < best && t > 0.0 && t < 1.0) { best = d; bc = cc; bf = 1; }
+                }
+                for (int k = g->start[GEOM_FEATURE_FACE][cell]; k < g->start[GEOM_FEATURE_FACE][cell + 1]; k++) {
+                    int f = g->items[GEOM_FEATURE_FACE][k];
+                    int b = s->face_start[f], m = s->face_start[f + 1] - b;
+                    if (m > GEOM_FACE_MAX) m = GEOM_FACE_MAX;
+                    for (int j = 0; j < m; j++) poly[j] = v3_load(s->v[s->face_v[b + j]]);
+                    vec3 cc;
+                    int in;
+                    double d = geom_point_polygon(pb, poly, m, geom_face_normal(s, f), &cc, &in);
+                    if (in && d < best) { best = d; bc = cc; bf = 2; }
+                }
+            }
+    if (bf < 0 || best > max_dist) return DBL_MAX;
+    if (c) *c = v3_add(v3_load(x), q_rotate(qq, bc));
+    if (feature) *feature = bf;
     return best;
 }

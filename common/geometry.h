@@ -57,4 +57,47 @@ double geom_body_core_distance(const lahar_shape *a, const double xa[3], const d
 /* Outward unit normal of face f (body frame), from Newell's method. */
 vec3 geom_face_normal(const lahar_shape *s, int f);
 
+/* ---- Feature grid: a uniform grid over the features (vertices, edges, faces) of one shape, in
+ * its own frame (body frame; world frame for fixed bodies), so that a query near a big terrain or
+ * flume surface visits only the nearby features. Built once at setup; queries allocate nothing. */
+enum { GEOM_FEATURE_VERTEX = 0, GEOM_FEATURE_EDGE = 1, GEOM_FEATURE_FACE = 2 };
+
+typedef struct {
+    double lo[3];   /* body-frame corner of the grid */
+    double h;       /* cell size */
+    int n[3];       /* cells per axis */
+    int nitem[3];   /* features of each type in the body */
+    int *start[3];  /* per type: ncell + 1 offsets into items */
+    int *items[3];  /* per type: feature indices, each feature in every cell its box touches */
+} geom_feature_grid;
+
+/* Scratch space for queries (one per thread). */
+typedef struct {
+    int *stamp[3];  /* per type: last query id that listed the feature */
+    int *out[3];    /* per type: the candidate feature indices */
+    int nout[3];
+    int cap[3];
+    int query;
+} geom_feature_query;
+
+/* Build the grid of shape s (features inflated by its sweep radius). Returns 0 or -1 (no memory). */
+int geom_feature_grid_build(geom_feature_grid *g, const lahar_shape *s);
+void geom_feature_grid_free(geom_feature_grid *g);
+
+/* Scratch able to serve grids with up to nv, ne, nf features. Returns 0 or -1. */
+int geom_feature_query_init(geom_feature_query *q, int nv, int ne, int nf);
+void geom_feature_query_free(geom_feature_query *q);
+
+/* Features whose inflated box meets the ball (body-frame centre c, radius r), without duplicates,
+ * in a deterministic order; results in q->out / q->nout. */
+void geom_feature_grid_query(const geom_feature_grid *g, vec3 c, double r, geom_feature_query *q);
+
+/* Closest point of the core like geom_point_body_core, but only among the features whose
+ * inflated box lies within max_dist of p (through the grid g of shape s placed at x, q). Returns
+ * the distance to the core, or DBL_MAX (c, feature untouched) when no feature is that close.
+ * Thread-safe and allocation-free: meant for many points against one big body (SPH particles
+ * against a terrain). Faces must have at most 64 vertices. */
+double geom_point_body_core_near(const geom_feature_grid *g, const lahar_shape *s, const double x[3],
+                                 const double q[4], vec3 p, double max_dist, vec3 *c, int *feature);
+
 #endif

@@ -12,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "dem_contact.h"
-#include "dem_feature_grid.h"
 #include "geometry.h"
 
 /* Contact types: which features of body a (lower index) and b meet. */
@@ -64,7 +63,7 @@ typedef struct {
 typedef struct {
     sp_contact *c;
     int n, cap;
-    dem_feature_query fq;
+    geom_feature_query fq;
     int *keep[2][3]; /* per side of a pair: features near the other body (vertex, edge, face) */
     int oom;
 } sp_thread;
@@ -87,7 +86,7 @@ struct lahar_dem_engine {
     int *fv;                  /* local vertex ids */
     vec3 *fw;                 /* world copy of the face polygons */
     vec3 *nb, *nw;            /* face normals body / world */
-    dem_feature_grid *grids;
+    geom_feature_grid *grids;
     int ngrid;
     /* broad phase */
     int nfree, *free_ids, nlarge, *large_ids;
@@ -505,13 +504,13 @@ static void pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread
     }
     if (big) {
         vec3 c = q_rotate_inv(e->st[ibig].q, v3_sub(e->st[ismall].x, e->st[ibig].x));
-        dem_feature_grid_query(&e->grids[gbig->grid], c, gsmall->bound, &t->fq);
-        big->nv = t->fq.nout[DEM_FEATURE_VERTEX];
-        big->ne = t->fq.nout[DEM_FEATURE_EDGE];
-        big->nf = e->dim == 3 ? t->fq.nout[DEM_FEATURE_FACE] : 0;
-        big->v = t->fq.out[DEM_FEATURE_VERTEX];
-        big->e = t->fq.out[DEM_FEATURE_EDGE];
-        big->f = t->fq.out[DEM_FEATURE_FACE];
+        geom_feature_grid_query(&e->grids[gbig->grid], c, gsmall->bound, &t->fq);
+        big->nv = t->fq.nout[GEOM_FEATURE_VERTEX];
+        big->ne = t->fq.nout[GEOM_FEATURE_EDGE];
+        big->nf = e->dim == 3 ? t->fq.nout[GEOM_FEATURE_FACE] : 0;
+        big->v = t->fq.out[GEOM_FEATURE_VERTEX];
+        big->e = t->fq.out[GEOM_FEATURE_EDGE];
+        big->f = t->fq.out[GEOM_FEATURE_FACE];
     }
     /* keep only the features that can reach the other body's bounding ball: a feature of A
      * touches B only if its core is within bound_B + R_A of B's centre */
@@ -866,11 +865,11 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
 static void sp_destroy(lahar_dem_engine *e)
 {
     if (!e) return;
-    for (int i = 0; i < e->ngrid; i++) dem_feature_grid_free(&e->grids[i]);
+    for (int i = 0; i < e->ngrid; i++) geom_feature_grid_free(&e->grids[i]);
     if (e->thr)
         for (int t = 0; t < e->nthr; t++) {
             free(e->thr[t].c);
-            dem_feature_query_free(&e->thr[t].fq);
+            geom_feature_query_free(&e->thr[t].fq);
             for (int sd = 0; sd < 2; sd++)
                 for (int k = 0; k < 3; k++) free(e->thr[t].keep[sd][k]);
         }
@@ -1062,7 +1061,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     e->free_ids = xcalloc((size_t)nb, sizeof(int));
     e->large_ids = xcalloc((size_t)nb, sizeof(int));
     e->cellc = xcalloc((size_t)nb, sizeof(long long[3]));
-    e->grids = xcalloc((size_t)nb, sizeof(dem_feature_grid));
+    e->grids = xcalloc((size_t)nb, sizeof(geom_feature_grid));
     e->rep_f = xcalloc((size_t)nb, sizeof(vec3));
     e->rep_t = xcalloc((size_t)nb, sizeof(vec3));
     e->ncontact_body = xcalloc((size_t)nb, sizeof(int));
@@ -1146,7 +1145,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
             e->large_ids[e->nlarge++] = i;
         }
         if (s->nv + s->ne + s->nf > SP_GRID_MIN_FEATURES) {
-            if (dem_feature_grid_build(&e->grids[e->ngrid], s)) {
+            if (geom_feature_grid_build(&e->grids[e->ngrid], s)) {
                 e->ngrid++;
                 snprintf(err, errlen, "spheropoly: out of memory for the feature grid of body '%s'", b->name);
                 goto fail;
@@ -1184,7 +1183,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     }
     for (int t = 0; t < e->nthr; t++) {
         sp_thread *th = &e->thr[t];
-        int bad = dem_feature_query_init(&th->fq, maxv, maxe, maxf);
+        int bad = geom_feature_query_init(&th->fq, maxv, maxe, maxf);
         for (int sd = 0; sd < 2; sd++) {
             th->keep[sd][0] = malloc(sizeof(int) * (size_t)allv);
             th->keep[sd][1] = malloc(sizeof(int) * (size_t)alle);

@@ -154,6 +154,64 @@ int main(void)
     }
     dem_test_check(nbad == 0, "6 random box pairs: core and point distances vs 41x41-per-face sampling, %d bad, "
                               "max |sampled - exact| %.3g (<= 0.03 sampling resolution)", nbad, maxerr);
+    /* feature grid: closest core point near a bumpy 30 x 30 x 2 triangle terrain and near a
+     * rotated box, against the brute-force geom_point_body_core */
+    {
+        enum { N = 30 };
+        static double tv[(N + 1) * (N + 1)][3];
+        static int fs[2 * N * N + 1], fv[6 * N * N];
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) {
+                double *v = tv[j * (N + 1) + i];
+                v[0] = 3.0 * i / N;
+                v[1] = 3.0 * j / N;
+                v[2] = 0.2 * sin(2.0 * v[0]) * cos(1.5 * v[1]);
+            }
+        int nf = 0;
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                int a = j * (N + 1) + i, b = a + 1, cc = a + N + 2, dd = a + N + 1;
+                int tri[2][3] = {{a, b, cc}, {a, cc, dd}};
+                for (int t2 = 0; t2 < 2; t2++, nf++) {
+                    fs[nf] = 3 * nf;
+                    for (int k = 0; k < 3; k++) fv[3 * nf + k] = tri[t2][k];
+                }
+            }
+        fs[nf] = 3 * nf;
+        lahar_shape T = {0};
+        char err[256];
+        int rc = lahar_shape_make_polyhedron(&T, (const double(*)[3])tv, (N + 1) * (N + 1), fs, fv, nf, 0.01, err,
+                                             sizeof err);
+        dem_test_check(rc == 0, "terrain mesh built (%s)", rc ? err : "1800 triangles");
+        const lahar_shape *shapes[2] = {&T, &B};
+        double xs[2][3] = {{0, 0, 0}, {0.3, -0.2, 0.5}}, qs[2][4] = {{1, 0, 0, 0}, {0, 0, 0, 0}};
+        q_store(q_normalize((quat){0.9, 0.3, -0.2, 0.4}), qs[1]);
+        int bad = 0, near = 0, far = 0;
+        for (int sh = 0; sh < 2; sh++) {
+            geom_feature_grid g;
+            dem_test_check(geom_feature_grid_build(&g, shapes[sh]) == 0, "feature grid built");
+            for (int it = 0; it < 2000; it++) {
+                vec3 p = sh == 0 ? v3(3.0 * urand(&seed), 3.0 * urand(&seed), 0.6 * urand(&seed) - 0.3)
+                                 : v3(0.3 + 2.4 * urand(&seed) - 1.2, -0.2 + 2.4 * urand(&seed) - 1.2, 0.5 + 2.4 * urand(&seed) - 1.2);
+                vec3 cb, cn;
+                int fb, fn;
+                double db = geom_point_body_core(shapes[sh], xs[sh], qs[sh], p, &cb, &fb);
+                double dn = geom_point_body_core_near(&g, shapes[sh], xs[sh], qs[sh], p, 0.15, &cn, &fn);
+                if (db <= 0.15) {
+                    near++;
+                    if (fabs(dn - db) > 1e-12 || v3_norm(v3_sub(cn, cb)) > 1e-9 || fn != fb) bad++;
+                } else {
+                    far++;
+                    if (dn != DBL_MAX) bad++;
+                }
+            }
+            geom_feature_grid_free(&g);
+        }
+        dem_test_check(bad == 0 && near > 200 && far > 200,
+                       "grid point queries (terrain + rotated box): %d within 0.15 m equal brute force, %d beyond "
+                       "return none, %d bad", near, far, bad);
+        lahar_shape_free(&T);
+    }
     lahar_shape_free(&A);
     lahar_shape_free(&B);
     return dem_test_failures ? 1 : 0;
