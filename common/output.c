@@ -1013,3 +1013,166 @@ static int out_xdmf_combine(const char *outdir, char *err, size_t n)
     }
     return 0;
 }
+
+/* ---------------------------------------------------------------- contact points -------- */
+
+struct lahar_contact_output {
+    char h5path[OUT_PATH_MAX];
+    int nbody;         /* bodies of the case */
+    int nmarked;
+    int *marked;       /* body indices marked record_contacts */
+    char (*group)[LAHAR_NAME_MAX + 16]; /* per marked body: its group name in a snapshot */
+    int *slot;         /* per body of the case: index into the listed bodies of the current write, -1 */
+    int64_t *offset;   /* per body of the case: first point in x/f of the current write */
+    int64_t nsnap;
+};
+
+void lahar_contact_output_close(lahar_contact_output *o)
+{
+    if (!o)
+        return;
+    free(o->marked);
+    free(o->group);
+    free(o->slot);
+    free(o->offset);
+    free(o);
+}
+
+lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_case *c, char *err, size_t n)
+{
+    err[0] = '\0';
+    int nmarked = 0;
+    for (int b = 0; b < c->nbody; b++)
+        nmarked += c->bodies[b].record_contacts != 0;
+    if (nmarked == 0)
+        return NULL;
+    lahar_contact_output *o = calloc(1, sizeof *o);
+    if (o) {
+        o->marked = calloc((size_t)nmarked, sizeof *o->marked);
+        o->group = calloc((size_t)nmarked, sizeof *o->group);
+        o->slot = calloc((size_t)c->nbody, sizeof *o->slot);
+        o->offset = calloc((size_t)c->nbody, sizeof *o->offset);
+    }
+    if (!o || !o->marked || !o->group || !o->slot || !o->offset) {
+        lahar_contact_output_close(o);
+        snprintf(err, n, "out of memory");
+        return NULL;
+    }
+    o->nbody = c->nbody;
+    for (int b = 0; b < c->nbody; b++)
+        if (c->bodies[b].record_contacts) {
+            int m = o->nmarked++;
+            o->marked[m] = b;
+            const char *name = c->bodies[b].name;
+            /* the body's name, unless HDF5 cannot take it as a link name */
+            if (name[0] && !strchr(name, '/') && strcmp(name, ".") != 0)
+                snprintf(o->group[m], sizeof o->group[m], "%s", name);
+            else
+                snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
+        }
+    snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
+    H5Pclose(fapl);
+    if (f < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
+        lahar_contact_output_close(o);
+        return NULL;
+    }
+    int rc = 0;
+    hid_t h = out_group(f, "header");
+    if (h < 0)
+        rc = -1;
+    else {
+        rc |= out_attr_int64(h, "dimensions", c->dim);
+        rc |= out_attr_string(h, "units", "SI");
+        rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
+        rc |= out_attr_string(h, "case_path", c->path);
+        rc |= out_attr_string(h, "contents",
+                              "per snapshot and marked body: points (virtual particles on the surface, world frame, m) "
+                              "and forces on the body at them (N, N/m in 2D); attributes force and torque (about the "
+                              "centre of mass) are their resultants. Forces of the SPH node at the snapshot time.");
+        const char **gn = malloc((size_t)o->nmarked * sizeof *gn);
+        if (!gn)
+            rc = -1;
+        for (int m = 0; m < o->nmarked && gn; m++)
+            gn[m] = o->group[m];
+        if (!rc) {
+            rc |= out_strings(h, "groups", o->nmarked, gn);
+            rc |= out_dataset(h, "body_index", H5T_NATIVE_INT, H5T_STD_I32LE, 1, (hsize_t)o->nmarked, 0, o->marked);
+        }
+        free(gn);
+        H5Gclose(h);
+    }
+    hid_t sg = out_group(f, "snapshots");
+    if (sg < 0)
+        rc = -1;
+    else
+        H5Gclose(sg);
+    if (H5Fclose(f) < 0 || rc) {
+        snprintf(err, n, "%s: writing the header failed", o->h5path);
+        lahar_contact_output_close(o);
+        return NULL;
+    }
+    return o;
+}
+
+int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, int nlisted, const int32_t *body_id,
+                               const int32_t *npoints, const double (*x)[3], const double (*f)[3],
+                               const double (*force)[3], const double (*torque)[3])
+{
+    if (!o)
+        return 0;
+    for (int b = 0; b < o->nbody; b++)
+        o->slot[b] = -1;
+    int64_t off = 0;
+    for (int i = 0; i < nlisted; i++) {
+        int b = body_id[i];
+        if (b >= 0 && b < o->nbody) {
+            o->slot[b] = i;
+            o->offset[b] = off;
+        }
+        off += npoints[i];
+    }
+    hid_t fapl = out_fapl_unlocked();
+    hid_t file = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
+    H5Pclose(fapl);
+    if (file < 0) {
+        fprintf(stderr, "lahar: %s: cannot reopen for contacts at step %" PRId64 "\n", o->h5path, step);
+        return -1;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
+    hid_t g = out_group(file, name);
+    int rc = g < 0 ? -1 : 0;
+    if (g >= 0) {
+        rc |= out_attr_double(g, "time", t);
+        rc |= out_attr_int64(g, "step", step);
+        for (int m = 0; m < o->nmarked && !rc; m++) {
+            int b = o->marked[m], i = o->slot[b];
+            hid_t bg = out_group(g, o->group[m]);
+            if (bg < 0) {
+                rc = -1;
+                break;
+            }
+            static const double zero[3] = {0.0, 0.0, 0.0};
+            hsize_t np = i >= 0 ? (hsize_t)npoints[i] : 0;
+            const double *pts = np ? x[o->offset[b]] : zero, *fs = np ? f[o->offset[b]] : zero;
+            rc |= out_attr_int64(bg, "n", (int64_t)np);
+            rc |= out_attr(bg, "force", H5T_NATIVE_DOUBLE, 3, i >= 0 ? force[i] : zero);
+            rc |= out_attr(bg, "torque", H5T_NATIVE_DOUBLE, 3, i >= 0 ? torque[i] : zero);
+            rc |= out_dataset(bg, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, pts);
+            rc |= out_dataset(bg, "forces", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, fs);
+            H5Gclose(bg);
+        }
+        H5Gclose(g);
+    }
+    if (H5Fclose(file) < 0)
+        rc = -1;
+    if (rc) {
+        fprintf(stderr, "lahar: %s: writing contacts %" PRId64 " failed\n", o->h5path, o->nsnap);
+        return -1;
+    }
+    o->nsnap++;
+    return 0;
+}

@@ -8,7 +8,8 @@
  *   OUT/bodies.xmf  XDMF temporal collection, rewritten in place after each snapshot.
  *   OUT/forces.h5   per-body force stream (SWMR: readable while the run appends to it).
  *   OUT/particles.h5 + OUT/particles.xmf   SPH particles (SoA datasets, fields selectable).
- *   OUT/lahar.xmf   bodies and particles in one XDMF (lahar_output_xdmf_combine). */
+ *   OUT/lahar.xmf   bodies and particles in one XDMF (lahar_output_xdmf_combine).
+ *   OUT/contacts.h5 fluid contact points and their forces on the bodies marked record_contacts. */
 #ifndef LAHAR_OUTPUT_H
 #define LAHAR_OUTPUT_H
 #include <stddef.h>
@@ -60,6 +61,21 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
                                                   char *err, size_t n);
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p);
 void lahar_particle_output_close(lahar_particle_output *o);
+
+/* Per-contact-point forces of the bodies a case marks record_contacts (OUT/contacts.h5, layout in
+ * tools/README.md): the points where the fluid pushes on them and the forces there, per snapshot.
+ * open returns NULL with err empty when no body is marked (nothing to write), NULL with a message
+ * on failure. */
+typedef struct lahar_contact_output lahar_contact_output;
+lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_case *c, char *err, size_t n);
+/* One snapshot at (step, t) from loads in the layout of loads_t: nlisted bodies body_id[i] with
+ * npoints[i] points each, consecutive in x (positions) and f (forces on the body), and their
+ * resultants force[i], torque[i]. Marked bodies not listed get an empty group. o NULL: no-op.
+ * Reopens and closes the file, so it is complete on disk after every call. 0 or -1. */
+int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, int nlisted, const int32_t *body_id,
+                               const int32_t *npoints, const double (*x)[3], const double (*f)[3],
+                               const double (*force)[3], const double (*torque)[3]);
+void lahar_contact_output_close(lahar_contact_output *o);
 
 /* Write OUT/lahar.xmf: one temporal collection whose time steps hold the body grids and the
  * particle grid of the snapshots found in OUT/bodies.h5 and OUT/particles.h5 (either may be

@@ -66,6 +66,7 @@ typedef struct {
     int32_t *body_id, *npoints;
     double (*force)[3], (*torque)[3];
     double (*point_x)[3], (*point_f)[3];
+    double reach_lo[3], reach_hi[3];
 } lahar_loads_buf;
 int lahar_loads_decode(const void *data, int size, lahar_loads_buf *b);
 void lahar_loads_buf_free(lahar_loads_buf *b);

@@ -1,9 +1,14 @@
 /* DEM node loop (see dem_node.h). Per step k:
  *   wait STEP(k) -> [SPH node present: wait LOADS(k)] -> engine advance(dt_k, loads)
- *   -> [SPH node present and moving bodies: publish BODY_STATE(k)] -> output -> STATUS(k).
+ *   -> [SPH node present and moving bodies: publish BODY_STATE(k), the moving bodies within reach
+ *   of the particles at t_{k+1}] -> output -> STATUS(k).
  * The loads of step k were computed by the SPH node from the body states at t_k (BODY_STATE(k-1)
- * or the scene for k = 0) and are held constant over the engine's substeps. */
+ * or the scene for k = 0) and are held constant over the engine's substeps; the engine adds them
+ * to the forces it reports (forces.h5), fixed bodies included (the fluid's force on a wall).
+ * Bodies marked record_contacts get their contact points written to contacts.h5 at the output
+ * times (the LOADS of the step that starts at an output time). */
 #include "dem_node.h"
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,6 +32,8 @@ typedef struct {
     const lahar_dem_engine_ops *ops;
     lahar_dem_engine *engine;
     lahar_body_output *out;
+    lahar_contact_output *contacts; /* NULL unless a body is marked record_contacts */
+    double *reach_radius;       /* per body: bounding sphere radius about the centre of mass */
     lahar_body_state *states;
     lahar_body_report *reports;
     lahar_body_load *loads;
@@ -41,6 +48,8 @@ typedef struct {
 static void dem_node_free(dem_node *d)
 {
     lahar_body_output_close(d->out);
+    lahar_contact_output_close(d->contacts);
+    free(d->reach_radius);
     if (d->engine)
         d->ops->destroy(d->engine);
     free(d->states);
@@ -74,19 +83,18 @@ static int dem_node_alloc(dem_node *d)
     d->pq = calloc((size_t)n, sizeof *d->pq);
     d->pv = calloc((size_t)n, sizeof *d->pv);
     d->pw = calloc((size_t)n, sizeof *d->pw);
-    if (!d->states || !d->reports || !d->loads || !d->moving_id || !d->bx || !d->bq || !d->bv || !d->bw ||
+    d->reach_radius = calloc((size_t)n, sizeof *d->reach_radius);
+    if (!d->reach_radius || !d->states || !d->reports || !d->loads || !d->moving_id || !d->bx || !d->bq || !d->bv || !d->bw ||
         !d->px || !d->pq || !d->pv || !d->pw)
         return -1;
     d->nmoving = 0;
-    for (int i = 0; i < d->ns.scene.nbody; i++)
-        if (d->ns.scene.bodies[i].motion != LAHAR_MOTION_FIXED) {
-            int m = d->nmoving++;
-            d->moving_id[m] = i;
-            d->px[m] = d->bx[m];
-            d->pq[m] = d->bq[m];
-            d->pv[m] = d->bv[m];
-            d->pw[m] = d->bw[m];
-        }
+    for (int i = 0; i < d->ns.scene.nbody; i++) {
+        const lahar_shape *sh = &d->ns.scene.bodies[i].shape;
+        double r2 = 0.0;
+        for (int v = 0; v < sh->nv; v++)
+            r2 = fmax(r2, sh->v[v][0] * sh->v[v][0] + sh->v[v][1] * sh->v[v][1] + sh->v[v][2] * sh->v[v][2]);
+        d->reach_radius[i] = sqrt(r2) + sh->radius;
+    }
     return 0;
 }
 
@@ -96,14 +104,35 @@ static void dem_node_get_states(dem_node *d)
         d->ops->get_state(d->engine, i, &d->states[i]);
 }
 
+/* BODY_STATE(k): the moving bodies at t_{k+1} whose bounding sphere reaches into the region
+ * where particles can touch them (LOADS(k).reach_lo/hi); the others are far from every particle
+ * and cost nothing on the wire. */
 static int dem_node_send_body_state(dem_node *d, int64_t k, double t)
 {
-    for (int m = 0; m < d->nmoving; m++) {
-        const lahar_body_state *s = &d->states[d->moving_id[m]];
+    const lahar_loads_buf *lm = &d->loads_msg;
+    d->nmoving = 0;
+    for (int i = 0; i < d->ns.scene.nbody; i++) {
+        if (d->ns.scene.bodies[i].motion == LAHAR_MOTION_FIXED)
+            continue;
+        const lahar_body_state *s = &d->states[i];
+        double r = d->reach_radius[i], gap2 = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double g = fmax(lm->reach_lo[a] - s->x[a], s->x[a] - lm->reach_hi[a]);
+            if (g > 0.0)
+                gap2 += g * g;
+        }
+        if (!(gap2 <= r * r)) /* NaN states are never sent (the engine stops on them anyway) */
+            continue;
+        int m = d->nmoving++;
+        d->moving_id[m] = i;
         memcpy(d->bx[m], s->x, sizeof d->bx[m]);
         memcpy(d->bq[m], s->q, sizeof d->bq[m]);
         memcpy(d->bv[m], s->v, sizeof d->bv[m]);
         memcpy(d->bw[m], s->w, sizeof d->bw[m]);
+        d->px[m] = d->bx[m];
+        d->pq[m] = d->bq[m];
+        d->pv[m] = d->bv[m];
+        d->pw[m] = d->bw[m];
     }
     lahar_body_state_t bs = {
         .run_id = lahar_link_run_id(d->link), .step = k, .t = t, .n = d->nmoving, .id = d->moving_id,
@@ -152,6 +181,10 @@ static int dem_node_loop(dem_node *d)
     char err[2048];
     lahar_link_msg msg;
     const int has_sph = d->ns.has_sph;
+    int moving = 0;
+    for (int i = 0; i < d->ns.scene.nbody; i++)
+        moving += d->ns.scene.bodies[i].motion != LAHAR_MOTION_FIXED;
+    int at_output_time = 1; /* t_0 */
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(d->link);
         int rc = lahar_link_wait(d->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, &msg);
@@ -177,14 +210,23 @@ static int dem_node_loop(dem_node *d)
                 return 3;
             if (rc != LAHAR_LINK_OK || dem_node_read_loads(d, &msg, err, sizeof err) != 0)
                 st.error = 1;
+            const lahar_loads_buf *lm = &d->loads_msg;
+            if (!st.error && at_output_time &&
+                lahar_contact_output_write(d->contacts, k, step.t, lm->nbody, lm->body_id, lm->npoints,
+                                           (const double(*)[3])lm->point_x, (const double(*)[3])lm->point_f,
+                                           (const double(*)[3])lm->force, (const double(*)[3])lm->torque) != 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "cannot write to contacts.h5 in %s", d->ns.output_dir);
+            }
         }
+        at_output_time = step.write_output;
         double c0 = lahar_now();
         int nsub = st.error ? -1 : d->ops->advance(d->engine, step.dt, has_sph ? d->loads : NULL, err, sizeof err);
         double compute = lahar_now() - c0;
         if (nsub < 0)
             st.error = 1;
         dem_node_get_states(d);
-        if (has_sph && d->nmoving > 0 && !st.error)
+        if (has_sph && moving > 0 && !st.error)
             dem_node_send_body_state(d, k, step.t_next);
         for (int i = 0; i < d->ns.scene.nbody; i++)
             d->ops->get_report(d->engine, i, &d->reports[i]);
@@ -258,6 +300,9 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     else if (!(d.engine = d.ops->create(&d.ns.scene, err, sizeof err)))
         ;
     else if (!(d.out = lahar_body_output_open(d.ns.output_dir, &d.ns.scene, err, sizeof err)))
+        ;
+    else if (d.ns.has_sph && !(d.contacts = lahar_contact_output_open(d.ns.output_dir, &d.ns.scene, err, sizeof err)) &&
+             err[0])
         ;
     else {
         dem_node_get_states(&d);

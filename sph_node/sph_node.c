@@ -1,9 +1,23 @@
-/* SPH node loop (see sph_node.h). Per step k:
- *   wait STEP(k) -> [DEM node present and moving bodies, k > 0: wait BODY_STATE(k-1), the body
- *   states at t_k] -> particle work -> [DEM node present: publish LOADS(k)] -> integrate
- *   -> output -> STATUS(k) with the proposed dt for step k+1.
- * No particle forces yet, so LOADS carry no bodies; the exchange is already in place so the
- * coupling (paper 000 eq. 12-14) only has to fill them. */
+/* SPH node loop (see sph_node.h and the lockstep in lcm_types/README.md). Per step k:
+ *
+ *   wait STEP(k)
+ *   k = 0: evaluate the rates at t_0 (particle-particle sums and the coupling with the bodies at
+ *          their initial states, K_n for dt_0): the forces on the bodies at t_0
+ *   [DEM node] send LOADS(k): per body near particles the resultant force and torque at t_k
+ *          (from the evaluation that ended step k-1, which used BODY_STATE(k-1), the bodies at t_k)
+ *          and, for moving bodies and bodies marked record_contacts, the contact points
+ *   [DEM node, moving bodies] wait BODY_STATE(k): the bodies at t_{k+1}, after the DEM node's
+ *          advance with LOADS(k)
+ *   sph_fluid_step(dt_k, bodies at t_{k+1}): kick, drift, sort, rates at t_{k+1} (with the
+ *          coupling forces at t_{k+1}, sent as LOADS(k+1)), kick
+ *   snapshot if write_output (or if a particle crossed a body surface), STATUS(k) with the
+ *   solver's dt proposal for step k+1.
+ *
+ * So the forces the DEM node applies over step k are those of the bodies and particles at t_k,
+ * and the fluid integrated over step k sees the bodies at t_k and t_{k+1} (KDK, both ends): a
+ * staggered explicit coupling. The DEM node's advance of step k overlaps the SPH node's wait
+ * only; splitting sph_fluid_step into a particle-particle part (before the BODY_STATE wait) and
+ * the coupling part would hide it behind computation. */
 #include "sph_node.h"
 #include <math.h>
 #include <omp.h>
@@ -17,42 +31,60 @@
 #include "link.h"
 #include "output.h"
 #include "scene_msg.h"
+#include "shape_build.h"
 #include "transport.h"
 
 #define ROLE LAHAR_ROLE_SPH
 
-/* Particles a block holds (the lattice of sph_particles_add_box), to size the arrays once. */
-static int64_t sph_node_block_count(int dim, double dx, const lahar_particle_block *b)
+/* Append the lattice points inside every block (lahar_particle_block_lattice: the order of
+ * sph_particles_add_box for boxes) at rest density with mass rho0 dx^D. 0, or -1 when out of
+ * memory or when p has no room. */
+static int sph_node_add_blocks(sph_particles *p, int dim, double dx, double rest_density, int nblock,
+                               const lahar_particle_block *blocks)
 {
-    int64_t count = 1;
-    for (int a = 0; a < (dim == 2 ? 2 : 3); a++) {
-        int64_t n = (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
-        count *= n > 0 ? n : 0;
+    int64_t most = 0;
+    for (int b = 0; b < nblock; b++) {
+        int64_t n = lahar_particle_block_lattice(&blocks[b], dim, dx, NULL, 0);
+        most = n > most ? n : most;
     }
-    return count;
+    double(*pts)[3] = malloc((size_t)(most > 0 ? most : 1) * sizeof *pts);
+    if (!pts)
+        return -1;
+    const double m = rest_density * pow(dx, dim);
+    int rc = 0;
+    for (int b = 0; b < nblock && !rc; b++) {
+        int64_t n = lahar_particle_block_lattice(&blocks[b], dim, dx, pts, most);
+        for (int64_t i = 0; i < n && !rc; i++)
+            rc = sph_particles_add(p, pts[i], blocks[b].v, m, rest_density, 0) < 0 ? -1 : 0;
+    }
+    free(pts);
+    return rc;
+}
+
+static int64_t sph_node_count(int dim, double dx, int nblock, const lahar_particle_block *blocks)
+{
+    int64_t total = 0;
+    for (int b = 0; b < nblock; b++)
+        total += lahar_particle_block_lattice(&blocks[b], dim, dx, NULL, 0);
+    return total;
 }
 
 int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
                             const lahar_particle_block *blocks)
 {
-    int64_t total = 0;
-    for (int b = 0; b < nblock; b++)
-        total += sph_node_block_count(dim, dx, &blocks[b]);
+    int64_t total = sph_node_count(dim, dx, nblock, blocks);
     if (sph_particles_init(p, total > 0 ? total : 1) != 0)
         return -1;
-    for (int b = 0; b < nblock; b++)
-        if (sph_particles_add_box(p, dim, dx, rest_density, blocks[b].lo, blocks[b].hi, blocks[b].v) < 0) {
-            sph_particles_free(p);
-            return -1;
-        }
+    if (sph_node_add_blocks(p, dim, dx, rest_density, nblock, blocks) != 0) {
+        sph_particles_free(p);
+        return -1;
+    }
     return p->n;
 }
 
 void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt)
 {
     const int64_t n = p->n;
-    /* below a few thousand particles a parallel region (and its barrier, on a loaded machine)
-     * costs more than the loop itself */
 #pragma omp parallel for schedule(static) if (n > 8192)
     for (int64_t i = 0; i < n; i++) {
         p->vx[i] += g[0] * dt;
@@ -68,7 +100,6 @@ double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double 
 {
     double vmax2 = 0.0;
     const int64_t n = p->n;
-    /* max is exact whatever the order of the reduction, so this stays deterministic */
 #pragma omp parallel for reduction(max : vmax2) schedule(static) if (n > 8192)
     for (int64_t i = 0; i < n; i++) {
         double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i];
@@ -79,20 +110,80 @@ double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double 
     return 0.25 * dx / (sqrt(vmax2) + sqrt(gn * dx));
 }
 
+int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen)
+{
+    const lahar_sph_options *o = &c->sph;
+    memset(prm, 0, sizeof *prm);
+    prm->dim = c->dim;
+    prm->kernel = o->kernel[0] ? o->kernel : NULL;
+    prm->dx = c->sph_dx;
+    prm->h_over_dx = o->h_over_dx;
+    prm->rho0 = c->sph_density;
+    prm->c0 = o->c0;
+    prm->eos = o->eos == LAHAR_SPH_EOS_TAIT ? SPH_EOS_TAIT : SPH_EOS_LINEAR;
+    prm->gamma = o->gamma;
+    prm->mu = o->mu;
+    prm->alpha = o->alpha;
+    prm->delta = o->delta;
+    for (int a = 0; a < 3; a++) {
+        prm->body_force[a] = c->gravity[a] + o->body_force[a];
+        prm->periodic[a] = o->periodic[a];
+        prm->lo[a] = o->lo[a];
+        prm->hi[a] = o->hi[a];
+    }
+    prm->cfl = o->cfl;
+    prm->cfl_force = o->cfl_force;
+    prm->cfl_visc = o->cfl_visc;
+    prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
+    /* options of the case the solver core does not offer yet: refuse rather than ignore */
+    if (o->sps) {
+        snprintf(err, errlen, "sph.sps: the SPS turbulence model is not implemented by the solver yet");
+        return -1;
+    }
+    if (o->shepard_interval > 0) {
+        snprintf(err, errlen, "sph.shepard_interval: the Shepard filter is not implemented by the solver yet");
+        return -1;
+    }
+    if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {
+        snprintf(err, errlen, "sph.halo: the coupling uses eps = dx/2 = %g m; another halo (%g m) is not implemented yet",
+                 0.5 * c->sph_dx, o->halo);
+        return -1;
+    }
+    const kernel_def *kd = kernel_find(prm->kernel ? prm->kernel : "cubic");
+    if (o->kappa > 0.0 && kd && fabs(o->kappa - kd->kappa) > 1e-12) {
+        snprintf(err, errlen, "sph.kappa: the coupling range is the kernel's support (%g h); %g h is not implemented yet",
+                 kd->kappa, o->kappa);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- the node -------------------------------------------------------------------------------- */
+
 typedef struct {
     lahar_link *link;
     lahar_node_scene ns;
-    sph_particles p;
+    sph_fluid f;
+    int fluid_ready;
     lahar_particle_output *out;
-    int nmoving;
-    lahar_body_state_buf bodies; /* moving bodies at t_k (BODY_STATE(k-1)), for the coupling */
+    int nbody, nmoving;
+    lahar_body_state *states;    /* per body: the poses the coupling uses (fixed: the scene's) */
+    lahar_body_state_buf bodies; /* BODY_STATE decoded in place */
+    /* LOADS being built (rows point into preallocated arrays / the coupling's contact list) */
+    int32_t *l_id, *l_np;
+    double (*l_force)[3], (*l_torque)[3];
+    double **l_pforce, **l_ptorque;
+    double **l_px, **l_pf;
+    int64_t l_pcap;
+    int64_t loads_points;        /* points sent, over the run (diagnostics) */
 } sph_node;
 
 static int sph_node_snapshot(sph_node *s, int64_t step, double t)
 {
+    const sph_particles *p = &s->f.p;
     lahar_particles_view v = {
-        .n = s->p.n, .x = s->p.x, .y = s->p.y, .z = s->p.z, .vx = s->p.vx, .vy = s->p.vy, .vz = s->p.vz,
-        .density = s->p.rho, .pressure = s->p.p, .phase = s->p.phase, .id = s->p.id,
+        .n = p->n, .x = p->x, .y = p->y, .z = p->z, .vx = p->vx, .vy = p->vy, .vz = p->vz,
+        .density = p->rho, .pressure = p->p, .phase = p->phase, .id = p->id,
     };
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }
@@ -107,12 +198,195 @@ static int sph_node_wait_stop(sph_node *s)
     }
 }
 
+static int sph_node_alloc(sph_node *s)
+{
+    int n = s->nbody > 0 ? s->nbody : 1;
+    s->states = calloc((size_t)n, sizeof *s->states);
+    s->l_id = calloc((size_t)n, sizeof *s->l_id);
+    s->l_np = calloc((size_t)n, sizeof *s->l_np);
+    s->l_force = calloc((size_t)n, sizeof *s->l_force);
+    s->l_torque = calloc((size_t)n, sizeof *s->l_torque);
+    s->l_pforce = calloc((size_t)n, sizeof *s->l_pforce);
+    s->l_ptorque = calloc((size_t)n, sizeof *s->l_ptorque);
+    s->l_pcap = 1024;
+    s->l_px = calloc((size_t)s->l_pcap, sizeof *s->l_px);
+    s->l_pf = calloc((size_t)s->l_pcap, sizeof *s->l_pf);
+    if (!s->states || !s->l_id || !s->l_np || !s->l_force || !s->l_torque || !s->l_pforce || !s->l_ptorque ||
+        !s->l_px || !s->l_pf)
+        return -1;
+    for (int i = 0; i < n; i++) {
+        s->l_pforce[i] = s->l_force[i];
+        s->l_ptorque[i] = s->l_torque[i];
+    }
+    const lahar_case *c = &s->ns.scene;
+    for (int b = 0; b < s->nbody; b++) {
+        const lahar_body *bd = &c->bodies[b];
+        lahar_body_state *st = &s->states[b];
+        memcpy(st->x, bd->x, sizeof st->x);
+        memcpy(st->q, bd->q, sizeof st->q);
+        if (bd->motion != LAHAR_MOTION_FIXED) {
+            memcpy(st->v, bd->v, sizeof st->v);
+            memcpy(st->w, bd->w, sizeof st->w);
+        }
+    }
+    return 0;
+}
+
+static void sph_node_free(sph_node *s)
+{
+    lahar_particle_output_close(s->out);
+    if (s->fluid_ready)
+        sph_fluid_free(&s->f);
+    lahar_body_state_buf_free(&s->bodies);
+    free(s->states);
+    free(s->l_id);
+    free(s->l_np);
+    free(s->l_force);
+    free(s->l_torque);
+    free(s->l_pforce);
+    free(s->l_ptorque);
+    free(s->l_px);
+    free(s->l_pf);
+    lahar_case_free(&s->ns.scene);
+}
+
+/* The region where a body can touch a particle at t_{k+1}: the particles' bounding box at t_k
+ * grown by the kernel support (the coupling's range) plus how far a particle can move in a step
+ * (CFL keeps it below a fraction of h; twice the support covers it with room to spare). The DEM
+ * node sends BODY_STATE only for moving bodies whose bounding sphere reaches into it. */
+static void sph_node_reach(const sph_node *s, double lo[3], double hi[3])
+{
+    const sph_particles *p = &s->f.p;
+    const double margin = 2.0 * s->f.k.support;
+    for (int a = 0; a < 3; a++) {
+        lo[a] = INFINITY;
+        hi[a] = -INFINITY;
+    }
+    for (int64_t i = 0; i < p->n; i++) {
+        lo[0] = fmin(lo[0], p->x[i]), hi[0] = fmax(hi[0], p->x[i]);
+        lo[1] = fmin(lo[1], p->y[i]), hi[1] = fmax(hi[1], p->y[i]);
+        lo[2] = fmin(lo[2], p->z[i]), hi[2] = fmax(hi[2], p->z[i]);
+    }
+    for (int a = 0; a < 3; a++) {
+        if (s->f.prm.periodic[a]) { /* particles wrap: the whole period, and beyond by the margin */
+            lo[a] = fmin(lo[a], s->f.prm.lo[a]);
+            hi[a] = fmax(hi[a], s->f.prm.hi[a]);
+        }
+        lo[a] -= margin;
+        hi[a] += margin;
+    }
+}
+
+/* LOADS(k) from the coupling's last evaluation (the bodies and particles at t_k): every body with
+ * at least one particle within reach; contact points for moving bodies and for bodies marked
+ * record_contacts (fixed ones: the resultant only otherwise, for forces.h5). */
+static int sph_node_send_loads(sph_node *s, int64_t k)
+{
+    const sph_coupling *cp = &s->f.cpl;
+    const lahar_case *c = &s->ns.scene;
+    int nb = 0;
+    int64_t np = 0;
+    for (int b = 0; b < s->nbody; b++) {
+        int64_t n = cp->body_start[b + 1] - cp->body_start[b];
+        if (n == 0)
+            continue;
+        const lahar_body *bd = &c->bodies[b];
+        int points = bd->motion != LAHAR_MOTION_FIXED || bd->record_contacts;
+        s->l_id[nb] = b;
+        memcpy(s->l_force[nb], cp->force[b], sizeof s->l_force[nb]);
+        memcpy(s->l_torque[nb], cp->torque[b], sizeof s->l_torque[nb]);
+        s->l_np[nb] = points ? (int32_t)n : 0;
+        if (points) {
+            if (np + n > s->l_pcap) {
+                int64_t cap = s->l_pcap;
+                while (cap < np + n)
+                    cap *= 2;
+                double **px = realloc(s->l_px, (size_t)cap * sizeof *px);
+                if (px)
+                    s->l_px = px;
+                double **pf = px ? realloc(s->l_pf, (size_t)cap * sizeof *pf) : NULL;
+                if (!px || !pf)
+                    return -1;
+                s->l_pf = pf;
+                s->l_pcap = cap;
+            }
+            for (int64_t i = 0; i < n; i++) {
+                sph_contact *ct = &cp->contacts[cp->body_start[b] + i];
+                s->l_px[np + i] = ct->xs;
+                s->l_pf[np + i] = ct->force;
+            }
+            np += n;
+        }
+        nb++;
+    }
+    if (np > INT32_MAX)
+        return -1;
+    lahar_loads_t m = {
+        .run_id = lahar_link_run_id(s->link), .step = k, .nbody = nb, .body_id = s->l_id, .force = s->l_pforce,
+        .torque = s->l_ptorque, .npoints = s->l_np, .ntotal = (int32_t)np, .point_x = s->l_px, .point_f = s->l_pf,
+    };
+    sph_node_reach(s, m.reach_lo, m.reach_hi);
+    s->loads_points += np;
+    int rc;
+    LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &m);
+    return rc;
+}
+
+/* Bodies at t_{k+1} from BODY_STATE(k). A moving body the DEM node did not list is out of reach
+ * of every particle: it is placed at infinity, where the coupling's distance test skips it (its
+ * last known pose may be near the water it has since left). */
+static void sph_node_take_states(sph_node *s)
+{
+    const lahar_case *c = &s->ns.scene;
+    for (int b = 0; b < s->nbody; b++)
+        if (c->bodies[b].motion != LAHAR_MOTION_FIXED) {
+            s->states[b].x[0] = s->states[b].x[1] = s->states[b].x[2] = INFINITY;
+        }
+    const lahar_body_state_buf *m = &s->bodies;
+    for (int i = 0; i < m->n; i++) {
+        int b = m->id[i];
+        if (b < 0 || b >= s->nbody)
+            continue;
+        lahar_body_state *st = &s->states[b];
+        memcpy(st->x, m->x[i], sizeof st->x);
+        memcpy(st->q, m->q[i], sizeof st->q);
+        memcpy(st->v, m->v[i], sizeof st->v);
+        memcpy(st->w, m->w[i], sizeof st->w);
+    }
+}
+
+/* Kinetic energy of the fluid (J, J/m in 2D), summed serially: the same bits for any thread count. */
+static double sph_node_kinetic_energy(const sph_particles *p)
+{
+    double e = 0.0;
+    for (int64_t i = 0; i < p->n; i++)
+        e += 0.5 * p->m[i] * (p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i]);
+    return e;
+}
+
+static void sph_node_crossing_message(const sph_node *s, int64_t k, double t, char *err, size_t n)
+{
+    const sph_coupling *cp = &s->f.cpl;
+    int b = cp->cross_body;
+    if (k < 0) {
+        snprintf(err, n, "particle %lld starts inside body %d '%s' (%.3g m inside the surface; %lld particle%s "
+                 "inside bodies at t = 0): move the particle block or the body",
+                 (long long)cp->cross_particle_id, b, b >= 0 && b < s->nbody ? s->ns.scene.bodies[b].name : "?",
+                 cp->cross_depth, (long long)cp->crossings, cp->crossings == 1 ? "" : "s");
+        return;
+    }
+    snprintf(err, n,
+             "particle %lld crossed the surface of body %d '%s' in step %lld (t = %.9g s; %.3g m inside; %lld "
+             "particle%s inside bodies); the last snapshot is the state after that step",
+             (long long)cp->cross_particle_id, b, b >= 0 && b < s->nbody ? s->ns.scene.bodies[b].name : "?",
+             (long long)k, t, cp->cross_depth, (long long)cp->crossings, cp->crossings == 1 ? "" : "s");
+}
+
 static int sph_node_loop(sph_node *s)
 {
     char err[2048];
     lahar_link_msg msg;
-    const int has_dem = s->ns.has_dem;
-    const lahar_case *c = &s->ns.scene;
+    const int has_dem = s->ns.has_dem && s->nbody > 0;
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
         int rc = lahar_link_wait(s->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, &msg);
@@ -130,33 +404,59 @@ static int sph_node_loop(sph_node *s)
             return 1;
         lahar_status_t st = {0};
         err[0] = '\0';
-        double c0 = lahar_now();
-        /* (particle-particle work goes here: it needs no body state) */
-        double compute = lahar_now() - c0;
-        if (has_dem && s->nmoving > 0 && k > 0) {
-            /* body states at t_k for the particle-body forces */
-            rc = lahar_link_wait(s->link, LAHAR_ROLE_DEM, LAHAR_FRAME_T_MSG_BODY_STATE, k - 1, -1, &msg);
+        double compute = 0.0, c0 = lahar_now();
+        int64_t cross = 0;
+        if (k == 0) {
+            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt) */
+            cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step.dt);
+            if (cross < 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "out of memory in the SPH rates");
+            } else if (cross > 0) {
+                st.error = 1;
+                sph_node_crossing_message(s, -1, 0.0, err, sizeof err);
+            }
+        }
+        if (has_dem && sph_node_send_loads(s, k) != 0 && !st.error) {
+            st.error = 1;
+            snprintf(err, sizeof err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
+        }
+        compute += lahar_now() - c0;
+        if (has_dem && s->nmoving > 0) {
+            /* the moving bodies at t_{k+1}, after the DEM node's advance with LOADS(k) */
+            rc = lahar_link_wait(s->link, LAHAR_ROLE_DEM, LAHAR_FRAME_T_MSG_BODY_STATE, k, -1, &msg);
             if (rc == LAHAR_LINK_STOP)
                 return 0;
             if (rc == LAHAR_LINK_LOST)
                 return 3;
             if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {
+                if (!st.error)
+                    snprintf(err, sizeof err, "undecodable BODY_STATE(%lld)", (long long)k);
                 st.error = 1;
-                snprintf(err, sizeof err, "undecodable BODY_STATE(%lld)", (long long)(k - 1));
+            } else {
+                sph_node_take_states(s);
             }
         }
         c0 = lahar_now();
-        if (has_dem) {
-            lahar_loads_t loads = {.run_id = lahar_link_run_id(s->link), .step = k};
-            LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &loads);
+        if (!st.error) {
+            cross = sph_fluid_step(&s->f, step.dt, has_dem ? s->states : NULL);
+            if (cross < 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "out of memory in the SPH step");
+            } else if (cross > 0) {
+                st.error = 1;
+                sph_node_crossing_message(s, k, step.t_next, err, sizeof err);
+            }
         }
-        lahar_sph_node_fall(&s->p, c->gravity, step.dt);
-        if (step.write_output && sph_node_snapshot(s, k + 1, step.t_next) != 0) {
+        /* on an error the state reached is kept as the last snapshot to look at */
+        if ((step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
         }
-        st.dt_proposed = lahar_sph_node_fall_dt(&s->p, c->gravity, c->sph_dx);
+        st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
+        st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
+        st.kinetic_energy = sph_node_kinetic_energy(&s->f.p);
         compute += lahar_now() - c0;
         st.compute_s = compute;
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
@@ -168,6 +468,47 @@ static int sph_node_loop(sph_node *s)
         }
         lahar_link_set_step(s->link, k);
     }
+}
+
+/* Build the solver from the scene: parameters, particles of every block, the bodies. */
+static int sph_node_setup(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    sph_params prm;
+    if (!(c->sph_dx > 0.0)) {
+        snprintf(err, errlen, "the particle spacing sph.dx must be > 0 (got %g)", c->sph_dx);
+        return -1;
+    }
+    if (lahar_sph_node_params(c, &prm, err, errlen) != 0)
+        return -1;
+    int64_t total = sph_node_count(c->dim, c->sph_dx, c->nblock, c->blocks);
+    if (sph_fluid_init(&s->f, &prm, total > 0 ? total : 1, err, (int)errlen) != 0)
+        return -1;
+    s->fluid_ready = 1;
+    if (sph_node_add_blocks(&s->f.p, c->dim, c->sph_dx, c->sph_density, c->nblock, c->blocks) != 0) {
+        snprintf(err, errlen, "out of memory for %lld particles", (long long)total);
+        return -1;
+    }
+    if (sph_node_alloc(s) != 0) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    if (s->nbody > 0 && sph_fluid_attach_bodies(&s->f, s->nbody, c->bodies) != 0) {
+        snprintf(err, errlen, "out of memory for the coupling");
+        return -1;
+    }
+    if (sph_cells_sort(&s->f.cells, &s->f.p) != 0) {
+        snprintf(err, errlen, "out of memory for the cell lists");
+        return -1;
+    }
+    /* rates at t_0 for the first dt proposal (with K_n of a CFL step; step 0 re-evaluates them
+     * with the granted dt) */
+    double dt_guess = prm.cfl > 0 ? prm.cfl * s->f.k.h / prm.c0 : 0.25 * s->f.k.h / prm.c0;
+    if (sph_fluid_rates(&s->f, s->nbody > 0 ? s->states : NULL, dt_guess) < 0) {
+        snprintf(err, errlen, "out of memory in the SPH rates");
+        return -1;
+    }
+    return 0;
 }
 
 int lahar_sph_node_run(const lahar_sph_node_options *o)
@@ -191,9 +532,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         lahar_transport_close(t);
         return 2;
     }
-    static const char *const caps[] = {"dim2", "dim3", "gravity"};
+    static const char *const caps[] = {"dim2", "dim3", "gravity", "wcsph", "coupling"};
     int status = 0;
-    int rc = lahar_node_join(s.link, ROLE, "lahar-sph/minimal", LAHAR_VERSION, caps, 3,
+    int rc = lahar_node_join(s.link, ROLE, "lahar-sph/wcsph", LAHAR_VERSION, caps, 5,
                              o->join_wait_s > 0 ? o->join_wait_s : 30.0, &s.ns, err, sizeof err);
     if (rc == LAHAR_LINK_STOP)
         goto done;
@@ -203,23 +544,25 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         goto done;
     }
     const lahar_case *c = &s.ns.scene;
+    s.nbody = c->nbody;
     for (int i = 0; i < c->nbody; i++)
         s.nmoving += c->bodies[i].motion != LAHAR_MOTION_FIXED;
     lahar_status_t st = {0};
     err[0] = '\0';
-    if (!(c->sph_dx > 0.0))
-        snprintf(err, sizeof err, "the particle spacing sph.dx must be > 0 (got %g)", c->sph_dx);
-    else if (lahar_sph_node_fill(&s.p, c->dim, c->sph_dx, c->sph_density, c->nblock, c->blocks) < 0)
-        snprintf(err, sizeof err, "out of memory for the particles");
+    if (sph_node_setup(&s, err, sizeof err) != 0)
+        ;
     else if (!(s.out = lahar_particle_output_open(s.ns.output_dir, c, c->output_fields, err, sizeof err)))
         ;
     else if (sph_node_snapshot(&s, 0, 0.0) != 0)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
-    char desc[128];
-    snprintf(desc, sizeof desc, "minimal (gravity only), %lld particles", (long long)s.p.n);
+    char desc[256];
+    if (s.fluid_ready)
+        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled",
+                 (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody);
     st.error = err[0] != '\0';
-    st.dt_proposed = st.error ? 0.0 : lahar_sph_node_fall_dt(&s.p, c->gravity, c->sph_dx);
+    st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;
+    st.kinetic_energy = st.error ? 0.0 : sph_node_kinetic_energy(&s.f.p);
     lahar_node_send_status(s.link, ROLE, -1, &st, st.error ? err : desc);
     if (st.error) {
         fprintf(stderr, "lahar-sph: %s\n", err);
@@ -230,10 +573,7 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     status = sph_node_loop(&s);
 done:
     lahar_link_heartbeat_stop(s.link);
-    lahar_particle_output_close(s.out);
-    sph_particles_free(&s.p);
-    lahar_body_state_buf_free(&s.bodies);
-    lahar_case_free(&s.ns.scene);
+    sph_node_free(&s);
     lahar_link_destroy(s.link);
     lahar_transport_close(t);
     return status;

@@ -1,6 +1,7 @@
-/* The SPH node's process loop (minimal for now: particles on a lattice falling under gravity, no
- * forces). Joins a run, creates the particles of the scene's blocks and answers each STEP of the
- * coordinator (protocol in lcm_types/README.md). Used by lahar-sph and `lahar run --in-process`. */
+/* The SPH node's process loop: joins a run, fills the scene's particle blocks, builds the WCSPH
+ * solver core (sph_fluid.h) coupled with the scene's DEM bodies (sph_coupling.h) and answers each
+ * STEP of the coordinator, exchanging LOADS and BODY_STATE with the DEM node (protocol and exchange
+ * order in lcm_types/README.md). Used by lahar-sph and `lahar run --in-process`. */
 #ifndef LAHAR_SPH_NODE_H
 #define LAHAR_SPH_NODE_H
 #include <stdint.h>
@@ -13,16 +14,24 @@ typedef struct {
     double join_wait_s;  /* how long to wait for the coordinator's HELLO */
 } lahar_sph_node_options;
 
-/* Particles: the solver core's structure of arrays (sph_particles.h). Until the node steps them
- * with the WCSPH core, they only fall under gravity. */
+#include <stddef.h>
+#include "sph_fluid.h"
 #include "sph_particles.h"
 
-/* Allocate and fill the lattice of spacing dx in every block (sph_particles_add_box: centres at
- * lo + (i + 1/2) dx, floor((hi - lo)/dx) per axis, one layer at z = 0 in 2D). Returns the number
- * of particles, or -1 when out of memory. */
+/* The solver parameters of a case (lahar_case.sph, sph_dx, sph_density, gravity added to the
+ * fluid's body force). Returns 0, or -1 with a message for options the solver core does not
+ * implement yet (SPS, Shepard filter, a halo other than dx/2, a coupling range other than the
+ * kernel support). */
+int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen);
+
+/* Allocate and fill the lattice points of spacing dx inside every block
+ * (lahar_particle_block_lattice: centres at lo + (i + 1/2) dx, one layer at z = 0 in 2D; boxes in
+ * the order of sph_particles_add_box), mass rho0 dx^D. Returns the number of particles, or -1
+ * when out of memory. */
 int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
                             const lahar_particle_block *blocks);
-/* Semi-implicit Euler under gravity only: v += g dt, then x += v dt. */
+/* Free fall without forces (the node before the WCSPH core; kept for test_sph_particles):
+ * semi-implicit Euler under gravity only: v += g dt, then x += v dt. */
 void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt);
 /* CFL-like step of a free fall: 0.25 dx / (|v|max + sqrt(|g| dx)). */
 double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double dx);
