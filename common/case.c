@@ -1321,8 +1321,81 @@ static int point_in_ring2d(const lahar_body *bd, vec3 x)
     return inside;
 }
 
-/* Lattice points of the blocks inside bodies (the swept solid) at t = 0 would start as crossed
- * particles; points of two blocks at the same place would double the mass. */
+int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
+{
+    const lahar_shape *s = &bd->shape;
+    vec3 p = v3_load(x), cp;
+    int feat;
+    if (geom_point_body_core(s, bd->x, bd->q, p, &cp, &feat) < s->radius)
+        return 1;
+    /* the core's interior: geom_point_body_core measures to its boundary features only */
+    if (dim == 2 && s->nv >= 3 && s->ne == s->nv)
+        return point_in_ring2d(bd, p);
+    if (dim == 3 && bd->convex && s->nf >= 4) {
+        quat q = q_load(bd->q);
+        for (int f = 0; f < s->nf; f++) {
+            vec3 nf = q_rotate(q, geom_face_normal(s, f));
+            vec3 p0 = geom_world_vertex(s, bd->x, bd->q, s->face_v[s->face_start[f]]);
+            if (v3_dot(v3_sub(p, p0), nf) >= 0)
+                return 0;
+        }
+        return 1;
+    }
+    return 0;
+}
+
+int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap)
+{
+    const lahar_particle_block *b = &c->blocks[block];
+    const int dim = c->dim;
+    const double dx = c->sph_dx;
+    /* bounding sphere of every body about its x, to skip the exact test for most points (fixed
+     * bodies keep world coordinates with x = 0: the sphere still covers them) */
+    double *reach = malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof *reach);
+    if (!reach)
+        return -1;
+    for (int m = 0; m < c->nbody; m++) {
+        const lahar_body *bd = &c->bodies[m];
+        reach[m] = 0.0;
+        for (int v = 0; v < bd->shape.nv; v++)
+            reach[m] = fmax(reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
+        reach[m] += bd->shape.radius;
+    }
+    int64_t n[3];
+    for (int a = 0; a < 3; a++) {
+        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
+        if (n[a] < 0)
+            n[a] = 0;
+    }
+    int64_t count = 0;
+    for (int64_t i = 0; i < n[0]; i++)
+        for (int64_t j = 0; j < n[1]; j++)
+            for (int64_t k = 0; k < n[2]; k++) {
+                double x[3] = {b->lo[0] + ((double)i + 0.5) * dx, b->lo[1] + ((double)j + 0.5) * dx,
+                               dim == 2 ? 0.0 : b->lo[2] + ((double)k + 0.5) * dx};
+                if (b->kind != LAHAR_BLOCK_BOX && !lahar_particle_block_contains(b, dim, x))
+                    continue;
+                int cut = 0;
+                for (int m = 0; m < c->nbody && !cut; m++) {
+                    const lahar_body *bd = &c->bodies[m];
+                    double d2 = 0;
+                    for (int a = 0; a < 3; a++)
+                        d2 += (x[a] - bd->x[a]) * (x[a] - bd->x[a]);
+                    if (d2 <= reach[m] * reach[m])
+                        cut = lahar_body_contains(bd, dim, x);
+                }
+                if (cut)
+                    continue;
+                if (out && count < cap)
+                    memcpy(out[count], x, sizeof x);
+                count++;
+            }
+    free(reach);
+    return count;
+}
+
+/* Blocks must hold particles; on periodic axes they stay inside the period; two boxes must not
+ * overlap (their particles would be created twice). */
 static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
 {
     const int dim = c->dim;
@@ -1332,12 +1405,6 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
         char key[KEY_MAX];
         snprintf(key, sizeof key, "sph.blocks[%d]", i);
         yaml_node_t *bn = seq_item(r, bl, i);
-        int64_t np = lahar_particle_block_lattice(b, dim, dx, NULL, 0);
-        if (np == 0) {
-            rd_fail(r, bn, key, "'%s' holds no particle at dx = %g (its region is smaller than one lattice cell or "
-                    "misses every lattice point lo + (i + 1/2) dx); enlarge it or lower sph.dx", b->name, dx);
-            return;
-        }
         for (int a = 0; a < dim; a++)
             if (c->sph.periodic[a] && (b->lo[a] < c->sph.lo[a] - 1e-9 * dx || b->hi[a] > c->sph.hi[a] + 1e-9 * dx)) {
                 rd_fail(r, bn, key, "'%s' reaches outside the period [%g, %g] of axis %c (block [%g, %g]); keep "
@@ -1357,54 +1424,16 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
                 return;
             }
         }
-        if (c->nbody == 0)
-            continue;
-        double (*pts)[3] = malloc((size_t)np * sizeof *pts);
-        if (!pts) {
+        int64_t np = lahar_case_block_lattice(c, i, NULL, 0);
+        if (np < 0) {
             rd_fail(r, bn, key, "out of memory");
             return;
         }
-        lahar_particle_block_lattice(b, dim, dx, pts, np);
-        for (int k = 0; k < c->nbody && !r->failed; k++) {
-            const lahar_body *bd = &c->bodies[k];
-            /* bounding sphere of the body about its position */
-            double reach = 0;
-            for (int v = 0; v < bd->shape.nv; v++)
-                reach = fmax(reach, v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
-            reach += bd->shape.radius;
-            int64_t inside = 0, first = -1;
-            for (int64_t p = 0; p < np; p++) {
-                vec3 x = v3_load(pts[p]);
-                if (v3_norm(v3_sub(x, v3_load(bd->x))) > reach)
-                    continue;
-                vec3 cp;
-                int feat;
-                double d = geom_point_body_core(&bd->shape, bd->x, bd->q, x, &cp, &feat);
-                /* closed convex cores: a point inside the core has distance 0 to no feature, so
-                 * test the point against the solid with the core faces too */
-                int in = d < bd->shape.radius * (1.0 - 1e-9);
-                if (!in && dim == 2 && bd->shape.nv >= 3 && bd->shape.ne == bd->shape.nv)
-                    in = point_in_ring2d(bd, x);
-                if (!in && dim == 3 && bd->convex && bd->shape.nf > 0) {
-                    in = 1;
-                    for (int f = 0; f < bd->shape.nf && in; f++) {
-                        vec3 nf = q_rotate(q_load(bd->q), geom_face_normal(&bd->shape, f));
-                        vec3 p0 = geom_world_vertex(&bd->shape, bd->x, bd->q, bd->shape.face_v[bd->shape.face_start[f]]);
-                        in = v3_dot(v3_sub(x, p0), nf) < 0;
-                    }
-                }
-                if (in) {
-                    if (first < 0)
-                        first = p;
-                    inside++;
-                }
-            }
-            if (inside > 0)
-                rd_fail(r, bn, key, "%lld particles of '%s' would start inside body '%s' (first at [%g, %g, %g]); "
-                        "particles must start outside bodies: shrink the block or shape it with polygon:/stl:",
-                        (long long)inside, b->name, bd->name, pts[first][0], pts[first][1], pts[first][2]);
+        if (np == 0) {
+            rd_fail(r, bn, key, "'%s' holds no particle at dx = %g (its region misses every lattice point "
+                    "lo + (i + 1/2) dx outside the bodies); enlarge it or lower sph.dx", b->name, dx);
+            return;
         }
-        free(pts);
     }
 }
 

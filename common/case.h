@@ -26,6 +26,18 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
  * zeroed case. */
 void lahar_case_free(lahar_case *c);
 
+/* Particles of block `block` at t = 0: the lattice points of lahar_particle_block_lattice
+ * (shape_build.h) that lie outside every body, so water poured around a cylinder or under a
+ * floating box leaves the bodies' room empty. Writes the first `cap` points to out (NULL to
+ * count) and returns how many there are, or -1 when out of memory. The SPH node fills its
+ * particles with this (mass rho0 dx^D each, the block's velocity). */
+int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap);
+
+/* 1 if the world point x lies in body b's solid at its stored pose: within the sweep radius of
+ * the core, or inside a closed core (2D: a closed ring of vertices, polygons, boxes and closed
+ * polylines alike; 3D: a convex polyhedron with >= 4 faces). */
+int lahar_body_contains(const lahar_body *b, int dim, const double x[3]);
+
 /* Index of the body / material called `name`, or -1. */
 int lahar_case_find_body(const lahar_case *c, const char *name);
 int lahar_case_find_material(const lahar_case *c, const char *name);
