@@ -45,21 +45,22 @@ static int check_read_attr(hid_t loc, const char *name, hid_t type, void *buf)
     return rc < 0 ? -1 : 0;
 }
 
-/* The first n rows of the int32 dataset `name` (n x ncol): other datasets of the force stream
- * may be ahead of /t while a writer is appending. */
-static int check_read_rows(hid_t loc, const char *name, hsize_t n, int ncol, int32_t *buf)
+/* The first n rows of the dataset `name` (n x ncol, or n x ncol/3 x 3 for the force rows): other
+ * datasets of the force stream may be ahead of /t while a writer is appending. */
+static int check_read_rows(hid_t loc, const char *name, hid_t type, hsize_t n, int ncol, void *buf)
 {
     hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT);
     if (ds < 0)
         return -1;
     hid_t fsp = H5Dget_space(ds);
-    hsize_t dims[2] = {0, 0}, off[2] = {0, 0}, cnt[2] = {n, (hsize_t)ncol};
-    int rc = -1;
-    if (H5Sget_simple_extent_ndims(fsp) == 2 && H5Sget_simple_extent_dims(fsp, dims, NULL) == 2 && dims[0] >= n &&
-        dims[1] == (hsize_t)ncol) {
-        hid_t msp = H5Screate_simple(2, cnt, NULL);
+    hsize_t dims[3] = {0, 0, 0}, off[3] = {0, 0, 0};
+    int rank = H5Sget_simple_extent_ndims(fsp), rc = -1;
+    if ((rank == 2 || rank == 3) && H5Sget_simple_extent_dims(fsp, dims, NULL) == rank && dims[0] >= n &&
+        (rank == 2 ? dims[1] == (hsize_t)ncol : dims[1] * dims[2] == (hsize_t)ncol)) {
+        hsize_t cnt[3] = {n, dims[1], dims[2]};
+        hid_t msp = H5Screate_simple(rank, cnt, NULL);
         H5Sselect_hyperslab(fsp, H5S_SELECT_SET, off, NULL, cnt, NULL);
-        rc = H5Dread(ds, H5T_NATIVE_INT32, msp, fsp, H5P_DEFAULT, buf) < 0 ? -1 : 0;
+        rc = H5Dread(ds, type, msp, fsp, H5P_DEFAULT, buf) < 0 ? -1 : 0;
         H5Sclose(msp);
     }
     H5Sclose(fsp);
@@ -87,12 +88,129 @@ static int check_load_forces(const char *outdir, lahar_check_data *d)
         d->nrow = (int64_t)n;
         d->ft = malloc((n ? n : 1) * sizeof *d->ft);
         d->ncontacts = malloc((n ? n : 1) * (size_t)(d->nbody ? d->nbody : 1) * sizeof *d->ncontacts);
-        if (d->ft && d->ncontacts && (n == 0 || (!check_read(f, "t", H5T_NATIVE_DOUBLE, (hssize_t)n, d->ft) &&
-                                                 (d->nbody == 0 || !check_read_rows(f, "ncontacts", n, d->nbody,
-                                                                                    d->ncontacts)))))
+        d->force = malloc((n ? n : 1) * (size_t)(d->nbody ? d->nbody : 1) * 3 * sizeof *d->force);
+        if (d->ft && d->ncontacts && d->force &&
+            (n == 0 ||
+             (!check_read(f, "t", H5T_NATIVE_DOUBLE, (hssize_t)n, d->ft) &&
+              (d->nbody == 0 ||
+               (!check_read_rows(f, "ncontacts", H5T_NATIVE_INT32, n, d->nbody, d->ncontacts) &&
+                !check_read_rows(f, "force", H5T_NATIVE_DOUBLE, n, 3 * d->nbody, d->force))))))
             rc = 0;
     }
     H5Fclose(f);
+    return rc;
+}
+
+/* OUT/particles.h5: header, snapshot times and counts; the file stays open for
+ * lahar_check_particles_read. No file: d->particles stays NULL. */
+static int check_load_particles(const char *outdir, lahar_check_data *d, char *err, size_t n)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/particles.h5", outdir);
+    if (access(path, R_OK) != 0)
+        return 0;
+    lahar_check_particles *p = calloc(1, sizeof *p);
+    if (!p) {
+        snprintf(err, n, "out of memory");
+        return -1;
+    }
+    d->particles = p;
+    p->cur = -1;
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_file_locking(fapl, 0, 1);
+    hid_t f = lahar_h5_file_open(path, H5F_ACC_RDONLY, fapl, 0);
+    H5Pclose(fapl);
+    if (f < 0) {
+        snprintf(err, n, "%s: not a readable HDF5 file", path);
+        return -1;
+    }
+    p->file = (int64_t)f;
+    int64_t dim = 0, fields = 0;
+    hid_t h = H5Gopen2(f, "header", H5P_DEFAULT);
+    hid_t g = H5Gopen2(f, "snapshots", H5P_DEFAULT);
+    H5G_info_t info = {0};
+    int rc = (h < 0 || g < 0 || check_read_attr(h, "dimensions", H5T_NATIVE_INT64, &dim) ||
+              check_read_attr(h, "fields", H5T_NATIVE_INT64, &fields) ||
+              check_read_attr(h, "dx", H5T_NATIVE_DOUBLE, &p->dx) ||
+              check_read_attr(h, "rest_density", H5T_NATIVE_DOUBLE, &p->rest_density) || H5Gget_info(g, &info) < 0)
+                 ? -1
+                 : 0;
+    if (h >= 0)
+        H5Gclose(h);
+    p->dim = (int)dim;
+    p->fields = (unsigned)fields;
+    size_t ns = info.nlinks ? info.nlinks : 1;
+    p->t = malloc(ns * sizeof *p->t);
+    p->n = malloc(ns * sizeof *p->n);
+    if (!rc && (!p->t || !p->n))
+        rc = -1;
+    for (hsize_t k = 0; rc == 0 && k < info.nlinks; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "%06" PRId64, (int64_t)k);
+        if (H5Lexists(g, name, H5P_DEFAULT) <= 0)
+            break;
+        hid_t s = H5Gopen2(g, name, H5P_DEFAULT);
+        if (s < 0 || check_read_attr(s, "time", H5T_NATIVE_DOUBLE, &p->t[k]) ||
+            check_read_attr(s, "n", H5T_NATIVE_INT64, &p->n[k]) || p->n[k] < 0)
+            rc = -1;
+        if (s >= 0)
+            H5Gclose(s);
+        if (rc == 0) {
+            p->nsnap = (int64_t)k + 1;
+            if (p->n[k] > p->nmax)
+                p->nmax = p->n[k];
+        }
+    }
+    if (g >= 0)
+        H5Gclose(g);
+    if (rc) {
+        snprintf(err, n, "%s: no /header or unreadable snapshot %" PRId64 " (not written by lahar?)", path, p->nsnap);
+        return -1;
+    }
+    size_t nm = (size_t)(p->nmax ? p->nmax : 1) * sizeof(double);
+    int vel = (p->fields & LAHAR_PFIELD_VELOCITY) != 0;
+    p->x = malloc(nm), p->y = malloc(nm), p->z = malloc(nm);
+    p->vx = vel ? malloc(nm) : NULL, p->vy = vel ? malloc(nm) : NULL, p->vz = vel ? malloc(nm) : NULL;
+    p->density = (p->fields & LAHAR_PFIELD_DENSITY) ? malloc(nm) : NULL;
+    p->pressure = (p->fields & LAHAR_PFIELD_PRESSURE) ? malloc(nm) : NULL;
+    if (!p->x || !p->y || !p->z || (vel && (!p->vx || !p->vy || !p->vz)) ||
+        ((p->fields & LAHAR_PFIELD_DENSITY) && !p->density) || ((p->fields & LAHAR_PFIELD_PRESSURE) && !p->pressure)) {
+        snprintf(err, n, "out of memory for %" PRId64 " particles", p->nmax);
+        return -1;
+    }
+    return 0;
+}
+
+int lahar_check_particles_read(lahar_check_particles *p, int64_t k, char *err, size_t n)
+{
+    if (k == p->cur)
+        return 0;
+    if (k < 0 || k >= p->nsnap) {
+        snprintf(err, n, "particles.h5: no snapshot %" PRId64 " (have %" PRId64 ")", k, p->nsnap);
+        return -1;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "snapshots/%06" PRId64, k);
+    hid_t s = H5Gopen2((hid_t)p->file, name, H5P_DEFAULT);
+    if (s < 0) {
+        snprintf(err, n, "particles.h5: cannot open %s", name);
+        return -1;
+    }
+    hssize_t cnt = (hssize_t)p->n[k];
+    const struct {
+        const char *name;
+        double *buf;
+    } col[] = {{"x", p->x},   {"y", p->y},   {"z", p->z},       {"vx", p->vx},
+               {"vy", p->vy}, {"vz", p->vz}, {"density", p->density}, {"pressure", p->pressure}};
+    int rc = 0;
+    for (size_t i = 0; i < sizeof col / sizeof col[0] && rc == 0; i++)
+        if (col[i].buf && cnt > 0 && check_read(s, col[i].name, H5T_NATIVE_DOUBLE, cnt, col[i].buf)) {
+            snprintf(err, n, "particles.h5: %s/%s missing or not %" PRId64 " values", name, col[i].name, p->n[k]);
+            rc = -1;
+        }
+    H5Gclose(s);
+    p->cur = rc ? -1 : k;
+    p->cur_n = rc ? 0 : p->n[k];
     return rc;
 }
 
@@ -132,9 +250,10 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
     d->t = malloc(ns * sizeof *d->t);
     d->step = malloc(ns * sizeof *d->step);
     d->x = malloc(ns * nb3 * sizeof *d->x);
+    d->q = malloc(ns * nb3 / 3 * 4 * sizeof *d->q);
     d->v = malloc(ns * nb3 * sizeof *d->v);
     d->w = malloc(ns * nb3 * sizeof *d->w);
-    int rc = (d->t && d->step && d->x && d->v && d->w) ? 0 : -1;
+    int rc = (d->t && d->step && d->x && d->q && d->v && d->w) ? 0 : -1;
     for (hsize_t k = 0; rc == 0 && k < info.nlinks; k++) {
         char name[32];
         snprintf(name, sizeof name, "%06" PRId64, (int64_t)k);
@@ -144,6 +263,8 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
         if (s < 0 || check_read_attr(s, "time", H5T_NATIVE_DOUBLE, &d->t[k]) ||
             check_read_attr(s, "step", H5T_NATIVE_INT64, &d->step[k]) ||
             (nbody > 0 && (check_read(s, "position", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->x + k * nb3) ||
+                           check_read(s, "quaternion", H5T_NATIVE_DOUBLE, (hssize_t)(nb3 / 3 * 4),
+                                      d->q + k * nb3 / 3 * 4) ||
                            check_read(s, "velocity", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->v + k * nb3) ||
                            check_read(s, "angular_velocity", H5T_NATIVE_DOUBLE, (hssize_t)nb3, d->w + k * nb3))))
             rc = -1;
@@ -164,24 +285,75 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
         lahar_check_data_free(d);
         return -1;
     }
+    if (check_load_particles(outdir, d, err, n)) {
+        lahar_check_data_free(d);
+        return -1;
+    }
     return 0;
+}
+
+static void check_particles_free(lahar_check_particles *p)
+{
+    if (!p)
+        return;
+    if (p->file > 0)
+        H5Fclose((hid_t)p->file);
+    free(p->t), free(p->n), free(p->x), free(p->y), free(p->z), free(p->vx), free(p->vy), free(p->vz);
+    free(p->density), free(p->pressure);
+    free(p);
 }
 
 void lahar_check_data_free(lahar_check_data *d)
 {
-    free(d->t), free(d->step), free(d->x), free(d->v), free(d->w), free(d->ft), free(d->ncontacts);
+    free(d->t), free(d->step), free(d->x), free(d->q), free(d->v), free(d->w), free(d->ft), free(d->ncontacts);
+    free(d->force);
+    check_particles_free(d->particles);
     memset(d, 0, sizeof *d);
 }
 
 /* ---------------------------------------------------------------- evaluator helpers ----- */
 
-static void check_value(lahar_check_result *r, const char *name, double v)
+void lahar_check_value(lahar_check_result *r, const char *name, double v)
 {
-    if (r->nvalue >= LAHAR_CHECK_MAX_VALUES)
+    if (r->nvalue >= LAHAR_CHECK_MAX_VALUES || strlen(name) >= sizeof r->value[0].name)
         return;
     snprintf(r->value[r->nvalue].name, sizeof r->value[0].name, "%s", name);
     r->value[r->nvalue].value = v;
     r->nvalue++;
+}
+#define check_value lahar_check_value
+
+int lahar_check_panel(lahar_check_result *r, const char *title, const char *xlabel, const char *ylabel)
+{
+    if (r->npanel >= LAHAR_CHECK_MAX_PANELS)
+        return -1;
+    snprintf(r->panel[r->npanel].title, sizeof r->panel[0].title, "%s", title);
+    snprintf(r->panel[r->npanel].xlabel, sizeof r->panel[0].xlabel, "%s", xlabel);
+    snprintf(r->panel[r->npanel].ylabel, sizeof r->panel[0].ylabel, "%s", ylabel);
+    return r->npanel++;
+}
+
+int lahar_check_curve(lahar_check_result *r, int panel, int measured, const char *label)
+{
+    if (panel < 0 || panel >= r->npanel || r->ncurve >= LAHAR_CHECK_MAX_CURVES)
+        return -1;
+    r->curve[r->ncurve].panel = panel;
+    r->curve[r->ncurve].measured = measured;
+    snprintf(r->curve[r->ncurve].label, sizeof r->curve[0].label, "%s", label);
+    r->curve[r->ncurve].start = r->npoint;
+    r->curve[r->ncurve].n = 0;
+    r->ncurve++;
+    return 0;
+}
+
+void lahar_check_point(lahar_check_result *r, double x, double y)
+{
+    if (r->ncurve == 0 || r->npoint >= LAHAR_CHECK_MAX_POINTS || !r->px)
+        return;
+    r->px[r->npoint] = x;
+    r->py[r->npoint] = y;
+    r->npoint++;
+    r->curve[r->ncurve - 1].n++;
 }
 
 static vec3 check_vec(const lahar_check_data *d, const double *a, int64_t k, int b)
@@ -539,6 +711,18 @@ static const lahar_check_reference check_references[] = {
      "restitution_rel_error", 0.01, check_restitution},
     {"incline_roll", "sphere/disc on a fixed incline: fitted acceleration vs rolling or sliding theory",
      "accel_rel_error", 0.01, check_incline_roll},
+    {"poiseuille", "plane Poiseuille flow between fixed plates: velocity profiles vs the transient series, plate force",
+     "steady_l2_rel_error", 0.01, lahar_check_poiseuille},
+    {"cylinder_array", "periodic square array of cylinders: K = rho g L^2/(mu U_s) vs Sangani & Acrivos 1982",
+     "K_rel_error", 0.05, lahar_check_cylinder_array},
+    {"hydrostatic", "water at rest in a tank: wall force vs rho g h^2/2, pressure vs rho g (h - y)",
+     "wall_force_rel_error", 0.01, lahar_check_hydrostatic},
+    {"floating_box", "box floating in water: draft vs Archimedes rho_b h/rho_f", "draft_rel_error", 0.02,
+     lahar_check_floating_box},
+    {"sinking_disc", "dense disc sinking onto the floor: no penetration, comes to rest", "floor_penetration", 0.0,
+     lahar_check_sinking_disc},
+    {"dam_break", "collapsing water column: particle count conserved, no particle escapes, front monotonic",
+     "escaped_particles", 0.0, lahar_check_dam_break},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 
@@ -550,7 +734,11 @@ const lahar_check_reference *lahar_check_find(const char *name)
     return NULL;
 }
 
-const char *lahar_check_names(void) { return "restitution, incline_roll"; }
+const char *lahar_check_names(void)
+{
+    return "restitution, incline_roll, poiseuille, cylinder_array, hydrostatic, floating_box, sinking_disc, "
+           "dam_break";
+}
 
 static int check_write_json(const char *path, cJSON *root)
 {
@@ -632,8 +820,14 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
         lahar_check_data_free(&d);
         return check_fail(outdir, ref->name, msg);
     }
+    if (d.particles && d.particles->dim != c->dim) {
+        snprintf(msg, sizeof msg, "%s/particles.h5 is %dD, the case %s is %dD: output of another case?", outdir,
+                 d.particles->dim, c->path, c->dim);
+        lahar_check_data_free(&d);
+        return check_fail(outdir, ref->name, msg);
+    }
     lahar_check_result *r = calloc(1, sizeof *r);
-    double *series = malloc(3 * LAHAR_CHECK_MAX_SERIES * sizeof *series);
+    double *series = malloc((3 * LAHAR_CHECK_MAX_SERIES + 2 * LAHAR_CHECK_MAX_POINTS) * sizeof *series);
     if (!r || !series) {
         free(r), free(series);
         lahar_check_data_free(&d);
@@ -641,6 +835,7 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
     }
     r->series_t = series, r->series_measured = series + LAHAR_CHECK_MAX_SERIES;
     r->series_reference = series + 2 * LAHAR_CHECK_MAX_SERIES;
+    r->px = series + 3 * LAHAR_CHECK_MAX_SERIES, r->py = r->px + LAHAR_CHECK_MAX_POINTS;
     int rc = ref->evaluate(c, &d, r);
     lahar_check_data_free(&d);
     if (rc) {
@@ -694,6 +889,28 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
     cJSON_AddItemToObject(plot, "t", cJSON_CreateDoubleArray(r->series_t, r->nseries));
     cJSON_AddItemToObject(plot, "measured", cJSON_CreateDoubleArray(r->series_measured, r->nseries));
     cJSON_AddItemToObject(plot, "reference", cJSON_CreateDoubleArray(r->series_reference, r->nseries));
+    if (r->npanel > 0) {
+        cJSON *panels = cJSON_AddArrayToObject(plot, "panels");
+        for (int p = 0; p < r->npanel; p++) {
+            cJSON *pj = cJSON_CreateObject();
+            cJSON_AddStringToObject(pj, "title", r->panel[p].title);
+            cJSON_AddStringToObject(pj, "xlabel", r->panel[p].xlabel);
+            cJSON_AddStringToObject(pj, "ylabel", r->panel[p].ylabel);
+            cJSON_AddBoolToObject(pj, "ylog", r->panel[p].ylog);
+            cJSON *curves = cJSON_AddArrayToObject(pj, "curves");
+            for (int k = 0; k < r->ncurve; k++) {
+                if (r->curve[k].panel != p)
+                    continue;
+                cJSON *cj = cJSON_CreateObject();
+                cJSON_AddStringToObject(cj, "label", r->curve[k].label);
+                cJSON_AddStringToObject(cj, "kind", r->curve[k].measured ? "measured" : "reference");
+                cJSON_AddItemToObject(cj, "x", cJSON_CreateDoubleArray(r->px + r->curve[k].start, r->curve[k].n));
+                cJSON_AddItemToObject(cj, "y", cJSON_CreateDoubleArray(r->py + r->curve[k].start, r->curve[k].n));
+                cJSON_AddItemToArray(curves, cj);
+            }
+            cJSON_AddItemToArray(panels, pj);
+        }
+    }
     char path[1200];
     snprintf(path, sizeof path, "%s/check.json", outdir);
     int wrc = check_write_json(path, root);

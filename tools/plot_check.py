@@ -3,9 +3,12 @@
 
   tools/plot_check.py OUT [-o FILE.png]
 
-check.json carries the measured and reference series ("plot": t, measured, reference) and the
-metrics; `lahar check` runs this script itself after writing check.json. Exit 3 when matplotlib
-is missing (lahar check then says so and keeps check.json)."""
+check.json carries the metrics and either one measured/reference series over t ("plot": t,
+measured, reference; drawn with the residual below it) or panels of labelled curves ("plot":
+panels: [{title, xlabel, ylabel, ylog, curves: [{label, kind: measured|reference, x, y}]}], one
+subplot each: e.g. velocity profiles at several times next to the analytic ones, a force history
+next to its reference line). `lahar check` runs this script itself after writing check.json.
+Exit 3 when matplotlib is missing (lahar check then says so and keeps check.json)."""
 import argparse
 import json
 import os
@@ -21,6 +24,55 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+def fmt(v):
+    """A metric value; cJSON writes NaN as null."""
+    return "nan" if v is None else f"{v:.4g}"
+
+
+def plot_series(plot, summary):
+    """One measured/reference series over t, the residual below."""
+    fig, (ax, axr) = plt.subplots(2, 1, sharex=True, figsize=(8, 7), gridspec_kw={"height_ratios": [3, 1]})
+    t, meas, ref = plot["t"], plot["measured"], plot["reference"]
+    ax.plot(t, meas, "o", ms=3, label="lahar")
+    ax.plot(t, ref, "-", label="reference")
+    ax.set_ylabel(plot.get("ylabel", ""))
+    ax.legend(loc="best")
+    ax.set_title(summary, fontsize=9)
+    axr.plot(t, [m - r for m, r in zip(meas, ref)], ".", ms=3)
+    axr.set_ylabel("lahar - reference")
+    axr.set_xlabel(plot.get("xlabel", ""))
+    fig.tight_layout()
+    return fig
+
+
+def plot_panels(panels, summary):
+    """One subplot per panel; measured curves as markers, reference curves as lines, a measured
+    curve and the reference curve that follows it share a colour (profile i vs series i)."""
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 4.2 * len(panels)), squeeze=False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
+    for ax, panel in zip(axes[:, 0], panels):
+        ci = -1
+        for curve in panel.get("curves", []):
+            measured = curve.get("kind") == "measured"
+            if measured or ci < 0:
+                ci += 1
+            colour = colours[ci % len(colours)]
+            if measured:
+                ax.plot(curve["x"], curve["y"], "o", ms=3, color=colour, label=curve.get("label", "lahar"))
+            else:
+                ax.plot(curve["x"], curve["y"], "-", lw=1.2, color=colour, label=curve.get("label", "reference"))
+        if panel.get("ylog"):
+            ax.set_yscale("log")
+        ax.set_xlabel(panel.get("xlabel", ""))
+        ax.set_ylabel(panel.get("ylabel", ""))
+        ax.set_title(panel.get("title", ""), fontsize=9)
+        if len(panel.get("curves", [])) <= 14:
+            ax.legend(loc="best", fontsize=7)
+    fig.suptitle(summary, fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", help="run output directory (holds check.json)")
@@ -33,23 +85,17 @@ def main():
     except (OSError, ValueError) as e:
         print(f"plot_check: {path}: {e}", file=sys.stderr)
         return 2
-    plot = check.get("plot")
-    if not plot or not plot.get("t"):
+    plot = check.get("plot") or {}
+    lines = [f"{name} = {fmt(m.get('value'))} (bound {fmt(m.get('bound'))}) {'pass' if m.get('pass') else 'FAIL'}"
+             for name, m in check.get("metrics", {}).items()]
+    summary = (plot.get("title") or check.get("reference", "")) + "\n" + "; ".join(lines)
+    if plot.get("panels"):
+        fig = plot_panels(plot["panels"], summary)
+    elif plot.get("t"):
+        fig = plot_series(plot, summary)
+    else:
         print(f"plot_check: {path}: nothing to plot ({check.get('error', 'no series')})", file=sys.stderr)
         return 2
-    fig, (ax, axr) = plt.subplots(2, 1, sharex=True, figsize=(8, 7), gridspec_kw={"height_ratios": [3, 1]})
-    t, meas, ref = plot["t"], plot["measured"], plot["reference"]
-    ax.plot(t, meas, "o", ms=3, label="lahar")
-    ax.plot(t, ref, "-", label="reference")
-    ax.set_ylabel(plot.get("ylabel", ""))
-    ax.legend(loc="best")
-    lines = [f"{name} = {m['value']:.4g} (bound {m['bound']:.4g}) {'pass' if m['pass'] else 'FAIL'}"
-             for name, m in check.get("metrics", {}).items()]
-    ax.set_title(plot.get("title", check.get("reference", "")) + "\n" + "; ".join(lines), fontsize=9)
-    axr.plot(t, [m - r for m, r in zip(meas, ref)], ".", ms=3)
-    axr.set_ylabel("lahar - reference")
-    axr.set_xlabel(plot.get("xlabel", ""))
-    fig.tight_layout()
     out = args.output or os.path.join(args.out, "check.png")
     fig.savefig(out, dpi=120)
     print(f"plot_check: wrote {out} ({'PASS' if check.get('pass') else 'FAIL'})")
