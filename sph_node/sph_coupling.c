@@ -7,28 +7,32 @@
 #include "geometry.h"
 #include "vec.h"
 
-/* G(d) = int over the half-space behind the wall (depth s > 0) of (1 + s/d) W'(r)/r dV, for a
- * particle at distance d in front of it; midpoint rule, fine enough for 1e-4 relative. */
-static double halfspace_integral(const kernel *k, int dim, double d)
+/* G(d) = sum over ghost layers at depths s_k = (k + 1/2) dx behind the surface of
+ * (1 + s_k/d) dx int_layer W'(r)/r r^2/(r^2 + eta^2) dA, for a particle at distance d in front of it.
+ * The layers mirror the fluid lattice (first fluid row at dx/2 in front of the surface, first
+ * ghost layer at dx/2 behind it), so for a linear velocity field the fluid rows and the ghosts
+ * cancel like a full lattice does; a continuous half-space integral instead leaves 4 % of the wall
+ * shear as a spurious force dipole on the first two rows (cubic, h = 1.3 dx). Within a layer the
+ * integral is continuous (midpoint rule), since the fluid slides along the wall. */
+static double ghost_layers(const kernel *k, int dim, double d, double dx)
 {
-    const int ns = 240, nt = 240;
-    double S = k->support;
-    if (d >= S)
-        return 0.0;
-    double smax = S - d, ds = smax / ns, dt = S / nt, g = 0.0;
-    for (int a = 0; a < ns; a++) {
-        double s = (a + 0.5) * ds, y = d + s, beta = 1.0 + s / d;
-        double row = 0.0;
+    const int nt = 2000;
+    double S = k->support, eta2 = 0.01 * k->h * k->h, dt = S / nt, g = 0.0;
+    for (int l = 0;; l++) {
+        double s = (l + 0.5) * dx, y = d + s;
+        if (y >= S)
+            break;
+        double layer = 0.0;
         for (int b = 0; b < nt; b++) {
-            double t = (b + 0.5) * dt, r = sqrt(t * t + y * y);
+            double t = (b + 0.5) * dt, r2 = t * t + y * y, r = sqrt(r2);
             if (r >= S)
                 break;
-            double f = kernel_dwdr(k, r) / r;
-            row += dim == 2 ? 2.0 * f : 2.0 * M_PI * t * f; /* 2D: both sides of the normal; 3D: ring */
+            double f = kernel_dwdr(k, r) / r * r2 / (r2 + eta2);
+            layer += dim == 2 ? 2.0 * f : 2.0 * M_PI * t * f; /* 2D: both sides of the normal; 3D: ring */
         }
-        g += beta * row * dt;
+        g += (1.0 + s / d) * layer * dt * dx;
     }
-    return g * ds;
+    return g;
 }
 
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d)
@@ -86,7 +90,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->gtab_d0 = 0.5 * c->eps;
     c->gtab_dd = (k->support - c->gtab_d0) / SPH_COUPLING_GTAB;
     for (int i = 0; i <= SPH_COUPLING_GTAB; i++)
-        c->gtab[i] = halfspace_integral(k, dim, c->gtab_d0 + i * c->gtab_dd);
+        c->gtab[i] = ghost_layers(k, dim, c->gtab_d0 + i * c->gtab_dd, dx);
     return 0;
 }
 
@@ -146,7 +150,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
     if (n > c->pcap)
         return -1;
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         int ns = 0;
         vec3 xi = v3(p->x[i], p->y[i], p->z[i]);

@@ -25,10 +25,12 @@
 
 /* The wall viscous force (virtual particle term). */
 typedef enum {
-    /* Default. The Morris (1997) viscous operator integrated over the half-space behind the
-     * body's surface, with the no-slip ghost velocity extrapolated as in Morris et al. (1997):
-     * u_ghost - u_wall = -(s/d)(u_i - u_wall) at depth s behind the surface. Then
-     *   a_tau = (2 mu_i / rho_i) G(d) u_rel,  G(d) = int_{s > 0} (1 + s/d) W'(r)/r dV
+    /* Default. The Morris (1997) viscous operator summed over ghost layers behind the body's
+     * surface, at depths s_k = (k + 1/2) dx (the mirror image of the fluid lattice), with the
+     * no-slip ghost velocity extrapolated as in Morris et al. (1997):
+     * u_ghost - u_wall = -(s/d)(u_i - u_wall). Then
+     *   a_tau = (2 mu_i / rho_i) G(d) u_rel,
+     *   G(d) = sum_k (1 + s_k/d) dx int_layer W'(r)/r r^2/(r^2 + eta^2) dA
      * which is the "readjusted normalising constant" idea of eq. 18 made exact for a flat wall:
      * the single virtual particle carries the whole missing neighbourhood. G is tabulated at setup
      * over d in [eps/2, kappa h] (d is clamped to eps/2 below). */

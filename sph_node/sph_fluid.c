@@ -164,7 +164,7 @@ static void fluid_pass(sph_fluid *f)
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
         switch (kind) {
@@ -184,7 +184,7 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const sph_params prm = f->prm;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++)
         p->p[i] = sph_fluid_pressure(&prm, p->rho[i]);
     fluid_pass(f);
@@ -195,7 +195,7 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
             return -1;
     }
     double vmax2 = 0.0, amax2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : vmax2, amax2)
+#pragma omp parallel for schedule(static) reduction(max : vmax2, amax2) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i];
         double a2 = p->ax[i] * p->ax[i] + p->ay[i] * p->ay[i] + p->az[i] * p->az[i];
@@ -218,7 +218,7 @@ int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
     const int64_t n = p->n;
     const double hdt = 0.5 * dt;
     const int d3 = f->prm.dim == 3;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         /* kick (half), drift, predict */
         p->vhx[i] = p->vx[i] + hdt * p->ax[i];
@@ -238,7 +238,7 @@ int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
     int64_t cross = sph_fluid_rates(f, states, dt);
     if (cross < 0)
         return -1;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         /* kick (half) with the new rates */
         p->vx[i] = p->vhx[i] + hdt * p->ax[i];

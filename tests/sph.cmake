@@ -4,3 +4,8 @@ add_executable(test_kernel ${LAHAR_TEST_DIR}/test_kernel.c)
 target_link_libraries(test_kernel PRIVATE lahar_common)
 add_test(NAME sph_kernel COMMAND test_kernel)
 set_tests_properties(sph_kernel PROPERTIES LABELS "fast;sph")
+
+add_executable(test_sph_poiseuille ${LAHAR_TEST_DIR}/test_sph_poiseuille.c)
+target_link_libraries(test_sph_poiseuille PRIVATE lahar_sph)
+add_test(NAME sph_poiseuille COMMAND test_sph_poiseuille)
+set_tests_properties(sph_poiseuille PROPERTIES LABELS "fast;sph" TIMEOUT 300)
