@@ -80,7 +80,7 @@ typedef struct {
 } lahar_particle_block;
 
 /* Weakly compressible SPH and the SPH-DEM coupling (section sph: of a case; every key is
- * documented in cases/dam_break_2d.yaml). Together with lahar_case.sph_dx (particle spacing) and
+ * documented in cases/dem_drop_3d.yaml). Together with lahar_case.sph_dx (particle spacing) and
  * lahar_case.sph_density (rest density) this is everything the SPH node needs (sph_params of
  * sph_node/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
 typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
