@@ -9,3 +9,8 @@ add_executable(test_sph_poiseuille ${LAHAR_TEST_DIR}/test_sph_poiseuille.c)
 target_link_libraries(test_sph_poiseuille PRIVATE lahar_sph)
 add_test(NAME sph_poiseuille COMMAND test_sph_poiseuille)
 set_tests_properties(sph_poiseuille PROPERTIES LABELS "fast;sph" TIMEOUT 300)
+
+add_executable(test_sph_fluid ${LAHAR_TEST_DIR}/test_sph_fluid.c)
+target_link_libraries(test_sph_fluid PRIVATE lahar_sph)
+add_test(NAME sph_fluid COMMAND test_sph_fluid)
+set_tests_properties(sph_fluid PROPERTIES LABELS "fast;sph" TIMEOUT 120)
