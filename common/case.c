@@ -1578,9 +1578,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     if (r->failed)
         return;
     if (!rmap_get(&m, "c0") && !(uref > 0)) {
-        rmap_missing(&m, "c0", "1.0  (the fluid starts at rest without gravity or body force, so the default "
-                     "c0 = 10 x the fall speed over the fluid's height is 0: give the numerical speed of sound, "
-                     "about 10 x the largest expected speed)");
+        rmap_fail(&m, "c0", "missing required key: the fluid starts at rest with no gravity or body force, so "
+                  "there is no default speed of sound; add e.g. `c0: 1.0` (about 10 x the largest expected speed)");
         return;
     }
     if (!(o->c0 > 0)) {
