@@ -166,9 +166,9 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 continue;
             vec3 core;
             double dc = geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
-            if (dc - R >= support)
+            int inside = inside_core(body, bx, bq, xi, c->dim); /* deep inside: far from the surface */
+            if (dc - R >= support && !inside)
                 continue;
-            int inside = inside_core(body, bx, bq, xi, c->dim);
             int cross = inside || dc < R;
             vec3 nrm;
             double d;

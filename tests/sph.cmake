@@ -14,3 +14,8 @@ add_executable(test_sph_fluid ${LAHAR_TEST_DIR}/test_sph_fluid.c)
 target_link_libraries(test_sph_fluid PRIVATE lahar_sph)
 add_test(NAME sph_fluid COMMAND test_sph_fluid)
 set_tests_properties(sph_fluid PROPERTIES LABELS "fast;sph" TIMEOUT 120)
+
+add_executable(test_sph_coupling ${LAHAR_TEST_DIR}/test_sph_coupling.c)
+target_link_libraries(test_sph_coupling PRIVATE lahar_sph)
+add_test(NAME sph_coupling COMMAND test_sph_coupling)
+set_tests_properties(sph_coupling PROPERTIES LABELS "fast;sph" TIMEOUT 120)
