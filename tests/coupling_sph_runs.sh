@@ -3,7 +3,7 @@
 # LOADS / BODY_STATE between the nodes, the force stream and contacts.h5.
 #
 #   coupling_sph_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: modes | far_body | hydrostatic
+#   TEST: modes | far_body | hydrostatic | crossing
 #
 # modes        a box dropped into a small 2D tank of water: `lahar run --in-process` (memq://) and
 #              `lahar run` (processes in lahar's own private network namespace) write bitwise the
@@ -16,6 +16,11 @@
 #              resolution (20 particles over h), the floor carries the weight within 2 %, and the
 #              contact points of the wall marked record_contacts (contacts.h5) add up to the
 #              wall's resultant with the centre of pressure at h/3 within 10 %.
+# crossing     a jet at 20 m/s with a far too small speed of sound (c0 = 1 m/s: the CFL step lets a
+#              particle move 0.3 dx per step) is driven through a thin wall: the run stops with
+#              exit 1 and a message naming the body, the particle and the step, and the last
+#              particle snapshot (the state after that step) has that particle inside the wall's
+#              swept surface (closer than its radius to the core).
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -157,6 +162,46 @@ with h5py.File(out + "/contacts.h5", "r") as f:
 yc = float(np.mean(ys))
 print("contacts.h5: %d snapshots; centre of pressure at %.4f m, h/3 = %.4f m" % (len(ys), yc, h / 3))
 assert abs(yc - h / 3) / (h / 3) < 0.10, yc
+PY
+    ;;
+crossing)
+    cat > jet.yaml <<'YAML'
+dimensions: 2
+gravity: [0, 0]
+time: {end: 0.05, dt_max: 1e-3, output_interval: 0.01}
+materials:
+  wall: {density: 2650, model: linear, kn: 1.0e5, restitution: 0.5, friction: 0.3}
+bodies:
+  - {name: thin_wall, shape: segment, motion: fixed, material: wall, radius: 0.002, vertices: [[0.1, -0.1], [0.1, 0.1]]}
+sph:
+  dx: 0.005
+  c0: 1.0
+  blocks:
+    - {name: jet, box: {lo: [0.0, -0.02], hi: [0.05, 0.02]}, velocity: [20, 0]}
+YAML
+    "$bin/lahar" run jet.yaml -o jet -q --in-process --threads 1 2> stderr.txt
+    rc=$?
+    cat stderr.txt
+    [ "$rc" -eq 1 ] || fail "exit status $rc, expected 1"
+    "$python" - jet stderr.txt <<'PY' || fail "crossing report"
+import json, re, sys
+import h5py, numpy as np
+s = json.load(open(sys.argv[1] + "/summary.json"))
+assert s["status"] == "error" and s["exit_status"] == 1, s["status"]
+m = re.search(r"particle (\d+) crossed the surface of body 0 'thin_wall' in step (\d+)", s["message"])
+assert m, s["message"]
+pid, k = int(m.group(1)), int(m.group(2))
+assert k == s["steps"], (k, s["steps"])  # steps completed before the failing one
+assert m.group(0) in open(sys.argv[2]).read(), "stderr does not carry the message"
+with h5py.File(sys.argv[1] + "/particles.h5", "r") as f:
+    last = f["snapshots"][sorted(f["snapshots"])[-1]]
+    assert int(last.attrs["step"]) == k + 1, (int(last.attrs["step"]), k + 1)
+    ids, x, y = np.asarray(last["id"]), np.asarray(last["x"]), np.asarray(last["y"])
+i = int(np.nonzero(ids == pid)[0][0])
+d = abs(x[i] - 0.1)  # distance to the wall's core (the segment x = 0.1, |y| <= 0.1)
+assert abs(y[i]) <= 0.1 and d < 0.002, (x[i], y[i], d)
+print("crossing: particle %d reported in step %d, %.2f mm from the core of a 2 mm wall in the last snapshot"
+      % (pid, k, 1e3 * d))
 PY
     ;;
 *)
