@@ -1344,7 +1344,9 @@ int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
     return 0;
 }
 
-int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap)
+/* As lahar_case_block_lattice; first_only: stop at the first particle (the loader only needs to
+ * know a block is not empty). */
+static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap, int first_only)
 {
     const lahar_particle_block *b = &c->blocks[block];
     const int dim = c->dim;
@@ -1389,9 +1391,17 @@ int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3
                 if (out && count < cap)
                     memcpy(out[count], x, sizeof x);
                 count++;
+                if (first_only)
+                    goto done;
             }
+done:
     free(reach);
     return count;
+}
+
+int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap)
+{
+    return case_block_lattice(c, block, out, cap, 0);
 }
 
 /* Blocks must hold particles; on periodic axes they stay inside the period; two boxes must not
@@ -1424,7 +1434,7 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
                 return;
             }
         }
-        int64_t np = lahar_case_block_lattice(c, i, NULL, 0);
+        int64_t np = case_block_lattice(c, i, NULL, 0, 1);
         if (np < 0) {
             rd_fail(r, bn, key, "out of memory");
             return;

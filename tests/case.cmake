@@ -13,3 +13,10 @@ target_link_libraries(test_case_bad PRIVATE lahar_common)
 # one fixture per class of bad input: exit status 2, message names file, line and key
 add_test(NAME case_bad_inputs COMMAND test_case_bad $<TARGET_FILE:lahar-case-check> ${LAHAR_TEST_DIR}/bad_cases)
 set_tests_properties(case_bad_inputs PROPERTIES LABELS fast)
+
+add_executable(test_case_blocks ${LAHAR_TEST_DIR}/test_case_blocks.c)
+target_link_libraries(test_case_blocks PRIVATE lahar_common)
+# SPH particle blocks: polygon / STL fill against exact counts and analytic areas and volumes,
+# bodies cut out of the lattice against an independent inside test
+add_test(NAME case_blocks COMMAND test_case_blocks ${CMAKE_CURRENT_BINARY_DIR})
+set_tests_properties(case_blocks PROPERTIES LABELS fast)
