@@ -7,7 +7,8 @@
 #
 # modes        a box dropped into a small 2D tank of water: `lahar run --in-process` (memq://) and
 #              `lahar run` (processes in lahar's own private network namespace) write bitwise the
-#              same particles.h5, bodies.h5, forces.h5 and contacts.h5.
+#              same particles.h5, bodies.h5, forces.h5 and contacts.h5, and so does a run on 2
+#              OpenMP threads; the water slows the box.
 # far_body     the same scene with one more free box 5 m away from the water: LOADS and BODY_STATE
 #              carry exactly the bytes of the run without it (the far body is never sent), and the
 #              water and the near box move bitwise as without it.
@@ -67,9 +68,11 @@ modes)
     write_drop drop.yaml
     "$bin/lahar" run drop.yaml -o ip -q --in-process --threads 1 || fail "in-process run failed"
     "$bin/lahar" run drop.yaml -o proc -q --threads 1 || fail "multi-process run failed"
+    "$bin/lahar" run drop.yaml -o ip2 -q --in-process --threads 2 || fail "in-process run on 2 threads failed"
     [ "$(summary proc "s['mode']")" = processes ] || fail "mode is not processes"
     for f in particles.h5 bodies.h5 forces.h5 contacts.h5; do
         "$python" "$tools/h5_compare.py" --quiet ip/$f proc/$f || fail "$f differs between --in-process and processes"
+        "$python" "$tools/h5_compare.py" --quiet ip/$f ip2/$f || fail "$f differs between 1 and 2 threads"
     done
     "$python" - ip <<'PY' || fail "wrong results"
 import json, sys
@@ -92,7 +95,7 @@ with h5py.File(out + "/forces.h5", "r") as f:
     F = np.asarray(f["force"])
     up = F[:, 3, 1].max()
 assert up > 0, "no upward load on the box"
-print("modes: %d steps, bitwise equal in both modes; box at %.3f m/s at t = %.2f s (free fall: %.3f), peak fluid load %.1f N/m"
+print("modes: %d steps, bitwise equal in both modes and on 1 and 2 threads; box at %.3f m/s at t = %.2f s (free fall: %.3f), peak fluid load %.1f N/m"
       % (steps, v[1], t, free, up))
 PY
     ;;
