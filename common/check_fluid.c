@@ -434,7 +434,8 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
         f_ref = sref / (double)(d->nrow - k0);
         f_lo = fluid_force_mean(d, k0, lo, ex), f_hi = fluid_force_mean(d, k0, hi, ex);
         perr = fmax(fabs(f_lo - f_ref), fabs(f_hi - f_ref)) / (tau_s * LW);
-        int pf = lahar_check_panel(r, "plate force per unit length along the flow", "t [s]", "F / L [N/m per m]");
+        int pf = lahar_check_panel(r, "plate force along the flow per unit plate length (= tau W)", "t [s]",
+                                   "F / L [N/m^2 in 2D, N/m in 3D]");
         char label[96];
         snprintf(label, sizeof label, "%s", c->bodies[lo].name);
         fluid_plot_force(r, pf, d, lo, ex, Lx, label);
@@ -651,7 +652,8 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
         if (p->vx)
             vmax = fmax(vmax, v3_norm(fluid_vel(p, i)));
     }
-    int pp = lahar_check_panel(r, "pressure at the last snapshot (mean per row of dx)", "p [Pa]", "height above the floor [m]");
+    int pp = lahar_check_panel(r, "pressure at the last snapshot (mean per row of dx)", "p [Pa]",
+                               "height above the floor [m]");
     lahar_check_curve(r, pp, 1, "lahar");
     for (int b = 0; b < nb; b++)
         if (bn[b])

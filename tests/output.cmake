@@ -38,3 +38,8 @@ set_tests_properties(output_check PROPERTIES LABELS "fast;output" TIMEOUT 120
 add_test(NAME output_h5_compare COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_h5_compare.py
   ${LAHAR_OUTPUT_TEST_DIR}/h5_compare)
 set_tests_properties(output_h5_compare PROPERTIES LABELS "fast;output" TIMEOUT 60)
+
+lahar_output_test(test_check_fluid)
+add_test(NAME output_check_fluid COMMAND test_check_fluid ${LAHAR_OUTPUT_TEST_DIR}/check_fluid)
+set_tests_properties(output_check_fluid PROPERTIES LABELS "fast;output" TIMEOUT 180
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

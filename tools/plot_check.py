@@ -46,17 +46,21 @@ def plot_series(plot, summary):
 
 
 def plot_panels(panels, summary):
-    """One subplot per panel; measured curves as markers, reference curves as lines, a measured
-    curve and the reference curve that follows it share a colour (profile i vs series i)."""
+    """One subplot per panel; measured curves as markers, reference curves as lines. A reference
+    curve right after a single measured one shares its colour (profile at t_i vs series at t_i);
+    one after several measured curves (e.g. both plates vs one reference) is black."""
     fig, axes = plt.subplots(len(panels), 1, figsize=(8, 4.2 * len(panels)), squeeze=False)
     colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
     for ax, panel in zip(axes[:, 0], panels):
-        ci = -1
+        ci, run = -1, 0
         for curve in panel.get("curves", []):
             measured = curve.get("kind") == "measured"
-            if measured or ci < 0:
-                ci += 1
-            colour = colours[ci % len(colours)]
+            if measured:
+                ci, run = ci + 1, run + 1
+                colour = colours[ci % len(colours)]
+            else:
+                colour = colours[ci % len(colours)] if run == 1 else "k"
+                run = 0
             if measured:
                 ax.plot(curve["x"], curve["y"], "o", ms=3, color=colour, label=curve.get("label", "lahar"))
             else:
