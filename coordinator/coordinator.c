@@ -683,7 +683,7 @@ out:
         printf("lahar: %s: %lld steps to t = %.6g s in %.2f s wall; output in %s\n", co.status, (long long)co.steps,
                co.sim_time, lahar_now() - co.wall0, co.outdir);
         printf("  look at it: paraview %s/lahar.xmf (bodies and particles over time)\n", co.outdir);
-        static const char *const files[] = {"bodies.h5", "forces.h5", "particles.h5"};
+        static const char *const files[] = {"bodies.h5", "forces.h5", "particles.h5", "contacts.h5"};
         for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
             char path[PATH_MAX + 32];
             snprintf(path, sizeof path, "%s/%s", co.outdir, files[i]);
