@@ -57,7 +57,7 @@ typedef struct {
     long long c[3]; /* cell */
     vec3 x;
     double bound;
-    int id;
+    int id, level;
 } sp_bin;
 
 typedef struct {
@@ -90,7 +90,10 @@ struct lahar_dem_engine {
     int ngrid;
     /* broad phase */
     int nfree, *free_ids, nlarge, *large_ids;
-    double cell;
+    int nlevel;               /* grid levels: cell of level l = D 2^(l - nlevel + 1), D the largest diameter */
+    double cell_inv[21];
+    int level_count[21];
+    int *level;               /* per free body (index into free_ids) */
     long long (*cellc)[3];
     int *bucket_of, *bucket_start, nbucket, bucket_cap, nhash, dense;
     long long dlo[3], dn[3];  /* dense grid: first cell and cells per axis */
@@ -570,14 +573,20 @@ static int add_pair(lahar_dem_engine *e, int a, int b)
     return 0;
 }
 
+/* Bucket of a cell of level lev in the hashed grid. */
+static inline int bucket_of_level_cell(const lahar_dem_engine *e, int lev, long long x, long long y, long long z)
+{
+    return (int)((cell_hash(x, y, z) ^ (uint32_t)lev * 0x9E3779B9u) & (uint32_t)(e->nhash - 1));
+}
+
 static int broad_phase(lahar_dem_engine *e)
 {
     e->npair = 0;
     if (e->nfree > 0) {
-        double inv = 1.0 / e->cell;
         long long lo[3] = {LLONG_MAX, LLONG_MAX, LLONG_MAX}, hi[3] = {LLONG_MIN, LLONG_MIN, LLONG_MIN};
         for (int k = 0; k < e->nfree; k++) {
             const sp_state *s = &e->st[e->free_ids[k]];
+            double inv = e->cell_inv[e->level[k]];
             e->cellc[k][0] = (long long)floor(s->x.x * inv);
             e->cellc[k][1] = (long long)floor(s->x.y * inv);
             e->cellc[k][2] = e->dim == 3 ? (long long)floor(s->x.z * inv) : 0;
@@ -586,10 +595,11 @@ static int broad_phase(lahar_dem_engine *e)
                 hi[d] = e->cellc[k][d] > hi[d] ? e->cellc[k][d] : hi[d];
             }
         }
-        /* a dense grid over the bodies' box when it is small enough (cache-friendly: bodies sorted
-         * by cell, neighbours adjacent in memory), else the hashed grid (any extent) */
+        /* one level: a dense grid over the bodies' box when it is small enough (cache-friendly:
+         * bodies sorted by cell, neighbours adjacent in memory), else hashed (any extent); several
+         * levels (sizes differing by more than 2x): hashed on (level, cell) */
         double ncell = (double)(hi[0] - lo[0] + 1) * (double)(hi[1] - lo[1] + 1) * (double)(hi[2] - lo[2] + 1);
-        e->dense = ncell <= 8.0 * e->nfree + 1024.0;
+        e->dense = e->nlevel == 1 && ncell <= 8.0 * e->nfree + 1024.0;
         int nb = e->dense ? (int)ncell : e->nhash;
         for (int d = 0; d < 3; d++) {
             e->dlo[d] = lo[d];
@@ -603,7 +613,9 @@ static int broad_phase(lahar_dem_engine *e)
         e->nbucket = nb;
         memset(e->bucket_start, 0, sizeof(int) * (size_t)(nb + 1));
         for (int k = 0; k < e->nfree; k++) {
-            e->bucket_of[k] = bucket_of_cell(e, e->cellc[k][0], e->cellc[k][1], e->cellc[k][2]);
+            e->bucket_of[k] = e->nlevel == 1 ? bucket_of_cell(e, e->cellc[k][0], e->cellc[k][1], e->cellc[k][2])
+                                             : bucket_of_level_cell(e, e->level[k], e->cellc[k][0], e->cellc[k][1],
+                                                                    e->cellc[k][2]);
             e->bucket_start[e->bucket_of[k] + 1]++;
         }
         for (int i = 0; i < nb; i++) e->bucket_start[i + 1] += e->bucket_start[i];
@@ -615,28 +627,43 @@ static int broad_phase(lahar_dem_engine *e)
             bn->x = e->st[i].x;
             bn->bound = e->geo[i].bound;
             bn->id = i;
+            bn->level = e->level[k];
         }
         for (int i = nb; i > 0; i--) e->bucket_start[i] = e->bucket_start[i - 1];
         e->bucket_start[0] = 0;
-        /* half shell: the own cell (partners j > i) and the 13 (2D: 4) neighbours that come after
-         * it in (z, y, x) order (all partners), so that each pair is met once */
+        /* Same level: the own cell (partners j > i) and the half shell of 13 (2D: 4) neighbours
+         * after it in (z, y, x) order, so that each pair is met once. Coarser levels (cell >= both
+         * diameters): all 27 (9) cells around the body, so a pair of different levels is met once,
+         * from its smaller body. */
         int zr = e->dim == 3 ? 1 : 0;
         for (int mk = 0; mk < e->nfree; mk++) {
             const sp_bin bi = e->bins[mk];
-            for (int dz = 0; dz <= zr; dz++)
-                for (int dy = dz > 0 ? -1 : 0; dy <= 1; dy++)
-                    for (int dx = (dz > 0 || dy > 0) ? -1 : 0; dx <= 1; dx++) {
-                        int own = dz == 0 && dy == 0 && dx == 0;
-                        long long cx = bi.c[0] + dx, cy = bi.c[1] + dy, cz = bi.c[2] + dz;
-                        int h = bucket_of_cell(e, cx, cy, cz);
-                        if (h < 0) continue;
-                        for (int m = e->bucket_start[h]; m < e->bucket_start[h + 1]; m++) {
-                            const sp_bin *bj = &e->bins[m];
-                            if ((own && bj->id <= bi.id) || bj->c[0] != cx || bj->c[1] != cy || bj->c[2] != cz) continue;
-                            double r = bi.bound + bj->bound;
-                            if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
+            for (int lev = bi.level; lev < e->nlevel; lev++) {
+                if (lev > bi.level && e->level_count[lev] == 0) continue;
+                int same = lev == bi.level;
+                long long c0[3] = {bi.c[0], bi.c[1], bi.c[2]};
+                if (!same) {
+                    c0[0] = (long long)floor(bi.x.x * e->cell_inv[lev]);
+                    c0[1] = (long long)floor(bi.x.y * e->cell_inv[lev]);
+                    c0[2] = e->dim == 3 ? (long long)floor(bi.x.z * e->cell_inv[lev]) : 0;
+                }
+                for (int dz = same ? 0 : -zr; dz <= zr; dz++)
+                    for (int dy = (same && dz == 0) ? 0 : -1; dy <= 1; dy++)
+                        for (int dx = (same && dz == 0 && dy == 0) ? 0 : -1; dx <= 1; dx++) {
+                            int own = same && dz == 0 && dy == 0 && dx == 0;
+                            long long cx = c0[0] + dx, cy = c0[1] + dy, cz = c0[2] + dz;
+                            int h = e->nlevel == 1 ? bucket_of_cell(e, cx, cy, cz) : bucket_of_level_cell(e, lev, cx, cy, cz);
+                            if (h < 0) continue;
+                            for (int m = e->bucket_start[h]; m < e->bucket_start[h + 1]; m++) {
+                                const sp_bin *bj = &e->bins[m];
+                                if ((own && bj->id <= bi.id) || bj->level != lev || bj->c[0] != cx || bj->c[1] != cy ||
+                                    bj->c[2] != cz)
+                                    continue;
+                                double r = bi.bound + bj->bound;
+                                if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
+                            }
                         }
-                    }
+            }
         }
     }
     for (int k = 0; k < e->nfree; k++) {
@@ -893,6 +920,7 @@ static void sp_destroy(lahar_dem_engine *e)
     free(e->free_ids);
     free(e->large_ids);
     free(e->cellc);
+    free(e->level);
     free(e->bucket_start);
     free(e->bucket_of);
     free(e->bins);
@@ -1140,7 +1168,6 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
                 st->L = q_rotate(st->q, v3(g->inertia[0] * wb.x, g->inertia[1] * wb.y, g->inertia[2] * wb.z));
             }
             e->free_ids[e->nfree++] = i;
-            e->cell = fmax(e->cell, 2.0 * g->bound);
         } else {
             e->large_ids[e->nlarge++] = i;
         }
@@ -1161,7 +1188,31 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         ofv += nfvi;
         body_update_world(e, i);
     }
-    e->cell *= 1.0 + 1e-9;
+    /* grid levels: the largest bounding diameter D sets the coarsest cell; a body lives in the
+     * finest cell D / 2^h that still holds its diameter, so a boulder among gravel does not blow
+     * the cell up for everybody, while sizes within a factor 2 share one level */
+    double dmax = 0.0;
+    for (int k = 0; k < e->nfree; k++) dmax = fmax(dmax, 2.0 * e->geo[e->free_ids[k]].bound);
+    dmax = dmax > 0.0 ? dmax * (1.0 + 1e-9) : 1.0;
+    e->level = xcalloc((size_t)nb, sizeof(int));
+    if (!e->level) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        goto fail;
+    }
+    int hmax = 0;
+    for (int k = 0; k < e->nfree; k++) {
+        double dk = 2.0 * e->geo[e->free_ids[k]].bound;
+        int hk = 0; /* halvings of D that still hold dk */
+        while (hk < 20 && ldexp(dmax, -(hk + 1)) >= dk) hk++;
+        e->level[k] = hk;
+        hmax = hk > hmax ? hk : hmax;
+    }
+    e->nlevel = hmax + 1;
+    for (int k = 0; k < e->nfree; k++) {
+        e->level[k] = hmax - e->level[k]; /* level 0 = finest, nlevel - 1 = coarsest (cell D) */
+        e->level_count[e->level[k]]++;
+    }
+    for (int l = 0; l < e->nlevel; l++) e->cell_inv[l] = 1.0 / ldexp(dmax, -(hmax - l));
     e->nhash = 16;
     while (e->nhash < 2 * e->nfree) e->nhash *= 2;
     e->bucket_cap = 8 * e->nfree + 1026 > e->nhash + 1 ? 8 * e->nfree + 1026 : e->nhash + 1;

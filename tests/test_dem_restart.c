@@ -210,6 +210,44 @@ int main(void)
     free(x);
     free(r);
 
+    /* strongly polydisperse (hierarchical grid levels): 12 boulders of R 0.3-0.5 among 1500
+     * grains of R 0.02-0.03 */
+    const int npoly = 1512;
+    dem_test_case_init(&c, 3, g0, npoly);
+    m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, 1e6, 0, 0, 0.5, 0.3);
+    x = malloc(sizeof(double[3]) * npoly);
+    r = malloc(sizeof(double) * npoly);
+    placed = 0;
+    while (placed < npoly) {
+        double p[3] = {3.0 * urand(&seed), 3.0 * urand(&seed), 1.5 * urand(&seed)};
+        double rad = placed < 12 ? 0.3 + 0.2 * urand(&seed) : 0.02 + 0.01 * urand(&seed);
+        if (placed >= 12 && placed % 2 == 0) { /* half the grains touch a boulder (cross-level pairs) */
+            int jb = placed % 12;
+            double u[3] = {urand(&seed) - 0.5, urand(&seed) - 0.5, urand(&seed) - 0.5};
+            double un = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) + 1e-12;
+            for (int k = 0; k < 3; k++) p[k] = x[jb][k] + u[k] / un * (r[jb] + 0.9 * rad);
+        }
+        int ok = 1;
+        for (int j = 0; j < placed && ok; j++) {
+            double dx = p[0] - x[j][0], dy = p[1] - x[j][1], dz = p[2] - x[j][2];
+            double lim = rad + r[j] - 0.2 * fmin(rad, r[j]);
+            if (dx * dx + dy * dy + dz * dz < lim * lim) ok = 0;
+        }
+        if (!ok) continue;
+        memcpy(x[placed], p, sizeof p);
+        r[placed] = rad;
+        dem_test_sphere(&c, placed < 12 ? "boulder" : "grain", m, rad, p, LAHAR_MOTION_FREE);
+        placed++;
+    }
+    e = dem_test_engine(&c, &ops);
+    brute = count_overlaps(npoly, (const double(*)[3])x, r);
+    dem_test_check(ops->ncontacts(e) == brute && brute > 300,
+                   "12 boulders among 1500 grains: grid finds %d contacts, brute force %d", ops->ncontacts(e), brute);
+    ops->destroy(e);
+    dem_test_case_free(&c);
+    free(x);
+    free(r);
+
     /* instability */
     dem_test_case_init(&c, 3, g0, 2);
     m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, 1e6, 0, 0, 0.5, 0.3);
