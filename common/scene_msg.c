@@ -145,7 +145,7 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         memcpy(b->q, a->q, sizeof b->q);
         memcpy(b->vel, a->v, sizeof b->vel);
         memcpy(b->w, a->w, sizeof b->w);
-        m->body_record_contacts[i] = (int8_t)(a->record_contacts != 0);
+        m->body_record_contacts[i] = a->record_contacts != 0;
     }
     for (int i = 0; i < c->nblock; i++) {
         const lahar_particle_block *a = &c->blocks[i];
