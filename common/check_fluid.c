@@ -79,9 +79,10 @@ static double fluid_core_dist(const lahar_case *c, const lahar_check_data *d, in
     return geom_point_body_core(&c->bodies[j].shape, x, q, p, cp, &feature);
 }
 
-/* 1 when p lies inside the convex core of body j (3D: behind every face; 2D: on the inner side
- * of every edge, the centre of mass being inside). Used to tell a particle that went through a
- * moving body's surface from one that is merely far from its edges. */
+/* 1 when p lies inside the closed convex core of body j (3D: a polyhedron of >= 4 faces, p
+ * behind every face; 2D: a polygon of >= 3 edges, p on the inner side of every edge, the centre
+ * of mass being inside). Tells a particle that went deep into a body from one merely far from
+ * its surface (geom_point_body_core gives an unsigned distance). */
 static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
 {
     const lahar_shape *s = &c->bodies[j].shape;
@@ -89,7 +90,9 @@ static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data 
     fluid_pose(c, d, j, k, x, q);
     if (!c->bodies[j].convex)
         return 0;
-    if (s->nf > 0) {
+    if (c->dim == 3) {
+        if (s->nf < 4)
+            return 0;
         for (int f = 0; f < s->nf; f++) {
             vec3 n = q_rotate(q_load(q), geom_face_normal(s, f));
             vec3 v0 = geom_world_vertex(s, x, q, s->face_v[s->face_start[f]]);
@@ -98,7 +101,7 @@ static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data 
         }
         return 1;
     }
-    if (c->dim != 2 || s->ne < 3)
+    if (s->ne < 3)
         return 0;
     vec3 xc = v3_load(x);
     for (int e = 0; e < s->ne; e++) {
@@ -109,6 +112,14 @@ static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data 
             return 0;
     }
     return 1;
+}
+
+/* How deep p lies inside the swept solid of body j at body snapshot k (negative: outside):
+ * R - distance to the core, or R + distance when p is inside a closed convex core. */
+static double fluid_depth(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
+{
+    double dist = fluid_core_dist(c, d, j, k, p, NULL), R = c->bodies[j].shape.radius;
+    return fluid_inside_convex_core(c, d, j, k, p) ? R + dist : R - dist;
 }
 
 /* Unit vector "up" (against gravity) and horizontal unit vectors e1 (and e2 in 3D). */
@@ -807,9 +818,10 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
 
 /* A dense free disc (or sphere) sinking through viscous fluid onto a fixed floor (the fixed body
  * whose surface is under the body's final position).
- *  - floor_penetration [m]: the deepest any particle centre gets inside the floor's swept layer
- *    (R_f - distance to the floor's core), or the disc's surface beyond the floor's core (its
- *    soft-contact overlap larger than the floor's sweep radius); 0 in a correct run.
+ *  - floor_penetration [m]: the deepest any particle centre gets inside the floor's swept solid
+ *    (R_f - distance to the floor's core, or deeper inside a closed convex core), or the disc's
+ *    surface beyond the floor's core (its soft-contact overlap larger than the floor's sweep
+ *    radius); 0 in a correct run.
  *  - particle_disc_penetration [m]: the deepest any particle centre gets inside the disc.
  *  - final_speed_rel: speed at the last snapshot / largest speed during the run (at rest: ~0).
  *  - rest_gap_rel: |gap between disc and floor surfaces| / disc radius at the last snapshot (on
@@ -853,6 +865,8 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
         double x[3], q[4];
         fluid_pose(c, d, b, k, x, q);
         double core = geom_body_core_distance(&disc->shape, x, q, &floor_b->shape, floor_b->x, floor_b->q);
+        if (disc->shape.nv == 1 && fluid_inside_convex_core(c, d, fl, -1, v3_load(x)))
+            core = -fluid_core_dist(c, d, fl, -1, v3_load(x), NULL); /* centre inside the floor's core */
         gap = core - Rd - Rf;
         pen = fmax(pen, Rd - core); /* the disc's surface past the floor's core */
         lahar_check_point(r, d->t[k], gap);
@@ -875,12 +889,9 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
         int64_t kb = fluid_body_snapshot(d, p->t[k], tol);
         for (int64_t i = 0; i < p->cur_n; i++) {
             vec3 x = fluid_pos(p, i);
-            part_pen = fmax(part_pen, Rf - fluid_core_dist(c, d, fl, -1, x, NULL));
-            if (kb >= 0) {
-                double dd = fluid_core_dist(c, d, b, kb, x, NULL);
-                double depth = fluid_inside_convex_core(c, d, b, kb, x) ? Rd + dd : Rd - dd;
-                part_disc = fmax(part_disc, depth);
-            }
+            part_pen = fmax(part_pen, fluid_depth(c, d, fl, -1, x));
+            if (kb >= 0)
+                part_disc = fmax(part_disc, fluid_depth(c, d, b, kb, x));
         }
     }
     vec3 v_last = v3_load(d->v + ((size_t)kl * (size_t)d->nbody + (size_t)b) * 3);
@@ -911,8 +922,8 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
  * run has:
  *  - mass_change: max over snapshots of |N - N_0| / N_0 (particles have constant mass).
  *  - escaped_particles: the most particles in one snapshot that are inside a body (centre within
- *    a body's swept layer, or inside a convex moving body's core) or outside the box around all
- *    fixed bodies (left the tank).
+ *    a body's swept layer, or inside a closed convex core) or more than dx outside the box around
+ *    all fixed bodies (left the tank).
  *  - front_regression: the front (furthest particle along the flow direction: horizontal, from
  *    the column towards the tank's far side) must advance until it reaches its furthest
  *    position; the largest step back before that, in units of dx.
@@ -987,9 +998,7 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
                 int fixed = c->bodies[j].motion == LAHAR_MOTION_FIXED;
                 if (!fixed && kb < 0)
                     continue;
-                out |= fluid_core_dist(c, d, j, fixed ? -1 : kb, x, NULL) < c->bodies[j].shape.radius;
-                if (!fixed)
-                    out |= fluid_inside_convex_core(c, d, j, kb, x);
+                out |= fluid_depth(c, d, j, fixed ? -1 : kb, x) > 0.0;
             }
             esc += out;
         }

@@ -12,8 +12,8 @@
  *    x 1.02 and pressure x 1.05 fail;
  *  - floating_box: box 0.2 x 0.1 m, density 500 -> draft 0.05 m; raised 2 mm -> error 0.04;
  *  - sinking_disc: a disc settles on the floor; a particle inside the floor's layer fails;
- *  - dam_break: a column spreading to the far wall; an escaped particle and a front that steps
- *    back fail;
+ *  - dam_break: a column spreading to the far wall; a particle out of the tank, one deep inside a
+ *    fixed box's core and a front that steps back fail;
  *  - missing particles / fields -> status 2.
  *   test_check_fluid OUTDIR */
 #include <cjson/cJSON.h>
@@ -556,6 +556,12 @@ static void dam_run(const char *dir, int escape, int regress)
     add_segment("floor", -0.05, -R, W + 0.05, -R, R);
     add_segment("left", -R, 0.0, -R, 0.8, R);
     add_segment("right", W + R, 0.0, W + R, 0.8, R);
+    /* a fixed box high above the water: escape == 2 puts a particle at its centre, deep in its
+     * core (0.05 from its edges, beyond the sweep radius) */
+    int ob = add_body("obstacle", LAHAR_MOTION_FIXED, 0);
+    double half[2] = {0.05, 0.05};
+    lahar_shape_make_box2d(&bodies[ob].shape, half, R);
+    bodies[ob].x[0] = 0.8, bodies[ob].x[1] = 0.7;
     metric("escaped_particles", 0.0);
     metric("mass_change", 0.0);
     metric("front_regression", 1.0);
@@ -574,8 +580,10 @@ static void dam_run(const char *dir, int escape, int regress)
                 px[np] = (i + 0.5) * dx * s, py[np] = (j + 0.5) * dx / s, pvx[np] = pvy[np] = 0.0;
                 pden[np] = 1000.0, ppr[np] = 0.0;
             }
-        if (escape && k == 7)
+        if (escape == 1 && k == 7)
             px[5] = W + 0.2;
+        if (escape == 2 && k == 7)
+            px[5] = 0.8, py[5] = 0.7;
         memset(reports, 0, sizeof reports);
         lahar_body_output_forces(o.bo, k, t, reports);
         run_snapshot(&o, k, t);
@@ -599,6 +607,10 @@ static void test_dam_break(const char *base)
     dam_run(dir, 1, 0);
     v = evaluate(dir, 1, "escaped_particles");
     CHECK(v == 1.0, "dam break escape: escaped_particles %g (1)", v);
+    snprintf(dir, sizeof dir, "%s/dam_inside", base);
+    dam_run(dir, 2, 0);
+    v = evaluate(dir, 1, "escaped_particles");
+    CHECK(v == 1.0, "dam break particle inside the obstacle's core: escaped_particles %g (1)", v);
     snprintf(dir, sizeof dir, "%s/dam_regress", base);
     dam_run(dir, 0, 1);
     v = evaluate(dir, 1, "front_regression");
