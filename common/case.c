@@ -1113,7 +1113,7 @@ static int seg2_intersect(const double *p0, const double *p1, const double *q0, 
     return 0;
 }
 
-static void read_block_polygon(reader *r, rmap *bm, yaml_node_t *pn, const char *prefix, lahar_particle_block *pb)
+static void read_block_polygon(reader *r, yaml_node_t *pn, const char *prefix, lahar_particle_block *pb)
 {
     char key[KEY_MAX];
     key_join(prefix, "polygon", key);
@@ -1147,7 +1147,6 @@ static void read_block_polygon(reader *r, rmap *bm, yaml_node_t *pn, const char 
         }
     if (!r->failed && !(fabs(area) > 0))
         rd_fail(r, pn, key, "the polygon has zero area");
-    (void)bm;
     lahar_particle_block_bounds(pb, 2);
 }
 
@@ -1247,7 +1246,7 @@ static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
         return;
     }
     if (pg) {
-        read_block_polygon(r, &bm, pg, prefix, pb);
+        read_block_polygon(r, pg, prefix, pb);
         return;
     }
     if (st) {

@@ -1278,29 +1278,6 @@ void lahar_particle_block_bounds(lahar_particle_block *b, int dim)
         b->lo[2] = b->hi[2] = 0.0;
 }
 
-int lahar_particle_block_copy(lahar_particle_block *dst, const lahar_particle_block *src)
-{
-    *dst = *src;
-    dst->vert = NULL;
-    dst->tri = NULL;
-    if (src->nvert > 0) {
-        dst->vert = malloc((size_t)src->nvert * sizeof *dst->vert);
-        if (!dst->vert)
-            goto fail;
-        memcpy(dst->vert, src->vert, (size_t)src->nvert * sizeof *dst->vert);
-    }
-    if (src->ntri > 0) {
-        dst->tri = malloc((size_t)src->ntri * sizeof *dst->tri);
-        if (!dst->tri)
-            goto fail;
-        memcpy(dst->tri, src->tri, (size_t)src->ntri * sizeof *dst->tri);
-    }
-    return 0;
-fail:
-    lahar_particle_block_free(dst);
-    return -1;
-}
-
 void lahar_particle_block_free(lahar_particle_block *b)
 {
     free(b->vert);

@@ -105,9 +105,7 @@ int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, dou
 /* lo/hi of a polygon or mesh block from its vertices (z = 0 .. 0 in 2D). */
 void lahar_particle_block_bounds(lahar_particle_block *b, int dim);
 
-/* Deep copy (dst is overwritten) and release of the arrays a block owns (vert, tri). Copy
- * returns 0 or -1 (out of memory; dst left without arrays). */
-int lahar_particle_block_copy(lahar_particle_block *dst, const lahar_particle_block *src);
+/* Release the arrays a block owns (vert, tri); the block keeps its other fields. */
 void lahar_particle_block_free(lahar_particle_block *b);
 
 #endif
