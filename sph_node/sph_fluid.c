@@ -92,67 +92,33 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, in
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
     const double rhoi = p->rho[i], pi_ = p->p[i], pri = pi_ / (rhoi * rhoi), mui = prm->mu;
     const double c0 = prm->c0, alpha = prm->alpha, ddelta = 2.0 * prm->delta * h * c0;
-    const int64_t cell = c->cell_of[i];
-    const int cx = (int)(cell % c->nc[0]), cy = (int)((cell / c->nc[0]) % c->nc[1]),
-              cz = (int)(cell / ((int64_t)c->nc[0] * c->nc[1]));
-    const int zr = c->dim == 3 ? 1 : 0;
+    /* hydrostatic density difference per unit x_ij, rho0 b / c0^2, from the body force along the
+     * non-periodic axes (Fourtakas et al. 2019): delta-SPH diffuses only the deviation from it */
+    const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
+                 hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
+                 hz = prm->periodic[2] ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
-    for (int dz = -zr; dz <= zr; dz++) {
-        int jz = cz + dz;
-        double sz = 0.0;
-        if (jz < 0 || jz >= c->nc[2]) {
-            if (!c->periodic[2])
-                continue;
-            sz = jz < 0 ? -(c->hi[2] - c->lo[2]) : (c->hi[2] - c->lo[2]);
-            jz = jz < 0 ? jz + c->nc[2] : jz - c->nc[2];
-        }
-        for (int dy = -1; dy <= 1; dy++) {
-            int jy = cy + dy;
-            double sy = 0.0;
-            if (jy < 0 || jy >= c->nc[1]) {
-                if (!c->periodic[1])
-                    continue;
-                sy = jy < 0 ? -(c->hi[1] - c->lo[1]) : (c->hi[1] - c->lo[1]);
-                jy = jy < 0 ? jy + c->nc[1] : jy - c->nc[1];
-            }
-            for (int dxc = -1; dxc <= 1; dxc++) {
-                int jx = cx + dxc;
-                double sx = 0.0;
-                if (jx < 0 || jx >= c->nc[0]) {
-                    if (!c->periodic[0])
-                        continue;
-                    sx = jx < 0 ? -(c->hi[0] - c->lo[0]) : (c->hi[0] - c->lo[0]);
-                    jx = jx < 0 ? jx + c->nc[0] : jx - c->nc[0];
-                }
-                const int64_t nb = ((int64_t)jz * c->nc[1] + jy) * c->nc[0] + jx;
-                for (int64_t j = c->start[nb]; j < c->start[nb + 1]; j++) {
-                    /* x_ij with j's periodic image */
-                    double rx = xi - (p->x[j] + sx), ry = yi - (p->y[j] + sy), rz = zi - (p->z[j] + sz);
-                    double r2 = rx * rx + ry * ry + rz * rz;
-                    if (r2 >= s2 || j == i)
-                        continue;
-                    double r = sqrt(r2);
-                    double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
-                    double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
-                    double rhoj = p->rho[j], mj = p->m[j], vj = mj / rhoj;
-                    double vdotr = vx * rx + vy * ry + vz * rz;
-                    double rsoft = r2 / (r2 + eta2);
-                    /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
-                    drho += rhoi * vj * vdotr * fij + ddelta * vj * (rhoi - rhoj) * fij * rsoft;
-                    /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij */
-                    double pij = pri + p->p[j] / (rhoj * rhoj);
-                    if (alpha > 0.0 && vdotr < 0.0) /* Pi_ij = -alpha c0 mu_ij / rho_ij > 0 */
-                        pij -= alpha * c0 * (h * vdotr / (r2 + eta2)) / (0.5 * (rhoi + rhoj));
-                    double gp = -mj * pij * fij;
-                    /* laminar viscosity, Morris 1997 */
-                    double gv = mj * (mui + prm->mu) / (rhoi * rhoj) * fij * rsoft;
-                    ax += gp * rx + gv * vx;
-                    ay += gp * ry + gv * vy;
-                    az += gp * rz + gv * vz;
-                }
-            }
-        }
-    }
+    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        double r = sqrt(r2);
+        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
+        double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
+        double rhoj = p->rho[j], mj = p->m[j], vj = mj / rhoj;
+        double vdotr = vx * rx + vy * ry + vz * rz;
+        double rsoft = r2 / (r2 + eta2);
+        /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
+        double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
+        drho += rhoi * vj * vdotr * fij + ddelta * vj * drho_dev * fij * rsoft;
+        /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij */
+        double pij = pri + p->p[j] / (rhoj * rhoj);
+        if (alpha > 0.0 && vdotr < 0.0) /* Pi_ij = -alpha c0 mu_ij / rho_ij > 0 */
+            pij -= alpha * c0 * (h * vdotr / (r2 + eta2)) / (0.5 * (rhoi + rhoj));
+        double gp = -mj * pij * fij;
+        /* laminar viscosity, Morris 1997 */
+        double gv = mj * (mui + prm->mu) / (rhoi * rhoj) * fij * rsoft;
+        ax += gp * rx + gv * vx;
+        ay += gp * ry + gv * vy;
+        az += gp * rz + gv * vz;
+    });
     out[0] = drho;
     out[1] = ax + prm->body_force[0];
     out[2] = ay + prm->body_force[1];
@@ -177,6 +143,29 @@ static void fluid_pass(sph_fluid *f)
         p->ay[i] = out[2];
         p->az[i] = out[3];
     }
+}
+
+void sph_fluid_shepard(sph_fluid *f)
+{
+    sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
+    const int64_t n = p->n;
+    const kernel *k = &f->k;
+    const double s2 = k->support * k->support, w0 = kernel_w(k, 0.0);
+    /* new densities into rhoh (free outside a step), then copied: gather, no races */
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        double num = p->m[i] * w0, den = p->m[i] / p->rho[i] * w0;
+        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
+            double w = kernel_w(k, sqrt(r2));
+            num += p->m[j] * w;
+            den += p->m[j] / p->rho[j] * w;
+        });
+        p->rhoh[i] = num / den;
+    }
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
+    for (int64_t i = 0; i < n; i++)
+        p->rho[i] = p->rhoh[i];
 }
 
 int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
@@ -248,6 +237,8 @@ int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
     }
     f->t += dt;
     f->step++;
+    if (f->prm.shepard_every > 0 && f->step % f->prm.shepard_every == 0)
+        sph_fluid_shepard(f);
     f->crossings = cross;
     return cross;
 }

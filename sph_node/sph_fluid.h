@@ -5,11 +5,15 @@
  *   continuity (000 eq. 1, first term; 003 eq. 9 in the rho_i V_j form):
  *     drho_i/dt = rho_i sum_j V_j v_ij . grad_i W_ij
  *   delta-SPH density diffusion (Molteni & Colagrossi 2009; 000 eq. 1, second term):
- *     + 2 delta h c0 sum_j V_j (rho_i - rho_j) F_ij r^2 / (r^2 + eta^2)
+ *     + 2 delta h c0 sum_j V_j [(rho_i - rho_j) - rho0 b.x_ij / c0^2] F_ij r^2 / (r^2 + eta^2)
  *     000 prints (rho_j - rho_i) x_ij with eta^2 = 0.1 h^2; Molteni & Colagrossi write
  *     (rho_j - rho_i) x_ji. With x_ij the sign must be (rho_i - rho_j) for the term to be
  *     Brookshaw's Laplacian delta h c0 lap(rho), which diffuses a bump (test_sph_fluid.c checks
  *     the rate of a sine mode against -delta h c0 k^2); eta^2 = 0.01 h^2 as 000's text says.
+ *     The hydrostatic part rho0 b.x_ij/c0^2 (b = body force along the non-periodic axes) is not
+ *     diffused (Fourtakas et al. 2019, DualSPHysics "DDT 2"): the plain Molteni term drives a
+ *     column at rest away from hydrostatics (003 section 3.3 says so; measured here: wall force
+ *     -4.6 % on a 20-particle column), the corrected one leaves it hydrostatic.
  *   momentum (000 eq. 2, 003 eq. 10):
  *     dv_i/dt = g - sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) grad_i W_ij         (symmetric)
  *             + sum_j m_j (mu_i + mu_j)/(rho_i rho_j) F_ij r^2/(r^2 + eta^2) v_ij     (Morris 1997)
@@ -20,6 +24,10 @@
  *     (Monaghan 1992), rho_ij the mean density; off when alpha = 0.
  *   EOS: linear p = c0^2 (rho - rho0) (000 eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
  *     (003 eq. 19). c0 is the constant numerical speed of sound.
+ *
+ *   Shepard filter (003 eq. 5, optional, every N steps): rho_i = sum_j m_j W_ij / sum_j V_j W_ij
+ *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
+ *     hydrostatic bias that delta-SPH has (003 section 3.3; test_sph_hydrostatic.c).
  *
  * Time integration: kick-drift-kick leapfrog, second order, one neighbour pass per step:
  *   v_h = v + dt/2 a;  rho_h = rho + dt/2 D;  x += dt v_h;
@@ -56,6 +64,7 @@ typedef struct {
     int periodic[3];        /* 1: axis periodic with period [lo, hi) */
     double lo[3], hi[3];
     sph_wall_viscous wall_viscous;
+    int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
 } sph_params;
 
 typedef struct {
@@ -92,6 +101,9 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
  * Returns the number of particles that crossed a body surface in this step (0 normally), or -1
  * (out of memory). */
 int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states);
+
+/* Apply the Shepard density filter now (particles sorted, cells valid). */
+void sph_fluid_shepard(sph_fluid *f);
 
 /* The step this state allows (see above). Call after a step (or sph_fluid_rates). */
 double sph_fluid_dt(const sph_fluid *f);

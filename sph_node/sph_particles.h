@@ -76,4 +76,57 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
     return i >= c->nc[a] ? c->nc[a] - 1 : i;
 }
 
+/* Loop over the neighbours j != i of particle i (sorted, cell_of valid) within sqrt(S2) of it, in
+ * cell order (deterministic). The body is the last (variadic) argument; inside it: j, and rx, ry, rz, r2 = x_i - (image of x_j) and its
+ * squared length. Particle i is at (XI, YI, ZI). Periodic images are taken across periodic axes
+ * (>= 3 cells each, so no pair is seen twice). */
+#define SPH_FOR_EACH_NEIGHBOUR(C, P, I, XI, YI, ZI, S2, ...)                                        \
+    do {                                                                                           \
+        const sph_cells *nc_c_ = (C);                                                              \
+        const int64_t nc_cell_ = nc_c_->cell_of[I];                                                \
+        const int nc_cx_ = (int)(nc_cell_ % nc_c_->nc[0]),                                         \
+                  nc_cy_ = (int)((nc_cell_ / nc_c_->nc[0]) % nc_c_->nc[1]),                        \
+                  nc_cz_ = (int)(nc_cell_ / ((int64_t)nc_c_->nc[0] * nc_c_->nc[1]));               \
+        const int nc_zr_ = nc_c_->dim == 3 ? 1 : 0;                                                \
+        for (int nc_dz_ = -nc_zr_; nc_dz_ <= nc_zr_; nc_dz_++) {                                   \
+            int nc_jz_ = nc_cz_ + nc_dz_;                                                          \
+            double nc_sz_ = 0.0;                                                                   \
+            if (nc_jz_ < 0 || nc_jz_ >= nc_c_->nc[2]) {                                            \
+                if (!nc_c_->periodic[2])                                                           \
+                    continue;                                                                      \
+                nc_sz_ = (nc_jz_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[2] - nc_c_->lo[2]);                \
+                nc_jz_ += nc_jz_ < 0 ? nc_c_->nc[2] : -nc_c_->nc[2];                               \
+            }                                                                                      \
+            for (int nc_dy_ = -1; nc_dy_ <= 1; nc_dy_++) {                                         \
+                int nc_jy_ = nc_cy_ + nc_dy_;                                                      \
+                double nc_sy_ = 0.0;                                                               \
+                if (nc_jy_ < 0 || nc_jy_ >= nc_c_->nc[1]) {                                        \
+                    if (!nc_c_->periodic[1])                                                       \
+                        continue;                                                                  \
+                    nc_sy_ = (nc_jy_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[1] - nc_c_->lo[1]);            \
+                    nc_jy_ += nc_jy_ < 0 ? nc_c_->nc[1] : -nc_c_->nc[1];                           \
+                }                                                                                  \
+                for (int nc_dx_ = -1; nc_dx_ <= 1; nc_dx_++) {                                     \
+                    int nc_jx_ = nc_cx_ + nc_dx_;                                                  \
+                    double nc_sx_ = 0.0;                                                           \
+                    if (nc_jx_ < 0 || nc_jx_ >= nc_c_->nc[0]) {                                    \
+                        if (!nc_c_->periodic[0])                                                   \
+                            continue;                                                              \
+                        nc_sx_ = (nc_jx_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[0] - nc_c_->lo[0]);        \
+                        nc_jx_ += nc_jx_ < 0 ? nc_c_->nc[0] : -nc_c_->nc[0];                       \
+                    }                                                                              \
+                    const int64_t nc_nb_ = ((int64_t)nc_jz_ * nc_c_->nc[1] + nc_jy_) * nc_c_->nc[0] + nc_jx_; \
+                    for (int64_t j = nc_c_->start[nc_nb_]; j < nc_c_->start[nc_nb_ + 1]; j++) {    \
+                        const double rx = (XI) - ((P)->x[j] + nc_sx_), ry = (YI) - ((P)->y[j] + nc_sy_), \
+                                     rz = (ZI) - ((P)->z[j] + nc_sz_);                              \
+                        const double r2 = rx * rx + ry * ry + rz * rz;                             \
+                        if (r2 >= (S2) || j == (I))                                                \
+                            continue;                                                              \
+                        __VA_ARGS__                                                                \
+                    }                                                                              \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+    } while (0)
+
 #endif

@@ -93,8 +93,13 @@ static void brute_rates(const sph_fluid *f, int64_t i, double out[4])
         double v[3] = {p->vx[i] - p->vx[j], p->vy[i] - p->vy[j], p->vz[i] - p->vz[j]};
         double vr = v[0] * r[0] + v[1] * r[1] + v[2] * r[2];
         double Vj = p->m[j] / p->rho[j];
-        drho += p->rho[i] * Vj * vr * F + 2.0 * prm->delta * h * prm->c0 * Vj * (p->rho[i] - p->rho[j]) * F * r2 /
-                                              (r2 + eta2);
+        double hyd = 0.0; /* hydrostatic density difference along non-periodic axes */
+        double b[3] = {prm->body_force[0], prm->body_force[1], prm->body_force[2]};
+        for (int d = 0; d < 3; d++)
+            if (!prm->periodic[d])
+                hyd += prm->rho0 * b[d] / (prm->c0 * prm->c0) * r[d];
+        drho += p->rho[i] * Vj * vr * F +
+                2.0 * prm->delta * h * prm->c0 * Vj * ((p->rho[i] - p->rho[j]) - hyd) * F * r2 / (r2 + eta2);
         double pi_ = sph_fluid_pressure(prm, p->rho[i]), pj = sph_fluid_pressure(prm, p->rho[j]);
         double P = pi_ / (p->rho[i] * p->rho[i]) + pj / (p->rho[j] * p->rho[j]);
         if (prm->alpha > 0 && vr < 0)
