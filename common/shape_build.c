@@ -1196,31 +1196,50 @@ static int block_polygon_contains(const lahar_particle_block *b, const double x[
 }
 
 /* Parity of the crossings of the ray x + t d (t > 0) with the triangles (Moller-Trumbore). The
- * direction is skew to every axis and to the diagonals so that rays from lattice points miss
- * the edges and vertices of meshes built on round coordinates. */
+ * directions are skew to every axis and diagonal so that rays from lattice points miss the edges
+ * and vertices of meshes built on round coordinates; a ray that passes within 1e-9 (in
+ * barycentric terms) of an edge, or starts on a face, is ambiguous and the next direction is
+ * tried. Returns 1 inside, 0 outside. */
 static int block_mesh_contains(const lahar_particle_block *b, const double x[3])
 {
-    const vec3 d = v3_normalize(v3(1.0, 0.3183098861837907, 0.2078795763507619));
+    static const double dirs[3][3] = {{1.0, 0.3183098861837907, 0.2078795763507619},
+                                      {-0.5772156649015329, 1.0, 0.6931471805599453},
+                                      {0.2718281828459045, -0.4142135623730951, 1.0}};
     const vec3 o = v3_load(x);
+    const double eps = 1e-9;
     int crossings = 0;
-    for (int t = 0; t < b->ntri; t++) {
-        vec3 p0 = v3_load(b->vert[b->tri[t][0]]), p1 = v3_load(b->vert[b->tri[t][1]]), p2 = v3_load(b->vert[b->tri[t][2]]);
-        vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
-        vec3 pv = v3_cross(d, e2);
-        double det = v3_dot(e1, pv);
-        if (det == 0.0)
-            continue; /* ray parallel to the triangle's plane */
-        double inv = 1.0 / det;
-        vec3 tv = v3_sub(o, p0);
-        double u = v3_dot(tv, pv) * inv;
-        if (u < 0.0 || u > 1.0)
-            continue;
-        vec3 qv = v3_cross(tv, e1);
-        double v = v3_dot(d, qv) * inv;
-        if (v < 0.0 || u + v > 1.0)
-            continue;
-        if (v3_dot(e2, qv) * inv > 0.0)
-            crossings++;
+    for (int k = 0; k < 3; k++) {
+        const vec3 d = v3_normalize(v3_load(dirs[k]));
+        int ambiguous = 0;
+        crossings = 0;
+        for (int t = 0; t < b->ntri && !ambiguous; t++) {
+            vec3 p0 = v3_load(b->vert[b->tri[t][0]]), p1 = v3_load(b->vert[b->tri[t][1]]);
+            vec3 p2 = v3_load(b->vert[b->tri[t][2]]);
+            vec3 e1 = v3_sub(p1, p0), e2 = v3_sub(p2, p0);
+            vec3 pv = v3_cross(d, e2);
+            double det = v3_dot(e1, pv);
+            if (det == 0.0)
+                continue; /* ray parallel to the triangle's plane */
+            double inv = 1.0 / det;
+            vec3 tv = v3_sub(o, p0);
+            double u = v3_dot(tv, pv) * inv;
+            if (u < -eps || u > 1.0 + eps)
+                continue;
+            vec3 qv = v3_cross(tv, e1);
+            double v = v3_dot(d, qv) * inv;
+            if (v < -eps || u + v > 1.0 + eps)
+                continue;
+            double s = v3_dot(e2, qv) * inv;
+            double scale = sqrt(v3_norm2(e1) + v3_norm2(e2));
+            if (fabs(s) <= eps * scale || u < eps || v < eps || u + v > 1.0 - eps) {
+                if (s < -eps * scale)
+                    continue; /* behind the start: irrelevant */
+                ambiguous = 1;
+            } else if (s > 0.0)
+                crossings++;
+        }
+        if (!ambiguous)
+            break;
     }
     return crossings & 1;
 }

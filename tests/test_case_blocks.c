@@ -6,7 +6,8 @@
  *  - a triangle with irrational slopes: |N dx^2 - A| <= the area of the cells its boundary can
  *    touch, (2 P/dx + 4) dx^2 (every misclassified lattice point's cell meets the boundary), and
  *    within 1 % at 100 points across;
- *  - a cube STL (binary, 12 triangles) aligned with the lattice holds exactly (L/dx)^3 points;
+ *  - a cube STL (binary, 12 triangles) aligned with the lattice holds exactly (L/dx)^3 points,
+ *    and points whose ray leaves through an edge or a corner are still inside;
  *  - a closed, non-convex, star-shaped mesh (perturbed icosphere, 1280 triangles, ASCII STL):
  *    N dx^3 against the mesh's own volume (divergence theorem) within 1 %, and within the
  *    boundary-shell bound A sqrt(3) dx;
@@ -247,6 +248,18 @@ static void test_meshes(const char *tmp)
         CHECK(fabs(b->lo[0] - 1.0) < 1e-7 && fabs(b->hi[2] - 3.1) < 1e-7, "cube: bounds moved to position");
         CHECK(n == 1000, "cube STL: %lld lattice points, expected (L/dx)^3 = 1000", (long long)n);
         CHECK(lahar_case_block_lattice(&c, 0, NULL, 0) == 1000, "cube STL: no body, nothing cut");
+        /* points whose first ray (direction (1, 1/pi, e^(-pi/2))) leaves the cube exactly through
+         * an edge or a corner, where two or three triangles meet: parity alone would be wrong */
+        vec3 d0 = v3_normalize(v3(1.0, 0.3183098861837907, 0.2078795763507619));
+        const double *lo = b->lo, *hi = b->hi; /* the mesh's own (float-rounded) coordinates */
+        const double targets[3][3] = {{hi[0], 0.5 * (lo[1] + hi[1]), hi[2]}, {hi[0], hi[1], hi[2]},
+                                      {hi[0], hi[1], 0.5 * (lo[2] + hi[2])}};
+        for (int k = 0; k < 3; k++) {
+            double x[3];
+            v3_store(v3_sub(v3_load(targets[k]), v3_scale(d0, 0.05)), x);
+            CHECK(lahar_particle_block_contains(b, 3, x), "cube STL: point [%g, %g, %g] whose ray grazes an edge or a "
+                  "corner must be inside", x[0], x[1], x[2]);
+        }
         lahar_case_free(&c);
     } else
         CHECK(0, "cube case does not load");
