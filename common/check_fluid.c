@@ -936,9 +936,31 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
 
 /* ---------------------------------------------------------------- dam break ------------- */
 
-/* A water column collapsing in a tank of fixed bodies. No published surge-front data is in
- * shared/reference (Martin & Moyce 1952 is not), so the metrics are the properties every correct
- * run has:
+/* Martin & Moyce (1952), "An experimental study of the collapse of liquid columns on a rigid
+ * horizontal plane", Phil. Trans. R. Soc. Lond. A 244:312-324, Figure 3: surge front Z = z/a
+ * (z from the column's back wall, a the column's initial width) against T = t sqrt(2 g / a) for
+ * a column of height n^2 a with n^2 = 2, a = 2.25 in. Not in shared/reference: the values are
+ * those digitised from the figure in PySPH (github.com/pypr/pysph, pysph/examples/db_exp_data.py,
+ * mm_data_2, commit 483e4449f50719350fc2857e8163ea3aae637cc7). */
+static const double mm_T[] = {0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5.091,
+                              5.685, 6.306, 6.822, 7.439, 8.031, 8.633, 9.237};
+static const double mm_Z[] = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980,
+                              7.945, 8.966, 9.986, 10.963, 11.977, 13.005, 13.970};
+#define MM_N ((int)(sizeof mm_T / sizeof mm_T[0]))
+
+/* Linear interpolation of the Martin & Moyce front at T (NAN outside the data). */
+static double fluid_martin_moyce(double T)
+{
+    if (T < mm_T[0] || T > mm_T[MM_N - 1])
+        return NAN;
+    int i = 0;
+    while (i + 2 < MM_N && T > mm_T[i + 1])
+        i++;
+    double s = (T - mm_T[i]) / (mm_T[i + 1] - mm_T[i]);
+    return (1.0 - s) * mm_Z[i] + s * mm_Z[i + 1];
+}
+
+/* A water column collapsing in a tank of fixed bodies. Metrics that every correct run has:
  *  - mass_change: max over snapshots of |N - N_0| / N_0 (particles have constant mass).
  *  - escaped_particles: the most particles in one snapshot that are inside a body (centre within
  *    a body's swept layer, or inside a closed convex core) or more than dx outside the box around
@@ -946,6 +968,12 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
  *  - front_regression: the front (furthest particle along the flow direction: horizontal, from
  *    the column towards the tank's far side) must advance until it reaches its furthest
  *    position; the largest step back before that, in units of dx.
+ *  - front_rel_error (only for a column of height 2 x width, Martin & Moyce's n^2 = 2, within
+ *    5 %): the largest |Z - Z_MM| / Z_MM over the snapshots inside the data's T range before the
+ *    front reaches its furthest position, Z = (front + dx/2 - back of the column at t = 0) / a,
+ *    the water's edge being dx/2 beyond the furthest particle (lattice) and the back dx/2 behind
+ *    the hindmost one, a the column's initial width (extent + dx).
+ *    The experiment's gate opening delays its early front; SPH fronts usually lead slightly.
  * Informative: front_speed_ritter_ratio, the mean front speed until the front has covered half
  * its run, over the Ritter (1892) dry-bed shallow-water front speed 2 sqrt(g H0) (an upper
  * bound for a real front; H0 the initial column height). */
@@ -990,9 +1018,14 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
         ylo = fmin(ylo, v3_dot(x, up)), yhi = fmax(yhi, v3_dot(x, up));
     }
     cen = v3_scale(cen, 1.0 / (double)(n0 ? n0 : 1));
-    double H0 = yhi - ylo + dx;
+    double H0 = yhi - ylo + dx, elo = INFINITY, ehi = -INFINITY;
     vec3 tank_c = v3(0.5 * (blo[0] + bhi[0]), 0.5 * (blo[1] + bhi[1]), c->dim == 3 ? 0.5 * (blo[2] + bhi[2]) : 0.0);
     vec3 ef = v3_dot(v3_sub(tank_c, cen), e1) >= 0.0 ? e1 : v3_neg(e1);
+    for (int64_t i = 0; i < n0; i++) {
+        double s = v3_dot(fluid_pos(p, i), ef);
+        elo = fmin(elo, s), ehi = fmax(ehi, s);
+    }
+    double a_col = ehi - elo + dx, back = elo - 0.5 * dx, Tscale = sqrt(2.0 * g / a_col);
     double tol = c->output_interval > 0.0 ? 0.25 * c->output_interval : 1e-9;
     double mass = 0.0, *front = malloc((size_t)p->nsnap * sizeof *front);
     int64_t escaped = 0;
@@ -1045,6 +1078,25 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
             ritter = (front[k] - front[0]) / (p->t[k] - p->t[0]) / c_r;
             break;
         }
+    /* Martin & Moyce */
+    int mm = fabs(H0 / a_col - 2.0) <= 0.1;
+    double mm_err = NAN;
+    if (mm) {
+        mm_err = 0.0;
+        for (int64_t k = 0; k < khit; k++) {
+            double zr = fluid_martin_moyce((p->t[k] - p->t[0]) * Tscale);
+            if (isfinite(zr))
+                mm_err = fmax(mm_err, fabs((front[k] + 0.5 * dx - back) / a_col - zr) / zr);
+        }
+        int pm = lahar_check_panel(r, "surge front against Martin & Moyce 1952 (n^2 = 2, a = 2.25 in)",
+                                   "T = t sqrt(2 g / a)", "Z = z / a");
+        lahar_check_curve(r, pm, 1, "lahar");
+        for (int64_t k = 0; k < p->nsnap; k++)
+            lahar_check_point(r, (p->t[k] - p->t[0]) * Tscale, (front[k] + 0.5 * dx - back) / a_col);
+        lahar_check_curve(r, pm, 0, "Martin & Moyce 1952 Fig. 3 (as digitised in PySPH)");
+        for (int i = 0; i < MM_N; i++)
+            lahar_check_point(r, mm_T[i], mm_Z[i]);
+    }
     int pf = lahar_check_panel(r, "surge front (furthest particle along the flow)", "t [s]", "front advance [m]");
     lahar_check_curve(r, pf, 1, "lahar");
     for (int64_t k = 0; k < p->nsnap; k++)
@@ -1057,13 +1109,18 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
     lahar_check_value(r, "mass_change", mass);
     lahar_check_value(r, "front_regression", regress);
     lahar_check_value(r, "front_speed_ritter_ratio", ritter);
+    if (mm)
+        lahar_check_value(r, "front_rel_error", mm_err);
+    lahar_check_value(r, "column_width", a_col);
     lahar_check_value(r, "column_height", H0);
     lahar_check_value(r, "particles", (double)n0);
     lahar_check_value(r, "t_last", p->t[p->nsnap - 1]);
     snprintf(r->note, sizeof r->note,
-             "no published front data in shared/reference (Martin & Moyce 1952 absent): metrics are particle count "
-             "conservation, no particle inside a body or out of the tank, and a front that only advances; Ritter's "
-             "2 sqrt(g H0) is shown as an upper bound");
+             "metrics: particle count conservation, no particle inside a body or out of the tank, a front that only "
+             "advances%s; Ritter's 2 sqrt(g H0) is shown as an upper bound",
+             mm ? ", front vs Martin & Moyce 1952 Fig. 3 n^2 = 2 (values digitised in PySPH db_exp_data.py, not in "
+                  "shared/reference)"
+                : "; no Martin & Moyce comparison (needs a column of height 2 x width)");
     snprintf(r->title, sizeof r->title, "dam_break: %" PRId64 " particles, H0 = %.4g m", n0, H0);
     return 0;
 }

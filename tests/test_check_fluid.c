@@ -14,6 +14,8 @@
  *  - sinking_disc: a disc settles on the floor; a particle inside the floor's layer fails;
  *  - dam_break: a column spreading to the far wall; a particle out of the tank, one deep inside a
  *    fixed box's core and a front that steps back fail;
+ *  - dam_break against Martin & Moyce 1952 (n^2 = 2): a front on their data passes, 10 % ahead
+ *    gives front_rel_error 0.1;
  *  - missing particles / fields -> status 2.
  *   test_check_fluid OUTDIR */
 #include <cjson/cJSON.h>
@@ -617,6 +619,63 @@ static void test_dam_break(const char *base)
     CHECK(fabs(v - 9.75) < 1e-9, "dam break regress: front_regression %.10g (9.75 dx)", v);
 }
 
+/* A column a = 0.1 m wide, 0.2 m high (Martin & Moyce's n^2 = 2) whose front follows their
+ * Figure 3 data times `zfac` (Z linear from 1 at T = 0 to the first data point, constant after
+ * the last): the evaluator must find front_rel_error = |zfac - 1|. */
+static const double mmT[] = {0.0, 0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5.091,
+                             5.685, 6.306, 6.822, 7.439, 8.031, 8.633, 9.237};
+static const double mmZ[] = {1.0, 1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980,
+                             7.945, 8.966, 9.986, 10.963, 11.977, 13.005, 13.970};
+
+static void mm_run(const char *dir, double zfac)
+{
+    case_begin("dam_break", 2);
+    const double W = 1.6, a = 0.1, dx = 0.005, R = 0.002, g = 9.81;
+    cs.sph_dx = dx, cs.output_interval = 0.02;
+    add_segment("floor", -0.05, -R, W + 0.05, -R, R);
+    add_segment("left", -R, 0.0, -R, 0.8, R);
+    add_segment("right", W + R, 0.0, W + R, 0.8, R);
+    metric("front_rel_error", 0.05);
+    run_out o;
+    if (run_open(dir, &o))
+        return;
+    const int n = (int)(sizeof mmT / sizeof mmT[0]);
+    for (int k = 0; k <= 40; k++) {
+        double t = 0.02 * k, T = t * sqrt(2.0 * g / a), Z = mmZ[n - 1];
+        for (int i = 0; i + 1 < n; i++)
+            if (T <= mmT[i + 1]) {
+                Z = mmZ[i] + (mmZ[i + 1] - mmZ[i]) * (T - mmT[i]) / (mmT[i + 1] - mmT[i]);
+                break;
+            }
+        Z = k == 0 ? 1.0 : zfac * Z;
+        /* furthest particle at 19.5 dx s, the water's edge dx/2 beyond: z = Z a */
+        double s = (Z * a - 0.5 * dx) / (19.5 * dx);
+        np = 0;
+        for (int i = 0; i < 20; i++)
+            for (int j = 0; j < 40; j++, np++) {
+                px[np] = (i + 0.5) * dx * s, py[np] = (j + 0.5) * dx / s, pvx[np] = pvy[np] = 0.0;
+                pden[np] = 1000.0, ppr[np] = 0.0;
+            }
+        memset(reports, 0, sizeof reports);
+        lahar_body_output_forces(o.bo, k, t, reports);
+        run_snapshot(&o, k, t);
+    }
+    run_close(&o);
+}
+
+static void test_martin_moyce(const char *base)
+{
+    char dir[1100];
+    snprintf(dir, sizeof dir, "%s/dam_mm_pass", base);
+    mm_run(dir, 1.0);
+    double v = evaluate(dir, 0, "front_rel_error");
+    CHECK(v < 1e-9, "dam break on Martin & Moyce's data: front_rel_error %g", v);
+    snprintf(dir, sizeof dir, "%s/dam_mm_fast", base);
+    mm_run(dir, 1.1);
+    v = evaluate(dir, 1, "front_rel_error");
+    CHECK(fabs(v - 0.1) < 1e-9, "dam break front 10 %% ahead: front_rel_error %.10g (0.1)", v);
+}
+
 /* ---------------------------------------------------------------- errors ---------------- */
 
 static void test_errors(const char *base)
@@ -664,6 +723,7 @@ int main(int argc, char **argv)
     test_floating_box(base);
     test_sinking_disc(base);
     test_dam_break(base);
+    test_martin_moyce(base);
     test_errors(base);
     case_begin("none", 2);
     if (failures) {
