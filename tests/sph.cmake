@@ -19,3 +19,8 @@ add_executable(test_sph_coupling ${LAHAR_TEST_DIR}/test_sph_coupling.c)
 target_link_libraries(test_sph_coupling PRIVATE lahar_sph)
 add_test(NAME sph_coupling COMMAND test_sph_coupling)
 set_tests_properties(sph_coupling PROPERTIES LABELS "fast;sph" TIMEOUT 120)
+
+add_executable(test_sph_hydrostatic ${LAHAR_TEST_DIR}/test_sph_hydrostatic.c)
+target_link_libraries(test_sph_hydrostatic PRIVATE lahar_sph)
+add_test(NAME sph_hydrostatic COMMAND test_sph_hydrostatic)
+set_tests_properties(sph_hydrostatic PROPERTIES LABELS "fast;sph" TIMEOUT 120)

@@ -1,0 +1,150 @@
+/* 2D hydrostatic water column in a tank of three fixed DEM walls (issue 3, "Hydrostatic tank";
+ * shared/reference/05_analytic_fluid_checks.txt 5.6): width W, water depth H = N dx, rho0 = 1000,
+ * g = 9.81, linear EOS with c0 = 20 sqrt(g H), particles start on the lattice with the
+ * hydrostatic density, Monaghan artificial viscosity damps the start-up waves.
+ * After settling (t = 2 s), against p = rho0 g (H - y) and the force per unit width
+ * F = rho0 g H^2 / 2 on a side wall (exact hydrostatics):
+ *   - each side wall's horizontal force within 1 %;
+ *   - the floor carries the weight of the water within 0.5 %;
+ *   - the pressure profile at gauges on the centre line (kernel support above the floor to h
+ *     below the surface) within 1 % of rho0 g H (RMS) and 1.5 % (max);
+ *   - no particle crossed a wall, the free surface stays level (height spread < dx/2) and the
+ *     kinetic energy has decayed (|v|max < 1 % of sqrt(g H)). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "shape_build.h"
+#include "sph_fluid.h"
+
+static int failures;
+#define CHECK(cond, ...)                                                                           \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fputc('\n', stderr);                                                                   \
+            failures++;                                                                            \
+        }                                                                                          \
+    } while (0)
+
+/* A fixed wall: 2D box with world-frame vertices, swept radius R. */
+static void wall(lahar_body *b, double cx, double cy, double hx, double hy)
+{
+    memset(b, 0, sizeof *b);
+    const double R = 0.005;
+    double half[2] = {hx - R, hy - R}, t[3] = {cx, cy, 0};
+    if (lahar_shape_make_box2d(&b->shape, half, R) != 0)
+        abort();
+    lahar_shape_transform(&b->shape, NULL, t, 1.0);
+    b->motion = LAHAR_MOTION_FIXED;
+    b->convex = 1;
+    b->q[0] = 1.0;
+}
+
+int main(int argc, char **argv)
+{
+    const int NX = 20, NY = argc > 1 ? atoi(argv[1]) : 20;
+    const double dx = 0.01, W = NX * dx, H = NY * dx, g = 9.81, rho0 = 1000, T = argc > 2 ? atof(argv[2]) : 2.0;
+    sph_params prm = {0};
+    prm.dim = 2;
+    prm.dx = dx;
+    prm.rho0 = rho0;
+    prm.c0 = 20.0 * sqrt(g * H);
+    prm.alpha = 0.1;
+    prm.delta = getenv("SPH_DELTA") ? atof(getenv("SPH_DELTA")) : 0.0;
+    prm.shepard_every = getenv("SPH_SHEPARD") ? atoi(getenv("SPH_SHEPARD")) : 0;
+    prm.mu = 1e-3;
+    prm.body_force[1] = -g;
+    sph_fluid f;
+    char err[256];
+    if (sph_fluid_init(&f, &prm, NX * NY, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    double lo[3] = {0, 0, 0}, hi[3] = {W, H, 0}, v0[3] = {0, 0, 0};
+    sph_particles_add_box(&f.p, 2, dx, rho0, lo, hi, v0);
+    for (int64_t i = 0; i < f.p.n; i++) { /* hydrostatic start: p = rho0 g (H - y), mass rho dx^2 */
+        f.p.rho[i] = rho0 + rho0 * g * (H - f.p.y[i]) / (prm.c0 * prm.c0);
+        f.p.m[i] = f.p.rho[i] * dx * dx;
+    }
+    lahar_body walls[3];
+    wall(&walls[0], W / 2, -0.05, W / 2 + 0.2, 0.05);  /* floor, surface y = 0 */
+    wall(&walls[1], -0.05, H, 0.05, H + 0.1);         /* left, surface x = 0 */
+    wall(&walls[2], W + 0.05, H, 0.05, H + 0.1);      /* right, surface x = W */
+    if (sph_fluid_attach_bodies(&f, 3, walls) != 0)
+        return 1;
+    int64_t crossings = 0;
+    int steps = 0;
+    double fsum[3][2] = {{0}};
+    int nsum = 0;
+    while (f.t < T) {
+        double dt = f.primed ? sph_fluid_dt(&f) : 1e-5;
+        int64_t c = sph_fluid_step(&f, dt, NULL);
+        crossings += c > 0 ? c : 0;
+        steps++;
+        if (f.t > T - 0.1) { /* average the wall forces over the last 0.1 s (acoustic ringing) */
+            for (int b = 0; b < 3; b++)
+                for (int a = 0; a < 2; a++)
+                    fsum[b][a] += f.cpl.force[b][a];
+            nsum++;
+        }
+    }
+    double mass = 0.0;
+    for (int64_t i = 0; i < f.p.n; i++)
+        mass += f.p.m[i];
+    const double f_wall = rho0 * g * H * H / 2.0, weight = mass * g;
+    /* the water pushes the left wall to -x, the right one to +x, the floor down */
+    double fl = -fsum[1][0] / nsum, fr = fsum[2][0] / nsum, ff = -fsum[0][1] / nsum;
+    /* pressure gauges on the centre line every dx from one kernel support above the floor to one
+     * h below the surface (as DualSPHysics' MeasureTool): Shepard-normalised kernel interpolation
+     * sum p_j V_j W / sum V_j W. Closer to the floor the particles pressed against the penalty
+     * wall read high (+13 % of rho g H at 1.5 dx): no wall particles complete their kernel. */
+    double rms = 0.0, worst = 0.0, vmax = 0.0, ytop_min = 1e9, ytop_max = -1e9;
+    int rows = 0;
+    for (double gy = f.k.support; gy <= H - f.k.h; gy += dx) {
+        double num = 0.0, den = 0.0;
+        for (int64_t i = 0; i < f.p.n; i++) {
+            double w = kernel_w(&f.k, hypot(f.p.x[i] - W / 2, f.p.y[i] - gy)) * f.p.m[i] / f.p.rho[i];
+            num += w * f.p.p[i];
+            den += w;
+        }
+        double e = (num / den - rho0 * g * (H - gy)) / (rho0 * g * H);
+        if (getenv("SPH_ROWS"))
+            printf("gauge y %.4f: p %.2f, hydrostatic %.2f (%+.2f %% of rho g H)\n", gy, num / den,
+                   rho0 * g * (H - gy), 100 * e);
+        rms += e * e;
+        worst = fmax(worst, fabs(e));
+        rows++;
+    }
+    rms = sqrt(rms / rows);
+    for (int64_t i = 0; i < f.p.n; i++) {
+        vmax = fmax(vmax, hypot(f.p.vx[i], f.p.vy[i]));
+        if (f.p.y[i] > H - 1.5 * dx) {
+            ytop_min = fmin(ytop_min, f.p.y[i]);
+            ytop_max = fmax(ytop_max, f.p.y[i]);
+        }
+    }
+    printf("hydrostatic 2D, %d x %d particles, %d steps to t = %.2f s (dt %.3g s):\n", NX, NY, steps, f.t,
+           sph_fluid_dt(&f));
+    printf("  side walls %.5g, %.5g N/m vs rho g H^2/2 = %.5g (%+.3f %%, %+.3f %%)\n", fl, fr, f_wall,
+           100 * (fl / f_wall - 1), 100 * (fr / f_wall - 1));
+    printf("  floor %.5g N/m vs weight %.5g (%+.3f %%); pressure gauges: RMS %.3f %%, max %.3f %% of rho g H\n", ff,
+           weight, 100 * (ff / weight - 1), 100 * rms, 100 * worst);
+    printf("  |v|max %.3g m/s, top row spread %.3g m, crossings %lld\n", vmax, ytop_max - ytop_min,
+           (long long)crossings);
+    CHECK(fabs(fl / f_wall - 1) <= 0.01 && fabs(fr / f_wall - 1) <= 0.01, "side wall force off rho g H^2/2 by > 1 %%");
+    CHECK(fabs(ff / weight - 1) <= 0.005, "floor force off the weight by > 0.5 %%");
+    CHECK(rms <= 0.01 && worst <= 0.015, "pressure profile off hydrostatic (RMS %.3f %%, max %.3f %%)", 100 * rms,
+          100 * worst);
+    CHECK(crossings == 0, "%lld wall crossings", (long long)crossings);
+    CHECK(ytop_max - ytop_min < 0.5 * dx, "free surface not level (spread %g m)", ytop_max - ytop_min);
+    CHECK(vmax < 0.01 * sqrt(g * H), "not settled: |v|max %g m/s", vmax);
+    sph_fluid_free(&f);
+    for (int b = 0; b < 3; b++)
+        lahar_shape_free(&walls[b].shape);
+    if (failures)
+        return 1;
+    printf("PASS test_sph_hydrostatic\n");
+    return 0;
+}
