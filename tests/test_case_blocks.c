@@ -12,7 +12,8 @@
  *    N dx^3 against the mesh's own volume (divergence theorem) within 1 %, and within the
  *    boundary-shell bound A sqrt(3) dx;
  *  - cut-out: a water box around a fixed disc, a free 2D box turned by 30 degrees and a 3D
- *    sphere loses exactly the lattice points an independent distance test puts inside them.
+ *    sphere loses exactly the lattice points an independent distance test puts inside them;
+ *  - every sph: default is the documented value (c0 = 10 sqrt(2 g H) computed independently).
  * usage: test_case_blocks TMP_DIR */
 #include <math.h>
 #include <stdint.h>
@@ -367,12 +368,47 @@ static void test_cutout(const char *tmp)
         CHECK(0, "3D cut-out case does not load");
 }
 
+/* The documented defaults of sph: (cases/dem_drop_3d.yaml) are the loaded values. */
+static void test_defaults(const char *tmp)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/blocks_defaults.yaml", tmp);
+    write_file(path, "dimensions: 2\ntime: {end: 1}\nsph:\n  dx: 0.01\n  kernel: quintic\n"
+                     "  blocks: [{box: {lo: [0, 0.1], hi: [0.3, 0.3]}}, {box: {lo: [0.3, 0.1], hi: [0.4, 0.2]}, velocity: [0.5, 0]}]\n");
+    lahar_case c;
+    if (lahar_case_load(path, &c) != 0) {
+        CHECK(0, "defaults case does not load");
+        return;
+    }
+    const lahar_sph_options *o = &c.sph;
+    double c0 = 10.0 * sqrt(2.0 * 9.81 * 0.2); /* fluid height: blocks span y = 0.1 .. 0.3 */
+    CHECK(c.sph_density == 1000.0, "density default 1000 (got %g)", c.sph_density);
+    CHECK(!strcmp(o->kernel, "quintic") && o->h_over_dx == 1.3, "kernel quintic, h_over_dx 1.3 (got %s, %g)", o->kernel,
+          o->h_over_dx);
+    CHECK(fabs(o->c0 - c0) < 1e-12 * c0, "c0 default 10 sqrt(2 g H) = %.15g (got %.15g)", c0, o->c0);
+    CHECK(o->eos == LAHAR_SPH_EOS_LINEAR && o->gamma == 7.0, "eos linear, gamma 7");
+    CHECK(o->mu == 1e-3 && o->alpha == 0.0 && o->delta == 0.1, "viscosity 1e-3, alpha 0, delta 0.1 (got %g %g %g)",
+          o->mu, o->alpha, o->delta);
+    CHECK(o->cfl == 0.25 && o->cfl_force == 0.25 && o->cfl_visc == 0.125, "cfl 0.25, 0.25, 0.125");
+    CHECK(o->body_force[0] == 0 && o->body_force[1] == 0 && !o->periodic[0] && !o->periodic[1], "no body force, "
+          "not periodic");
+    CHECK(o->shepard_interval == 0 && !o->sps && o->sps_cs == 0.12, "Shepard off, SPS off (cs 0.12)");
+    CHECK(o->halo == 0.005 && o->kappa == 3.0, "halo dx/2 = 0.005, kappa = quintic support 3 (got %g, %g)", o->halo,
+          o->kappa);
+    CHECK(o->wall_viscous == LAHAR_SPH_WALL_HALFSPACE, "wall_viscous halfspace");
+    CHECK(c.nblock == 2 && !strcmp(c.blocks[0].name, "block0") && !strcmp(c.blocks[1].name, "block1") &&
+              c.blocks[1].v[0] == 0.5 && c.blocks[0].kind == LAHAR_BLOCK_BOX,
+          "block names default to block<i>, velocity kept");
+    lahar_case_free(&c);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
         fprintf(stderr, "usage: %s TMP_DIR\n", argv[0]);
         return 2;
     }
+    test_defaults(argv[1]);
     test_polygons();
     test_meshes(argv[1]);
     test_cutout(argv[1]);
