@@ -80,8 +80,8 @@ static double fluid_core_dist(const lahar_case *c, const lahar_check_data *d, in
 }
 
 /* 1 when p lies inside the closed convex core of body j (3D: a polyhedron of >= 4 faces, p
- * behind every face; 2D: a polygon of >= 3 edges, p on the inner side of every edge, the centre
- * of mass being inside). Tells a particle that went deep into a body from one merely far from
+ * behind every face; 2D: a polygon of >= 3 edges, p on the same side of every edge as the
+ * vertex mean). Tells a particle that went deep into a body from one merely far from
  * its surface (geom_point_body_core gives an unsigned distance). */
 static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
 {
@@ -103,7 +103,11 @@ static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data 
     }
     if (s->ne < 3)
         return 0;
-    vec3 xc = v3_load(x);
+    /* an interior point: the vertex mean (fixed bodies keep world-frame vertices with x = 0) */
+    vec3 xc = v3(0, 0, 0);
+    for (int i = 0; i < s->nv; i++)
+        xc = v3_add(xc, geom_world_vertex(s, x, q, i));
+    xc = v3_scale(xc, 1.0 / s->nv);
     for (int e = 0; e < s->ne; e++) {
         vec3 a = geom_world_vertex(s, x, q, s->e[e][0]), b = geom_world_vertex(s, x, q, s->e[e][1]);
         vec3 ab = v3_sub(b, a);

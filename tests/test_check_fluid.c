@@ -563,7 +563,9 @@ static void dam_run(const char *dir, int escape, int regress)
     int ob = add_body("obstacle", LAHAR_MOTION_FIXED, 0);
     double half[2] = {0.05, 0.05};
     lahar_shape_make_box2d(&bodies[ob].shape, half, R);
-    bodies[ob].x[0] = 0.8, bodies[ob].x[1] = 0.7;
+    /* as the case loader places fixed bodies: world-frame vertices, x = 0, identity q */
+    const double I3[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, at[3] = {0.8, 0.7, 0.0};
+    lahar_shape_transform(&bodies[ob].shape, I3, at, 1.0);
     metric("escaped_particles", 0.0);
     metric("mass_change", 0.0);
     metric("front_regression", 1.0);
