@@ -398,8 +398,10 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     lahar_link_stats *st = &l->stats[f.type];
     st->frames_heard++;
     st->bytes_heard += (uint64_t)size;
-    if (f.flags & LAHAR_FRAME_T_FLAG_RESEND)
+    if (f.flags & LAHAR_FRAME_T_FLAG_RESEND) {
         st->frames_resent_heard++;
+        st->bytes_resent_heard += (uint64_t)size;
+    }
     else if (f.index == 0)
         st->msgs_heard++;
 

@@ -42,7 +42,7 @@ typedef struct {
     uint64_t msgs_sent, frames_sent, bytes_sent;         /* first publications by this process */
     uint64_t frames_resent, bytes_resent;                /* re-publications on NACK by this process */
     uint64_t msgs_heard, frames_heard, bytes_heard;      /* frames of this run from other processes */
-    uint64_t frames_resent_heard;                        /* ... of which were re-sends */
+    uint64_t frames_resent_heard, bytes_resent_heard;    /* ... of which were re-sends */
     uint64_t nacks_sent;                                 /* NACKs this process sent for this channel */
     uint64_t send_failures;                              /* frames the transport refused (repaired by NACK) */
 } lahar_link_stats;

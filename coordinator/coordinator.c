@@ -494,6 +494,9 @@ static void coord_write_summary(coord *co)
             cJSON_AddNumberToObject(j, "bytes", (double)(s->bytes_sent + s->bytes_resent + s->bytes_heard));
             cJSON_AddNumberToObject(j, "frames", (double)(s->frames_sent + s->frames_resent + s->frames_heard));
             cJSON_AddNumberToObject(j, "resent_frames", (double)(s->frames_resent + s->frames_resent_heard));
+            /* bytes without the re-sends: what the run itself costs on the wire (the re-sends
+             * depend on timing, e.g. a NACK that crossed a late original) */
+            cJSON_AddNumberToObject(j, "first_bytes", (double)(s->bytes_sent + s->bytes_heard - s->bytes_resent_heard));
             cJSON_AddNumberToObject(j, "sent_messages", (double)s->msgs_sent);
             cJSON_AddNumberToObject(j, "sent_bytes", (double)(s->bytes_sent + s->bytes_resent));
             cJSON_AddNumberToObject(j, "heard_messages", (double)s->msgs_heard);

@@ -113,7 +113,8 @@ import h5py, numpy as np
 near, far = (json.load(open(d + "/summary.json")) for d in sys.argv[1:3])
 assert near["steps"] == far["steps"], (near["steps"], far["steps"])
 for ch in ("LAHAR_LOADS", "LAHAR_BODY_STATE"):
-    a, b = near["channels"][ch]["bytes"], far["channels"][ch]["bytes"]
+    # first publications only: re-sends on a NACK depend on timing (a slow sanitizer build)
+    a, b = near["channels"][ch]["first_bytes"], far["channels"][ch]["first_bytes"]
     assert a == b, "%s: %d bytes without the far body, %d with it" % (ch, a, b)
 with h5py.File(sys.argv[1] + "/bodies.h5") as a, h5py.File(sys.argv[2] + "/bodies.h5") as b:
     for name in a["snapshots"]:
@@ -125,7 +126,7 @@ with h5py.File(sys.argv[1] + "/bodies.h5") as a, h5py.File(sys.argv[2] + "/bodie
 exact = 0.13 - 1.0 * t - 0.5 * 9.81 * t * t
 assert abs(y - exact) < 1e-9, (y, exact)
 print("far_body: LOADS %d B and BODY_STATE %d B with and without the far body; far box in free fall (error %.1e m)"
-      % (far["channels"]["LAHAR_LOADS"]["bytes"], far["channels"]["LAHAR_BODY_STATE"]["bytes"], abs(y - exact)))
+      % (far["channels"]["LAHAR_LOADS"]["first_bytes"], far["channels"]["LAHAR_BODY_STATE"]["first_bytes"], abs(y - exact)))
 PY
     ;;
 hydrostatic)
