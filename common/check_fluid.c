@@ -347,6 +347,13 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
                  lo >= 0 ? c->bodies[lo].name : "none", hi >= 0 ? " and " : "", hi >= 0 ? c->bodies[hi].name : "");
         return -1;
     }
+    if (ny.x + ny.y + ny.z < 0.0) { /* y = 0 at the plate on the low side of the axes */
+        int tj = lo;
+        lo = hi, hi = tj;
+        double tg = gap_lo;
+        gap_lo = gap_hi, gap_hi = tg;
+        ny = v3_neg(ny);
+    }
     double H = gap_lo + gap_hi;
     /* period along the flow and the width across (3D) */
     vec3 ez = v3_cross(ex, ny);
