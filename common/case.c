@@ -1061,6 +1061,9 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
  * rejected instead of silently running without them. Flip when the solver grows them. */
 #define LAHAR_SPH_HAVE_SHEPARD 0
 #define LAHAR_SPH_HAVE_SPS 0
+/* the coupling (sph_node/sph_coupling.h) uses eps = dx/2 and the kernel's support */
+#define LAHAR_SPH_HAVE_HALO 0
+#define LAHAR_SPH_HAVE_KAPPA 0
 
 /* Edges of a closed surface are shared by exactly two triangles. Returns 0, or the number of
  * edges that are not (first one in *bad_a, *bad_b), or -1 out of memory. */
@@ -1539,6 +1542,12 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     else if (!(o->halo > 0 && o->halo < o->kappa * h))
         rmap_fail(&m, "halo", "must be in (0, kappa h = %g) m (got %g); dx/2 = %g is usual", o->kappa * h, o->halo,
                   0.5 * dx);
+    else if (!LAHAR_SPH_HAVE_HALO && fabs(o->halo - 0.5 * dx) > 1e-12 * dx)
+        rmap_fail(&m, "halo", "a halo other than dx/2 = %g m is not implemented yet (got %g); remove the key",
+                  0.5 * dx, o->halo);
+    else if (!LAHAR_SPH_HAVE_KAPPA && fabs(o->kappa - kd->kappa) > 1e-12)
+        rmap_fail(&m, "kappa", "a coupling range other than the kernel's support (%g h for %s) is not implemented "
+                  "yet (got %g); remove the key", kd->kappa, o->kernel, o->kappa);
     if (r->failed)
         return;
     o->shepard_interval = (int)shep;
