@@ -135,13 +135,10 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->cfl_force = o->cfl_force;
     prm->cfl_visc = o->cfl_visc;
     prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
+    prm->shepard_every = o->shepard_interval;
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->sps) {
         snprintf(err, errlen, "sph.sps: the SPS turbulence model is not implemented by the solver yet");
-        return -1;
-    }
-    if (o->shepard_interval > 0) {
-        snprintf(err, errlen, "sph.shepard_interval: the Shepard filter is not implemented by the solver yet");
         return -1;
     }
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {

@@ -20,8 +20,7 @@ typedef struct {
 
 /* The solver parameters of a case (lahar_case.sph, sph_dx, sph_density, gravity added to the
  * fluid's body force). Returns 0, or -1 with a message for options the solver core does not
- * implement yet (SPS, Shepard filter, a halo other than dx/2, a coupling range other than the
- * kernel support). */
+ * implement yet (SPS, a halo other than dx/2, a coupling range other than the kernel support). */
 int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen);
 
 /* Allocate and fill the lattice points of spacing dx inside every block
