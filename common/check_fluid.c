@@ -975,7 +975,7 @@ static double fluid_martin_moyce(double T)
  *  - mass_change: max over snapshots of |N - N_0| / N_0 (particles have constant mass).
  *  - escaped_particles: the most particles in one snapshot that are inside a body (centre within
  *    a body's swept layer, or inside a closed convex core) or more than dx outside the box around
- *    all fixed bodies (left the tank).
+ *    all fixed bodies, except above it (left the tank; a splash may rise above the walls).
  *  - front_regression: the front (furthest particle along the flow direction: horizontal, from
  *    the column towards the tank's far side) must advance until it reaches its furthest
  *    position; the largest step back before that, in units of dx.
@@ -1055,8 +1055,10 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
             vec3 x = fluid_pos(p, i);
             fr = fmax(fr, v3_dot(x, ef));
             int out = 0;
-            for (int a = 0; a < c->dim; a++)
-                out |= v3_get(x, a) < blo[a] - dx || v3_get(x, a) > bhi[a] + dx;
+            for (int a = 0; a < c->dim; a++) {
+                double ua = v3_get(up, a); /* the tank is open at the top: splashes may rise above it */
+                out |= (ua < 0.9 && v3_get(x, a) > bhi[a] + dx) || (ua > -0.9 && v3_get(x, a) < blo[a] - dx);
+            }
             for (int j = 0; j < c->nbody && !out; j++) {
                 int fixed = c->bodies[j].motion == LAHAR_MOTION_FIXED;
                 if (!fixed && kb < 0)

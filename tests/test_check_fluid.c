@@ -588,6 +588,8 @@ static void dam_run(const char *dir, int escape, int regress)
             px[5] = W + 0.2;
         if (escape == 2 && k == 7)
             px[5] = 0.8, py[5] = 0.7;
+        if (escape == 3 && k == 7)
+            px[5] = 0.5, py[5] = 1.0; /* a splash above the walls (top 0.8): not escaped */
         memset(reports, 0, sizeof reports);
         lahar_body_output_forces(o.bo, k, t, reports);
         run_snapshot(&o, k, t);
@@ -615,6 +617,10 @@ static void test_dam_break(const char *base)
     dam_run(dir, 2, 0);
     v = evaluate(dir, 1, "escaped_particles");
     CHECK(v == 1.0, "dam break particle inside the obstacle's core: escaped_particles %g (1)", v);
+    snprintf(dir, sizeof dir, "%s/dam_splash", base);
+    dam_run(dir, 3, 0);
+    v = evaluate(dir, 0, "escaped_particles");
+    CHECK(v == 0.0, "dam break splash above the walls: escaped_particles %g (0)", v);
     snprintf(dir, sizeof dir, "%s/dam_regress", base);
     dam_run(dir, 0, 1);
     v = evaluate(dir, 1, "front_regression");
