@@ -146,11 +146,19 @@ static int fluid_frame(const lahar_case *c, vec3 *up, vec3 *e1, vec3 *e2)
     return 0;
 }
 
+/* Column tops of fluid_surface, kept across snapshots (grown by doubling, freed by the caller). */
+typedef struct {
+    double *top;
+    size_t cap;
+} fluid_columns;
+
 /* Free-surface level of the particles in the buffers (see the top of the file), skipping those
  * whose e1 coordinate lies in [skip_lo, skip_hi] (e.g. under a floating body). Returns the
- * number of columns (0: no particles), the level, and min/max of the column tops. */
+ * number of columns (0: no particles or out of memory), the level, and min/max of the column
+ * tops. */
 static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 e1, vec3 e2, double dx,
-                         double skip_lo, double skip_hi, double *level, double *top_min, double *top_max)
+                         double skip_lo, double skip_hi, fluid_columns *col, double *level, double *top_min,
+                         double *top_max)
 {
     double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
@@ -161,9 +169,16 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
     if (p->cur_n == 0 || dx <= 0.0)
         return 0;
     int64_t n1 = (int64_t)floor((hi1 - lo1) / dx) + 1, n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx) + 1 : 1;
-    double *top = malloc((size_t)(n1 * n2) * sizeof *top);
-    if (!top)
-        return 0;
+    if ((size_t)(n1 * n2) > col->cap) {
+        size_t cap = col->cap ? 2 * col->cap : 1024;
+        while (cap < (size_t)(n1 * n2))
+            cap *= 2;
+        double *t = realloc(col->top, cap * sizeof *t);
+        if (!t)
+            return 0;
+        col->top = t, col->cap = cap;
+    }
+    double *top = col->top;
     for (int64_t b = 0; b < n1 * n2; b++)
         top[b] = -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
@@ -185,7 +200,6 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
         nc++, sum += top[b];
         *top_min = fmin(*top_min, top[b]), *top_max = fmax(*top_max, top[b]);
     }
-    free(top);
     if (nc)
         *level = sum / nc + 0.5 * dx;
     return nc;
@@ -651,7 +665,9 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
             best = gap, floor_j = j, y_floor = v3_dot(v3_axpy(c->bodies[j].shape.radius, n, cp), up);
     }
     double level = 0.0, tmin = 0.0, tmax = 0.0;
-    if (floor_j < 0 || !fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &level, &tmin, &tmax)) {
+    fluid_columns cols = {NULL, 0};
+    if (floor_j < 0 || !fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &cols, &level, &tmin, &tmax)) {
+        free(cols.top);
         snprintf(r->err, sizeof r->err, "hydrostatic: no fixed floor under the fluid");
         return -1;
     }
@@ -663,7 +679,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
     double *bp = calloc((size_t)nb, sizeof *bp), *by = calloc((size_t)nb, sizeof *by);
     int64_t *bn = calloc((size_t)nb, sizeof *bn);
     if (!bp || !by || !bn) {
-        free(bp), free(by), free(bn);
+        free(bp), free(by), free(bn), free(cols.top);
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
@@ -671,10 +687,10 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
     int nwin = 0;
     for (int64_t k = kl; k >= 0 && (k == kl || p->t[k] >= t_from); k--) {
         if (fluid_read(d, k, r)) {
-            free(bp), free(by), free(bn);
+            free(bp), free(by), free(bn), free(cols.top);
             return -1;
         }
-        if (!fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &level, &tmin, &tmax))
+        if (!fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &cols, &level, &tmin, &tmax))
             continue;
         level_sum += level, spread_sum += tmax - tmin, nwin++;
         for (int64_t i = 0; i < p->cur_n; i++) {
@@ -700,7 +716,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
     lahar_check_curve(r, pp, 0, "rho g (h - y)");
     lahar_check_point(r, rho * g * h, 0.0);
     lahar_check_point(r, 0.0, h);
-    free(bp), free(by), free(bn);
+    free(bp), free(by), free(bn), free(cols.top);
     if (fluid_read(d, kl, r))
         return -1;
     /* side walls */
@@ -793,6 +809,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     lahar_check_curve(r, pd, 1, box->name);
     double sum = 0.0, hb = NAN, d_last = NAN, tilt = 0.0;
     int nwin = 0;
+    fluid_columns cols = {NULL, 0};
     for (int64_t k = 0; k < p->nsnap; k++) {
         int64_t kb = fluid_body_snapshot(d, p->t[k], tol);
         if (kb < 0)
@@ -805,10 +822,13 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
             bot = fmin(bot, v3_dot(v, up)), top = fmax(top, v3_dot(v, up));
             slo = fmin(slo, v3_dot(v, e1)), shi = fmax(shi, v3_dot(v, e1));
         }
-        if (fluid_read(d, k, r))
+        if (fluid_read(d, k, r)) {
+            free(cols.top);
             return -1;
+        }
         double level, tmin, tmax;
-        if (!fluid_surface(p, c->dim, up, e1, e2, dx, slo - R - dx, shi + R + dx, &level, &tmin, &tmax))
+        if (!fluid_surface(p, c->dim, up, e1, e2, dx, slo - R - dx, shi + R + dx, &cols, &level, &tmin,
+                           &tmax))
             continue;
         double draft = level - (bot - R);
         hb = top - bot + 2.0 * R;
@@ -819,6 +839,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
         if (p->t[k] >= from)
             sum += draft, nwin++;
     }
+    free(cols.top);
     if (nwin == 0) {
         snprintf(r->err, sizeof r->err,
                  "floating_box: no particle snapshot matches a body snapshot in time (same output interval?) or no "
