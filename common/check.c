@@ -880,6 +880,8 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
     cJSON_AddBoolToObject(root, "pass", all_pass);
     cJSON_AddStringToObject(root, "reference", ref->name);
     cJSON_AddStringToObject(root, "case", c->path);
+    if (r->convention[0])
+        cJSON_AddStringToObject(root, "convention", r->convention);
     cJSON_AddItemToObject(root, "metrics", metrics);
     cJSON_AddItemToObject(root, "info", info);
     cJSON *plot = cJSON_AddObjectToObject(root, "plot");

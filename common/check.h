@@ -1,7 +1,7 @@
 /* `lahar check`: compare a finished run's output with the reference named in the case's check:
  * section, write OUT/check.json and OUT/check.png (plot through tools/plot_check.py).
  *
- * check.json: {"pass": bool, "reference": name,
+ * check.json: {"pass": bool, "reference": name, "convention": "..." (some references),
  *              "metrics": {name: {"value": v, "bound": b, "pass": bool}},
  *              "info": {...measured and reference quantities...},
  *              "plot": {"title", "xlabel", "ylabel", "t": [...], "measured": [...], "reference": [...]}}
@@ -72,7 +72,8 @@ typedef struct {
         char name[64];
         double value;
     } value[LAHAR_CHECK_MAX_VALUES];
-    char note[512];            /* e.g. "rolling" / "sliding", the body used, conventions */
+    char note[512];            /* e.g. "rolling" / "sliding", the body used */
+    char convention[256];      /* how the compared quantities are defined, when it matters */
     char title[128], xlabel[64], ylabel[64];
     int nseries;
     double *series_t, *series_measured, *series_reference; /* LAHAR_CHECK_MAX_SERIES each */

@@ -499,6 +499,9 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
     lahar_check_value(r, "nu", nu);
     lahar_check_value(r, "accel", a);
     lahar_check_value(r, "t_last", p->t[p->nsnap - 1]);
+    snprintf(r->convention, sizeof r->convention,
+             "u along the driving acceleration, y from the lower plate's surface; plate force per unit plate length "
+             "F/L = tau W, tau = rho nu du/dy at the wall");
     snprintf(r->note, sizeof r->note,
              "plates %s (y = 0) and %s; u(y,t): transient series of shared/reference/05 section 5.1 (Morris et al. "
              "1997 eq. 21); plate force: late-window mean along the flow vs tau(t) L W, steady tau = rho a H/2 "
@@ -603,6 +606,10 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
     lahar_check_value(r, "disc_force", F);
     lahar_check_value(r, "force_balance_rel_error", fabs(F - F_exp) / F_exp);
     lahar_check_value(r, "K_from_disc_force", F / ((1.0 - conc) * mu * Us));
+    snprintf(r->convention, sizeof r->convention,
+             "K = rho g L^2 / (mu U_s): F = rho g L^2 (driving force per cell and unit length, body force per fluid "
+             "volume times the cell area), U_s = (1 - c) <u>_fluid the superficial velocity (Sangani & Acrivos 1982 "
+             "as reproduced by Basilisk, shared/reference/01)");
     snprintf(r->note, sizeof r->note,
              "disc %s, r = %g m, L = %g m; K interpolated in ln K between tabulated c (low-c asymptote below 0.05); "
              "force balance: at steady state the disc carries the body force on the fluid, rho g (1 - c) L^2",

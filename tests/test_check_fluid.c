@@ -9,7 +9,8 @@
  *  - cylinder_array: c = 0.1 (K = 24.83), uniform velocity giving U_s exactly; U x 1.06 fails;
  *    the table's interpolation and low-c asymptote (7.981 at c = 0.01, shared/reference/01);
  *  - hydrostatic: 2D tank, h = 0.3 m, p = rho g (h - y), wall forces rho g h^2/2; wall force
- *    x 1.02 and pressure x 1.05 fail;
+ *    x 1.02 and pressure x 1.05 fail; 3D tank of planes (wetted widths per wall), a wall at 0.97
+ *    fails;
  *  - floating_box: box 0.2 x 0.1 m, density 500 -> draft 0.05 m; raised 2 mm -> error 0.04;
  *  - sinking_disc: a disc settles on the floor; a particle inside the floor's layer fails;
  *  - dam_break: a column spreading to the far wall; a particle out of the tank, one deep inside a
@@ -43,7 +44,7 @@ static int failures;
 
 #define MAXP 20000
 #define MAXB 6
-static double px[MAXP], py[MAXP], pvx[MAXP], pvy[MAXP], pden[MAXP], ppr[MAXP];
+static double px[MAXP], py[MAXP], pz[MAXP], pvx[MAXP], pvy[MAXP], pden[MAXP], ppr[MAXP];
 static int64_t np;
 static lahar_material mats[2];
 static lahar_body bodies[MAXB];
@@ -62,6 +63,7 @@ static void case_begin(const char *ref, int dim)
     memset(&cs, 0, sizeof cs);
     memset(mats, 0, sizeof mats);
     nbodies = 0;
+    memset(pz, 0, sizeof pz);
     snprintf(mats[0].name, sizeof mats[0].name, "wall");
     mats[0].density = 2000, mats[0].restitution = 0.5, mats[0].friction = 0.5, mats[0].kn = 1e6;
     snprintf(mats[1].name, sizeof mats[1].name, "light");
@@ -128,7 +130,7 @@ static void run_snapshot(run_out *o, int64_t k, double t)
             memcpy(states[j].q, bodies[j].q, sizeof states[j].q);
         }
     CHECK(lahar_body_output_snapshot(o->bo, k, t, states) == 0, "body snapshot");
-    lahar_particles_view v = {np, px, py, NULL, pvx, pvy, NULL, pden, ppr, NULL, NULL};
+    lahar_particles_view v = {np, px, py, pz, pvx, pvy, NULL, pden, ppr, NULL, NULL};
     static double zeros[MAXP];
     static int32_t phase[MAXP];
     static int64_t ids[MAXP];
@@ -435,6 +437,66 @@ static void test_hydrostatic(const char *base)
     CHECK(fabs(v - 0.05) < 1e-9, "hydrostatic p x 1.05: pressure_l2_rel_error %.10g", v);
 }
 
+/* 3D: a 0.1 x 0.05 m tank of four wall planes and a floor plane, h = 0.1 m, dx = 0.005. The
+ * wall forces per unit width need the wetted widths 0.05 (x walls) and 0.1 (y walls). */
+static int add_plane(const char *name, double cx, double cy, double cz, double nx, double ny, double nz,
+                     double s0, double s1, double R)
+{
+    int j = add_body(name, LAHAR_MOTION_FIXED, 0);
+    double c[3] = {cx, cy, cz}, n[3] = {nx, ny, nz}, size[2] = {s0, s1};
+    lahar_shape_make_plane(&bodies[j].shape, c, n, size, R);
+    return j;
+}
+
+static void hydro3d_run(const char *dir, double yfac)
+{
+    case_begin("hydrostatic", 3);
+    const double Lx = 0.1, Ly = 0.05, h = 0.1, dx = 0.005, R = 0.002, rho = 1000.0, g = 9.81;
+    cs.sph_dx = dx;
+    int fl = add_plane("floor", 0.05, 0.025, -R, 0, 0, 1, 0.2, 0.2, R);
+    int wx0 = add_plane("wall_xmin", -R, 0.025, 0.1, 1, 0, 0, 0.2, 0.3, R);
+    int wx1 = add_plane("wall_xmax", Lx + R, 0.025, 0.1, -1, 0, 0, 0.2, 0.3, R);
+    int wy0 = add_plane("wall_ymin", 0.05, -R, 0.1, 0, 1, 0, 0.2, 0.3, R);
+    int wy1 = add_plane("wall_ymax", 0.05, Ly + R, 0.1, 0, -1, 0, 0.2, 0.3, R);
+    metric("wall_force_rel_error", 0.01);
+    metric("pressure_l2_rel_error", 0.01);
+    run_out o;
+    if (run_open(dir, &o))
+        return;
+    for (int k = 0; k <= 4; k++) {
+        np = 0;
+        for (int i = 0; i < 20; i++)
+            for (int j = 0; j < 10; j++)
+                for (int l = 0; l < 20; l++, np++) {
+                    px[np] = (i + 0.5) * dx, py[np] = (j + 0.5) * dx, pz[np] = (l + 0.5) * dx;
+                    pvx[np] = pvy[np] = 0.0, pden[np] = rho, ppr[np] = rho * g * (h - pz[np]);
+                }
+        memset(reports, 0, sizeof reports);
+        double f = 0.5 * rho * g * h * h;
+        reports[fl].force[2] = -rho * g * h * Lx * Ly;
+        reports[wx0].force[0] = -f * Ly, reports[wx1].force[0] = f * Ly;
+        reports[wy0].force[1] = -f * Lx * yfac, reports[wy1].force[1] = f * Lx;
+        lahar_body_output_forces(o.bo, k, 0.1 * k, reports);
+        run_snapshot(&o, k, 0.1 * k);
+    }
+    run_close(&o);
+}
+
+static void test_hydrostatic_3d(const char *base)
+{
+    char dir[1100];
+    snprintf(dir, sizeof dir, "%s/hydro3d_pass", base);
+    hydro3d_run(dir, 1.0);
+    double v = evaluate(dir, 0, "wall_force_rel_error");
+    CHECK(v < 1e-9, "hydrostatic 3D exact: wall_force_rel_error %g", v);
+    v = json_metric(dir, "side_walls", NULL);
+    CHECK(v == 4.0, "hydrostatic 3D: %g side walls (4)", v);
+    snprintf(dir, sizeof dir, "%s/hydro3d_wall", base);
+    hydro3d_run(dir, 0.97);
+    v = evaluate(dir, 1, "wall_force_rel_error");
+    CHECK(fabs(v - 0.03) < 1e-9, "hydrostatic 3D y wall x 0.97: wall_force_rel_error %.10g (0.03)", v);
+}
+
 /* ---------------------------------------------------------------- floating box ---------- */
 
 static void box_run(const char *dir, double lift)
@@ -728,6 +790,7 @@ int main(int argc, char **argv)
     test_poiseuille(base);
     test_cylinder(base);
     test_hydrostatic(base);
+    test_hydrostatic_3d(base);
     test_floating_box(base);
     test_sinking_disc(base);
     test_dam_break(base);
