@@ -65,6 +65,8 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->pcap = particle_cap < 1 ? 1 : particle_cap;
     int nb = nbody > 0 ? nbody : 1;
     c->bound = calloc((size_t)nb, sizeof *c->bound);
+    c->grid = calloc((size_t)nb, sizeof *c->grid);
+    c->has_grid = calloc((size_t)nb, sizeof *c->has_grid);
     c->force = calloc((size_t)nb, sizeof *c->force);
     c->torque = calloc((size_t)nb, sizeof *c->torque);
     c->body_start = calloc((size_t)nb + 1, sizeof *c->body_start);
@@ -74,7 +76,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->slot = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
     c->contacts_cap = 1024;
     c->contacts = calloc((size_t)c->contacts_cap, sizeof *c->contacts);
-    if (!c->bound || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
+    if (!c->bound || !c->grid || !c->has_grid || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
         !c->slot || !c->contacts) {
         sph_coupling_free(c);
         return -1;
@@ -85,6 +87,13 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
         for (int i = 0; i < s->nv; i++)
             r = fmax(r, v3_norm(v3_load(s->v[i])));
         c->bound[b] = r + s->radius;
+        if (s->nv + s->ne + s->nf > SPH_COUPLING_GRID_FEATURES) {
+            if (geom_feature_grid_build(&c->grid[b], s) != 0) {
+                sph_coupling_free(c);
+                return -1;
+            }
+            c->has_grid[b] = 1;
+        }
     }
     /* the half-space factor, tabulated from eps/2 (closest a particle is let near) to the support */
     c->gtab_d0 = 0.5 * c->eps;
@@ -96,6 +105,11 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
 
 void sph_coupling_free(sph_coupling *c)
 {
+    for (int b = 0; c->has_grid && b < c->nbody; b++)
+        if (c->has_grid[b])
+            geom_feature_grid_free(&c->grid[b]);
+    free(c->grid);
+    free(c->has_grid);
     free(c->bound);
     free(c->force);
     free(c->torque);
@@ -164,11 +178,16 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             /* bounding sphere; fixed bodies keep world-frame vertices (x = origin of that frame) */
             if (v3_norm(v3_sub(xi, xb)) > c->bound[b] + support)
                 continue;
-            vec3 core;
-            double dc = geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
+            vec3 core = xb;
+            /* big shapes (terrain, flumes): only the features near the particle */
+            double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
+                                                                   &core, NULL)
+                                       : geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
             int inside = inside_core(body, bx, bq, xi, c->dim); /* deep inside: far from the surface */
             if (dc - R >= support && !inside)
                 continue;
+            if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
+                dc = 0.0;
             int cross = inside || dc < R;
             vec3 nrm;
             double d;

@@ -19,6 +19,7 @@
 #ifndef LAHAR_SPH_COUPLING_H
 #define LAHAR_SPH_COUPLING_H
 #include <stdint.h>
+#include "geometry.h"
 #include "kernel.h"
 #include "scene.h"
 #include "sph_particles.h"
@@ -56,6 +57,8 @@ typedef struct {
     int dim, nbody;
     const lahar_body *bodies;  /* borrowed: shapes, motion */
     double *bound;             /* per body: max |core vertex - x| (body frame) + R */
+    geom_feature_grid *grid;   /* per body: feature grid for big shapes (terrain), else unused */
+    int *has_grid;
     kernel k;
     double eps;                /* halo thickness, dx/2 (eq. 14) */
     double m_min;              /* eq. 15 */
@@ -80,6 +83,9 @@ typedef struct {
     int64_t cross_particle_id;
     double cross_depth;        /* how far inside the swept surface (m, > 0) */
 } sph_coupling;
+
+/* Shapes with more features than this get a feature grid (geom_point_body_core_near). */
+#define SPH_COUPLING_GRID_FEATURES 64
 
 /* Set up the coupling with nbody bodies (borrowed; shapes must stay valid), halo eps = dx/2,
  * m_min = min(particle mass m_sph, masses of free bodies) (eq. 15), dynamic viscosity mu, for

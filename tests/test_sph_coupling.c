@@ -176,6 +176,45 @@ int main(void)
         sph_fluid_free(&f);
         lahar_shape_free(&box.shape);
     }
+    /* 4b. a big shape (feature grid path, > SPH_COUPLING_GRID_FEATURES features): a 2D polygon of
+     * 120 vertices; the force equals the brute-force closest point's K_n (eps - d) n */
+    {
+        lahar_body poly;
+        memset(&poly, 0, sizeof poly);
+        double pts[120][3];
+        for (int i = 0; i < 120; i++) {
+            pts[i][0] = 0.1 * cos(2 * M_PI * i / 120.0);
+            pts[i][1] = 0.1 * sin(2 * M_PI * i / 120.0);
+            pts[i][2] = 0.0;
+        }
+        char err[128];
+        if (lahar_shape_make_polyline(&poly.shape, (const double(*)[3])pts, 120, 1, 0.005, err, sizeof err) != 0)
+            abort();
+        poly.motion = LAHAR_MOTION_FIXED;
+        poly.q[0] = 1.0;
+        double worst = 0.0;
+        int n_in = 0;
+        for (int t = 0; t < 40; t++) {
+            double ang = 0.37 + t * 0.157, rr = 0.1 + 0.005 + (0.2 + 0.01 * t) * DX;
+            double x[3] = {rr * cos(ang), rr * sin(ang), 0}, v[3] = {0, 0, 0};
+            one_particle(&f, 2, x, v, 1, &poly);
+            CHECK(f.cpl.has_grid[0] == 1, "no feature grid for a 240-feature shape");
+            vec3 cp;
+            double dc = geom_point_body_core(&poly.shape, poly.x, poly.q, v3_load(x), &cp, NULL);
+            double delta = eps - (dc - 0.005);
+            double fx = delta > 0 ? kn * delta * (x[0] - cp.x) / dc : 0.0, fy = delta > 0 ? kn * delta * (x[1] - cp.y) / dc : 0.0;
+            double e = hypot(f.p.ax[0] * m2 - fx, f.p.ay[0] * m2 - fy) / fmax(hypot(fx, fy), kn * 1e-3 * DX);
+            worst = fmax(worst, e);
+            n_in += delta > 0;
+            sph_fluid_free(&f);
+        }
+        CHECK(worst < 1e-12 && n_in > 5, "grid path off brute force by %.2e (%d in the halo)", worst, n_in);
+        double xc[3] = {0.01, 0.0, 0}, v0[3] = {0, 0, 0}; /* deep inside, far from every feature */
+        one_particle(&f, 2, xc, v0, 1, &poly);
+        CHECK(f.cpl.crossings == 1, "particle inside a big polygon not counted (%lld)", (long long)f.cpl.crossings);
+        sph_fluid_free(&f);
+        lahar_shape_free(&poly.shape);
+    }
     /* 5. many particles: thread-count independence and action = reaction */
     {
         lahar_body bodies[2];
