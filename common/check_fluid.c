@@ -631,7 +631,8 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
  *    bodies of their own (one body holding floor and walls gets horizontal forces that cancel).
  *  - pressure_l2_rel_error: particle pressures averaged over the window in rows of dx (row mean
  *    p_b at mean height y_b, n_b samples), sqrt(sum n_b (p_b - rho g (level - y_b))^2 /
- *    sum n_b (rho g (level - y_b))^2).
+ *    sum n_b (rho g (level - y_b))^2); pressure_l2_rel_error_interior the same over the rows at
+ *    least 3 dx from the floor and from the surface (where kernels are not cut by them).
  *  - free_surface_spread_rel: (highest - lowest column top) / h, mean over the window;
  *    max_speed_rel: largest particle speed at the last snapshot / sqrt(g h) (nothing drifts). */
 int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
@@ -710,7 +711,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
         }
     }
     level = level_sum / (nwin ? nwin : 1);
-    double h = level - y_floor, se = 0.0, sr = 0.0;
+    double h = level - y_floor, se = 0.0, sr = 0.0, sei = 0.0, sri = 0.0;
     int pp = lahar_check_panel(r, "pressure, late-window mean per row of dx", "p [Pa]", "height above the floor [m]");
     lahar_check_curve(r, pp, 1, "lahar");
     for (int b = 0; b < nb; b++) {
@@ -718,6 +719,8 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
             continue;
         double pm = bp[b] / (double)bn[b], ym = by[b] / (double)bn[b], pr = rho * g * (level - ym);
         se += (double)bn[b] * (pm - pr) * (pm - pr), sr += (double)bn[b] * pr * pr;
+        if (ym - y_floor >= 3.0 * dx && level - ym >= 3.0 * dx)
+            sei += (double)bn[b] * (pm - pr) * (pm - pr), sri += (double)bn[b] * pr * pr;
         lahar_check_point(r, pm, ym - y_floor);
     }
     lahar_check_curve(r, pp, 0, "rho g (h - y)");
@@ -772,6 +775,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
     }
     lahar_check_value(r, "wall_force_rel_error", werr);
     lahar_check_value(r, "pressure_l2_rel_error", sr > 0.0 ? sqrt(se / sr) : NAN);
+    lahar_check_value(r, "pressure_l2_rel_error_interior", sri > 0.0 ? sqrt(sei / sri) : NAN);
     lahar_check_value(r, "free_surface_spread_rel", spread_sum / (nwin ? nwin : 1) / h);
     if (p->vx)
         lahar_check_value(r, "max_speed_rel", vmax / sqrt(g * h));
