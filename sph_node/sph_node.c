@@ -173,6 +173,7 @@ typedef struct {
     double **l_px, **l_pf;
     int64_t l_pcap;
     int64_t loads_points;        /* points sent, over the run (diagnostics) */
+    int64_t last_snapshot;       /* step of the last snapshot written */
 } sph_node;
 
 static int sph_node_snapshot(sph_node *s, int64_t step, double t)
@@ -182,6 +183,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
         .n = p->n, .x = p->x, .y = p->y, .z = p->z, .vx = p->vx, .vy = p->vy, .vz = p->vz,
         .density = p->rho, .pressure = p->p, .phase = p->phase, .id = p->id,
     };
+    s->last_snapshot = step;
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }
 
@@ -435,7 +437,8 @@ static int sph_node_loop(sph_node *s)
             }
         }
         c0 = lahar_now();
-        if (!st.error) {
+        int stepped = !st.error;
+        if (stepped) {
             cross = sph_fluid_step(&s->f, step.dt, has_dem ? s->states : NULL);
             if (cross < 0) {
                 st.error = 1;
@@ -445,10 +448,13 @@ static int sph_node_loop(sph_node *s)
                 sph_node_crossing_message(s, k, step.t_next, err, sizeof err);
             }
         }
-        /* on an error the state reached is kept as the last snapshot to look at */
-        if ((step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
+        /* on an error the state reached is kept as the last snapshot to look at: after the step,
+         * or at t_k when the step was not taken (unless a snapshot of t_k exists) */
+        if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
+        } else if (!stepped && s->last_snapshot != k) {
+            sph_node_snapshot(s, k, step.t);
         }
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
