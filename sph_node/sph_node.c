@@ -172,7 +172,6 @@ typedef struct {
     double **l_pforce, **l_ptorque;
     double **l_px, **l_pf;
     int64_t l_pcap;
-    int64_t loads_points;        /* points sent, over the run (diagnostics) */
     int64_t last_snapshot;       /* step of the last snapshot written */
 } sph_node;
 
@@ -325,7 +324,6 @@ static int sph_node_send_loads(sph_node *s, int64_t k)
         .torque = s->l_ptorque, .npoints = s->l_np, .ntotal = (int32_t)np, .point_x = s->l_px, .point_f = s->l_pf,
     };
     sph_node_reach(s, m.reach_lo, m.reach_hi);
-    s->loads_points += np;
     int rc;
     LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &m);
     return rc;
