@@ -736,8 +736,11 @@ const lahar_check_reference *lahar_check_find(const char *name)
 
 const char *lahar_check_names(void)
 {
-    return "restitution, incline_roll, poiseuille, cylinder_array, hydrostatic, floating_box, sinking_disc, "
-           "dam_break";
+    static char names[512];
+    size_t pos = 0;
+    for (size_t k = 0; k < CHECK_NREF && pos < sizeof names; k++)
+        pos += (size_t)snprintf(names + pos, sizeof names - pos, "%s%s", k ? ", " : "", check_references[k].name);
+    return names;
 }
 
 static int check_write_json(const char *path, cJSON *root)
