@@ -798,7 +798,8 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
  * (columns at least dx clear of the box) - lowest point of the box's swept surface, averaged over
  * the late window of the snapshots; reference rho_b h / rho_f with rho_b the box material's
  * density, h its height along gravity (core extent + 2 sweep radius; rounded corners of radius R
- * change the displaced area by (4 - pi) R^2, ignored). */
+ * change the displaced area by (4 - pi) R^2, ignored). draft_spread_rel: (largest - smallest
+ * draft) / reference over the window, how far the heave has settled. */
 int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
 {
     if (fluid_need(d, 0, "floating_box", r))
@@ -818,7 +819,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     double tol = c->output_interval > 0.0 ? 0.25 * c->output_interval : 1e-9;
     int pd = lahar_check_panel(r, "draft of the box", "t [s]", "draft [m]");
     lahar_check_curve(r, pd, 1, box->name);
-    double sum = 0.0, hb = NAN, d_last = NAN, tilt = 0.0;
+    double sum = 0.0, hb = NAN, d_last = NAN, tilt = 0.0, wmin = INFINITY, wmax = -INFINITY;
     int nwin = 0;
     fluid_columns cols = {NULL, 0};
     for (int64_t k = 0; k < p->nsnap; k++) {
@@ -848,7 +849,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
         tilt = 2.0 * atan2(sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]), fabs(q[0])) * 180.0 / M_PI;
         lahar_check_point(r, p->t[k], draft);
         if (p->t[k] >= from)
-            sum += draft, nwin++;
+            sum += draft, nwin++, wmin = fmin(wmin, draft), wmax = fmax(wmax, draft);
     }
     free(cols.top);
     if (nwin == 0) {
@@ -864,6 +865,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     lahar_check_value(r, "draft_rel_error", fabs(draft - d_ref) / d_ref);
     lahar_check_value(r, "draft_measured", draft);
     lahar_check_value(r, "draft_last", d_last);
+    lahar_check_value(r, "draft_spread_rel", (wmax - wmin) / d_ref);
     lahar_check_value(r, "draft_reference", d_ref);
     lahar_check_value(r, "box_height", hb);
     lahar_check_value(r, "box_density", rho_b);
