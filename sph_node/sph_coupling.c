@@ -66,6 +66,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     int nb = nbody > 0 ? nbody : 1;
     c->bound = calloc((size_t)nb, sizeof *c->bound);
     c->grid = calloc((size_t)nb, sizeof *c->grid);
+    c->box = calloc((size_t)nb, sizeof *c->box);
     c->has_grid = calloc((size_t)nb, sizeof *c->has_grid);
     c->force = calloc((size_t)nb, sizeof *c->force);
     c->torque = calloc((size_t)nb, sizeof *c->torque);
@@ -76,7 +77,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->slot = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
     c->contacts_cap = 1024;
     c->contacts = calloc((size_t)c->contacts_cap, sizeof *c->contacts);
-    if (!c->bound || !c->grid || !c->has_grid || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
+    if (!c->bound || !c->box || !c->grid || !c->has_grid || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
         !c->slot || !c->contacts) {
         sph_coupling_free(c);
         return -1;
@@ -87,6 +88,18 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
         for (int i = 0; i < s->nv; i++)
             r = fmax(r, v3_norm(v3_load(s->v[i])));
         c->bound[b] = r + s->radius;
+        /* fixed bodies never move: a tight world box culls most particles (long walls) */
+        for (int a = 0; a < 3; a++) {
+            c->box[b][a] = s->nv ? INFINITY : -INFINITY;
+            c->box[b][3 + a] = s->nv ? -INFINITY : INFINITY;
+        }
+        for (int i = 0; i < s->nv; i++) {
+            vec3 w = geom_world_vertex(s, bodies[b].x, bodies[b].q, i);
+            for (int a = 0; a < 3; a++) {
+                c->box[b][a] = fmin(c->box[b][a], v3_get(w, a) - s->radius);
+                c->box[b][3 + a] = fmax(c->box[b][3 + a], v3_get(w, a) + s->radius);
+            }
+        }
         if (s->nv + s->ne + s->nf > SPH_COUPLING_GRID_FEATURES) {
             if (geom_feature_grid_build(&c->grid[b], s) != 0) {
                 sph_coupling_free(c);
@@ -109,6 +122,7 @@ void sph_coupling_free(sph_coupling *c)
         if (c->has_grid[b])
             geom_feature_grid_free(&c->grid[b]);
     free(c->grid);
+    free(c->box);
     free(c->has_grid);
     free(c->bound);
     free(c->force);
@@ -171,13 +185,20 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         vec3 ftot = v3(0, 0, 0);
         for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
             const lahar_body *body = &c->bodies[b];
-            const double *bx = states ? states[b].x : body->x, *bq = states ? states[b].q : body->q;
-            const double *bv = states ? states[b].v : body->v, *bw = states ? states[b].w : body->w;
+            const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
+            const double *bx = st ? st->x : body->x, *bq = st ? st->q : body->q;
+            const double *bv = st ? st->v : body->v, *bw = st ? st->w : body->w;
             vec3 xb = v3_load(bx);
             const double R = body->shape.radius;
             /* bounding sphere; fixed bodies keep world-frame vertices (x = origin of that frame) */
             if (v3_norm(v3_sub(xi, xb)) > c->bound[b] + support)
                 continue;
+            if (body->motion == LAHAR_MOTION_FIXED) {
+                const double *bb = c->box[b];
+                if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support ||
+                    xi.y > bb[4] + support || xi.z < bb[2] - support || xi.z > bb[5] + support)
+                    continue;
+            }
             vec3 core = xb;
             /* big shapes (terrain, flumes): only the features near the particle */
             double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
@@ -282,7 +303,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             int b = c->slot_body[k];
             const sph_contact *ct = &c->slot[k];
             c->contacts[c->body_fill[b]++] = *ct;
-            const double *bx = states ? states[b].x : c->bodies[b].x;
+            const double *bx = states && c->bodies[b].motion != LAHAR_MOTION_FIXED ? states[b].x : c->bodies[b].x;
             vec3 f = v3_load(ct->force), r = v3_sub(v3_load(ct->xs), v3_load(bx));
             vec3 t = v3_cross(r, f); /* eq. 21 with the torque as r x F */
             for (int a = 0; a < 3; a++) {

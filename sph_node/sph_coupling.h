@@ -57,6 +57,7 @@ typedef struct {
     int dim, nbody;
     const lahar_body *bodies;  /* borrowed: shapes, motion */
     double *bound;             /* per body: max |core vertex - x| (body frame) + R */
+    double (*box)[6];          /* per fixed body: world box of the swept shape (lo, hi) */
     geom_feature_grid *grid;   /* per body: feature grid for big shapes (terrain), else unused */
     int *has_grid;
     kernel k;
@@ -95,8 +96,8 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
 void sph_coupling_free(sph_coupling *c);
 
 /* Add the coupling forces (eq. 19) to the particle accelerations p->ax.. (divided by the
- * particle mass) for a step of length dt (K_n = 0.1 m_min/dt^2), with the bodies at `states`
- * (NULL: the poses and velocities stored in the bodies). Fills the per-body resultants, the
+ * particle mass) for a step of length dt (K_n = 0.1 m_min/dt^2), with the moving bodies at
+ * `states` (NULL: the poses and velocities stored in the bodies; fixed bodies always use theirs). Fills the per-body resultants, the
  * contact list and the crossing count. Returns the number of crossings, or -1 when the contact
  * list cannot grow (out of memory). */
 int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt);

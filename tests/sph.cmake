@@ -24,3 +24,8 @@ add_executable(test_sph_hydrostatic ${LAHAR_TEST_DIR}/test_sph_hydrostatic.c)
 target_link_libraries(test_sph_hydrostatic PRIVATE lahar_sph)
 add_test(NAME sph_hydrostatic COMMAND test_sph_hydrostatic)
 set_tests_properties(sph_hydrostatic PROPERTIES LABELS "fast;sph" TIMEOUT 120)
+
+add_executable(test_sph_hydrostatic3d ${LAHAR_TEST_DIR}/test_sph_hydrostatic3d.c)
+target_link_libraries(test_sph_hydrostatic3d PRIVATE lahar_sph)
+add_test(NAME sph_hydrostatic3d COMMAND test_sph_hydrostatic3d)
+set_tests_properties(sph_hydrostatic3d PROPERTIES LABELS "slow;sph" TIMEOUT 300)
