@@ -1,13 +1,13 @@
 /* 3D hydrostatic water column in a square tank of five fixed DEM walls (3D sphero-boxes: the
  * coupling through faces, edges and corners): base W x W, depth H = N dx, gravity -z, linear EOS
  * c0 = 20 sqrt(g H), hydrostatic start, artificial viscosity to damp the start-up.
- * At t = 1 s, exact hydrostatics (05_analytic_fluid_checks.txt 5.6):
- *   - the floor carries the weight within 0.5 % (measured +0.07 %);
- *   - each side wall carries rho0 g H^2 W / 2 within 5 % (measured +3.2 %: the issue's 1 % is NOT
- *     met by this small tank, 10 particles deep, where the free surface, floor and the vertical
- *     corners are a large part of each wall; the 2D column of 20 reaches -0.06 %);
- *   - no crossing, |v|max < 5 % of sqrt(g H) (measured 3 %: still ringing at 1 s).
- * Labelled slow: ~20 s of CPU for 640 particles (3D neighbour sums). */
+ * At t = 3 s, exact hydrostatics (05_analytic_fluid_checks.txt 5.6), forces averaged over the
+ * last 0.1 s:
+ *   - the floor carries the weight within 0.5 % (measured +0.007 %);
+ *   - each side wall carries rho0 g H^2 W / 2 within 1 % (measured +0.83 %; at 1 s, still
+ *     ringing, it was +3.2 %);
+ *   - no crossing, |v|max < 5 % of sqrt(g H) (measured 2.2 %).
+ * Labelled slow: ~30-50 s of CPU for 640 particles over 18000 steps (3D neighbour sums). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,7 +42,7 @@ static void wall(lahar_body *b, const double c[3], const double outer_half[3])
 int main(int argc, char **argv)
 {
     const int NB = 8, NZ = argc > 1 ? atoi(argv[1]) : 10;
-    const double dx = 0.01, W = NB * dx, H = NZ * dx, g = 9.81, rho0 = 1000, T = argc > 2 ? atof(argv[2]) : 1.0;
+    const double dx = 0.01, W = NB * dx, H = NZ * dx, g = 9.81, rho0 = 1000, T = argc > 2 ? atof(argv[2]) : 3.0;
     sph_params prm = {0};
     prm.dim = 3;
     prm.dx = dx;
@@ -107,7 +107,7 @@ int main(int argc, char **argv)
            f_wall, 100 * worst);
     printf("  floor %.5g N vs weight %.5g (%+.3f %%); |v|max %.3g m/s; crossings %lld\n", ff, weight,
            100 * (ff / weight - 1), vmax, (long long)crossings);
-    CHECK(worst <= 0.05, "side wall force off rho g H^2 W/2 by %.3f %% > 5 %%", 100 * worst);
+    CHECK(worst <= 0.01, "side wall force off rho g H^2 W/2 by %.3f %% > 1 %%", 100 * worst);
     CHECK(fabs(ff / weight - 1) <= 0.005, "floor force off the weight by > 0.5 %%");
     CHECK(crossings == 0, "%lld wall crossings", (long long)crossings);
     CHECK(vmax < 0.05 * sqrt(g * H), "not settled: |v|max %g m/s", vmax);
