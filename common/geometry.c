@@ -91,6 +91,20 @@ double geom_segment_segment(vec3 p0, vec3 p1, vec3 q0, vec3 q1, vec3 *cp, vec3 *
     return geom_segment_segment_param(p0, p1, q0, q1, NULL, NULL, cp, cq);
 }
 
+int geom_point_polygon_inside(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *proj)
+{
+    vec3 nn = v3_normalize(normal);
+    vec3 pp = v3_axpy(-v3_dot(v3_sub(p, poly[0]), nn), nn, p); /* projection on the plane */
+    if (proj) *proj = pp;
+    for (int i = 0; i < n; i++) {
+        vec3 a = poly[i], b = poly[i + 1 < n ? i + 1 : 0];
+        vec3 ab = v3_sub(b, a);
+        /* inclusive with a relative tolerance so that points on an edge count as inside */
+        if (v3_dot(v3_cross(ab, v3_sub(pp, a)), nn) < -1e-12 * v3_norm2(ab)) return 0;
+    }
+    return 1;
+}
+
 double geom_point_polygon(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *c, int *inside)
 {
     if (inside) *inside = 0;
@@ -103,16 +117,8 @@ double geom_point_polygon(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *c,
         return v3_norm(v3_sub(p, poly[0]));
     }
     if (n == 2) return geom_point_segment(p, poly[0], poly[1], c);
-    vec3 nn = v3_normalize(normal);
-    vec3 pp = v3_axpy(-v3_dot(v3_sub(p, poly[0]), nn), nn, p); /* projection on the plane */
-    int in = 1;
-    for (int i = 0; i < n && in; i++) {
-        vec3 a = poly[i], b = poly[(i + 1) % n];
-        vec3 ab = v3_sub(b, a);
-        /* inclusive with a relative tolerance so that points on an edge count as inside */
-        if (v3_dot(v3_cross(ab, v3_sub(pp, a)), nn) < -1e-12 * v3_norm2(ab)) in = 0;
-    }
-    if (in) {
+    vec3 pp;
+    if (geom_point_polygon_inside(p, poly, n, normal, &pp)) {
         if (inside) *inside = 1;
         if (c) *c = pp;
         return v3_norm(v3_sub(p, pp));

@@ -40,6 +40,11 @@ double geom_segment_segment_param(vec3 p0, vec3 p1, vec3 q0, vec3 q1, double *s,
  * to p; returns |p - c|. *inside = 1 when the projection of p falls inside the polygon. */
 double geom_point_polygon(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *c, int *inside);
 
+/* The inside test of geom_point_polygon alone (n >= 3): 1 when the projection of p on the
+ * polygon's plane falls inside it (boundary inclusive), the projection in *proj (may be NULL).
+ * No closest point on the boundary when outside: the DEM narrow phase only needs the test. */
+int geom_point_polygon_inside(vec3 p, const vec3 *poly, int n, vec3 normal, vec3 *proj);
+
 /* World-frame vertex i of a body at position x and orientation q. */
 vec3 geom_world_vertex(const lahar_shape *s, const double x[3], const double q[4], int i);
 

@@ -20,6 +20,10 @@ enum { SP_VF = 0, SP_FV, SP_EE, SP_VE, SP_EV, SP_VV };
 /* Bodies with more features than this get a feature grid. */
 enum { SP_GRID_MIN_FEATURES = 64 };
 
+/* Per-body loops (kick, drift) run on the thread team from this many bodies on: below it the
+ * fork/join of a team costs more than the loop (README, "Performance"). */
+enum { SP_PAR_MIN_BODIES = 1024 };
+
 typedef struct {
     int a, b, type, fa, fb;
     vec3 xi;     /* tangential spring (world), kept across steps while the contact lasts */
@@ -65,6 +69,8 @@ typedef struct {
     int n, cap;
     geom_feature_query fq;
     int *keep[2][3]; /* per side of a pair: features near the other body (vertex, edge, face) */
+    vec3 *emid;      /* edge-edge prefilter: midpoints and half-lengths of the kept edges of b */
+    double *ehalf;
     int oom;
 } sp_thread;
 
@@ -103,7 +109,8 @@ struct lahar_dem_engine {
     /* contacts: previous evaluation (history) and hash over it */
     sp_contact *prev, *cur;
     int nprev, contact_cap;
-    int *hash, *vhash, hash_cap; /* by full key; by (pair, touching vertex) */
+    int *hash, *vhash, hash_cap; /* by full key; by (pair, touching vertex); allocated size */
+    int hash_n;               /* table size in use: a power of 2 >= 2 nprev (cost of a rebuild ~ contacts) */
     sp_thread *thr;
     int nthr;
     /* report accumulators over the substeps of one advance */
@@ -141,16 +148,20 @@ static void body_update_world(lahar_dem_engine *e, int i)
 {
     sp_geo *g = &e->geo[i];
     sp_state *s = &e->st[i];
+    for (int k = 0; k < g->nv; k++) e->vw[g->v0 + k] = v3_add(s->x, q_rotate(s->q, e->vb[g->v0 + k]));
+    for (int f = 0; f < g->nf; f++) e->nw[g->f0 + f] = q_rotate(s->q, e->nb[g->f0 + f]);
+    /* the face polygons of a body are consecutive in fv/fw */
+    int nfv = g->nf > 0 ? e->fstart[g->fs0 + g->nf] - e->fstart[g->fs0] : 0;
+    const int *fv = e->fv + (g->nf > 0 ? e->fstart[g->fs0] : 0);
+    vec3 *fw = e->fw + (g->nf > 0 ? e->fstart[g->fs0] : 0);
+    const vec3 *vw = e->vw + g->v0;
+    for (int k = 0; k < nfv; k++) fw[k] = vw[fv[k]];
+    if (g->motion == LAHAR_MOTION_FREE) return; /* free bodies are binned by centre, not by box */
     vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
     for (int k = 0; k < g->nv; k++) {
-        vec3 w = v3_add(s->x, q_rotate(s->q, e->vb[g->v0 + k]));
-        e->vw[g->v0 + k] = w;
+        vec3 w = e->vw[g->v0 + k];
         lo = v3(fmin(lo.x, w.x), fmin(lo.y, w.y), fmin(lo.z, w.z));
         hi = v3(fmax(hi.x, w.x), fmax(hi.y, w.y), fmax(hi.z, w.z));
-    }
-    for (int f = 0; f < g->nf; f++) {
-        e->nw[g->f0 + f] = q_rotate(s->q, e->nb[g->f0 + f]);
-        for (int k = e->fstart[g->fs0 + f]; k < e->fstart[g->fs0 + f + 1]; k++) e->fw[k] = e->vw[g->v0 + e->fv[k]];
     }
     vec3 r = v3(g->radius, g->radius, g->radius);
     g->aabb_lo = v3_sub(lo, r);
@@ -200,7 +211,7 @@ static uint64_t contact_key_hash(int a, int b, int type, int fa, int fb)
 static const sp_contact *history_find(const lahar_dem_engine *e, int a, int b, int type, int fa, int fb)
 {
     if (e->nprev == 0) return NULL;
-    uint64_t m = (uint64_t)e->hash_cap - 1;
+    uint64_t m = (uint64_t)e->hash_n - 1;
     for (uint64_t h = contact_key_hash(a, b, type, fa, fb) & m;; h = (h + 1) & m) {
         int i = e->hash[h];
         if (i < 0) return NULL;
@@ -226,7 +237,7 @@ static const sp_contact *history_find_moved(const lahar_dem_engine *e, int a, in
 {
     int side, v = contact_vertex(type, fa, fb, &side);
     if (e->nprev == 0 || v < 0) return NULL;
-    uint64_t m = (uint64_t)e->hash_cap - 1;
+    uint64_t m = (uint64_t)e->hash_n - 1;
     const sp_contact *best = NULL;
     double bestd = reach * reach;
     for (uint64_t h = contact_key_hash(a, b, 100 + side, v, -1) & m;; h = (h + 1) & m) {
@@ -248,17 +259,19 @@ static int history_rebuild(lahar_dem_engine *e)
     int need = 16;
     while (need < 2 * e->nprev) need *= 2;
     if (need > e->hash_cap) {
-        int *h = realloc(e->hash, sizeof(int) * (size_t)need);
+        int cap = need > 2 * e->hash_cap ? need : 2 * e->hash_cap; /* at least double: grow rarely */
+        int *h = realloc(e->hash, sizeof(int) * (size_t)cap);
         if (!h) return -1;
         e->hash = h;
-        h = realloc(e->vhash, sizeof(int) * (size_t)need);
+        h = realloc(e->vhash, sizeof(int) * (size_t)cap);
         if (!h) return -1;
         e->vhash = h;
-        e->hash_cap = need;
+        e->hash_cap = cap;
     }
-    memset(e->hash, 0xff, sizeof(int) * (size_t)e->hash_cap);
-    memset(e->vhash, 0xff, sizeof(int) * (size_t)e->hash_cap);
-    uint64_t m = (uint64_t)e->hash_cap - 1;
+    e->hash_n = need;
+    memset(e->hash, 0xff, sizeof(int) * (size_t)need);
+    memset(e->vhash, 0xff, sizeof(int) * (size_t)need);
+    uint64_t m = (uint64_t)need - 1;
     for (int i = 0; i < e->nprev; i++) {
         const sp_contact *c = &e->prev[i];
         uint64_t h = contact_key_hash(c->a, c->b, c->type, c->fa, c->fb) & m;
@@ -370,9 +383,7 @@ static int edge_face_owns(const lahar_dem_engine *e, const sp_geo *g, int j, vec
         int f = e->edge_face[g->e0 + j][s];
         if (f < 0) continue;
         int b = e->fstart[g->fs0 + f], m = e->fstart[g->fs0 + f + 1] - b;
-        int in;
-        geom_point_polygon(p, e->fw + b, m, e->nw[g->f0 + f], NULL, &in);
-        if (in) return 1;
+        if (m >= 3 && geom_point_polygon_inside(p, e->fw + b, m, e->nw[g->f0 + f], NULL)) return 1;
     }
     return 0;
 }
@@ -388,9 +399,8 @@ static void test_vertex_face(sp_pair_ctx *x, const sp_geo *gv, int i, const sp_g
     if (fabs(dplane) >= rsum) return;
     int b = e->fstart[gf->fs0 + f], m = e->fstart[gf->fs0 + f + 1] - b;
     vec3 c;
-    int in;
-    geom_point_polygon(p, e->fw + b, m, nrm, &c, &in);
-    if (!in) return; /* outside the face: an edge or vertex contact owns it */
+    if (m < 3 || !geom_point_polygon_inside(p, e->fw + b, m, nrm, &c)) return; /* outside the face: an edge or
+                                                                                  vertex contact owns it */
     vec3 side = dplane >= 0.0 ? nrm : v3_neg(nrm); /* from the face towards the vertex */
     if (v_is_a) contact_emit(x, SP_VF, i, f, p, c, 0, 1, v3_neg(side));
     else contact_emit(x, SP_FV, f, i, c, p, 1, 0, side);
@@ -425,11 +435,26 @@ static void pair_narrow(sp_pair_ctx *x, const sp_side *A, const sp_side *B)
             for (int k = 0; k < A->nf; k++) test_vertex_face(x, gb, side_id(B->v, l), ga, side_id(A->f, k), 0);
         /* edge-edge only when the closest points are interior to both edges and the edges are not
          * parallel (then vertex-edge contacts at the ends carry the load) */
+        /* Prefilter: two segments are at least |m_a - m_b| - h_a - h_b apart (midpoints m,
+         * half-lengths h), so pairs with that bound >= rsum (plus a margin for rounding) cannot
+         * touch and skip the closest-point computation without changing any result. */
+        vec3 *emid = x->t->emid;
+        double *ehalf = x->t->ehalf;
+        for (int l = 0; l < B->ne; l++) {
+            int j = side_id(B->e, l);
+            vec3 q0 = e->vw[gb->v0 + e->edge[gb->e0 + j][0]], q1 = e->vw[gb->v0 + e->edge[gb->e0 + j][1]];
+            emid[l] = v3_scale(v3_add(q0, q1), 0.5);
+            ehalf[l] = 0.5 * v3_norm(v3_sub(q1, q0));
+        }
         for (int k = 0; k < A->ne; k++) {
             int i = side_id(A->e, k);
             vec3 p0 = e->vw[ga->v0 + e->edge[ga->e0 + i][0]], p1 = e->vw[ga->v0 + e->edge[ga->e0 + i][1]];
             vec3 da = v3_sub(p1, p0);
+            vec3 ma = v3_scale(v3_add(p0, p1), 0.5);
+            double ha = 0.5 * v3_norm(da);
             for (int l = 0; l < B->ne; l++) {
+                double reach = (ha + ehalf[l] + rsum) * (1.0 + 1e-9);
+                if (v3_norm2(v3_sub(emid[l], ma)) > reach * reach) continue;
                 int j = side_id(B->e, l);
                 vec3 q0 = e->vw[gb->v0 + e->edge[gb->e0 + j][0]], q1 = e->vw[gb->v0 + e->edge[gb->e0 + j][1]];
                 vec3 db = v3_sub(q1, q0);
@@ -476,7 +501,9 @@ static void side_filter(const lahar_dem_engine *e, sp_side *sd, const sp_geo *g,
     for (int k = 0; k < sd->ne; k++) {
         int i = side_id(sd->e, k);
         vec3 p0 = e->vw[g->v0 + e->edge[g->e0 + i][0]], p1 = e->vw[g->v0 + e->edge[g->e0 + i][1]];
-        if (geom_point_segment_dist2(c, p0, p1, NULL) < r2) keep[1][n++] = i;
+        /* an end within reach keeps the edge without the segment distance (which is <= it) */
+        if (v3_norm2(v3_sub(p0, c)) < r2 || v3_norm2(v3_sub(p1, c)) < r2 || geom_point_segment_dist2(c, p0, p1, NULL) < r2)
+            keep[1][n++] = i;
     }
     sd->e = keep[1];
     sd->ne = n;
@@ -782,6 +809,8 @@ static void rotate_about_axis(quat *q, vec3 *pi, const double inertia[3], int k,
 
 static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 {
+    /* each body only writes its own state: bitwise the same on any thread count */
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nfree >= SP_PAR_MIN_BODIES)
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
         sp_state *s = &e->st[i];
@@ -803,6 +832,7 @@ static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 
 static void drift(lahar_dem_engine *e, double h)
 {
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nbody >= SP_PAR_MIN_BODIES)
     for (int i = 0; i < e->nbody; i++) {
         sp_geo *g = &e->geo[i];
         sp_state *s = &e->st[i];
@@ -896,6 +926,8 @@ static void sp_destroy(lahar_dem_engine *e)
     if (e->thr)
         for (int t = 0; t < e->nthr; t++) {
             free(e->thr[t].c);
+            free(e->thr[t].emid);
+            free(e->thr[t].ehalf);
             geom_feature_query_free(&e->thr[t].fq);
             for (int sd = 0; sd < 2; sd++)
                 for (int k = 0; k < 3; k++) free(e->thr[t].keep[sd][k]);
@@ -1235,6 +1267,9 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     for (int t = 0; t < e->nthr; t++) {
         sp_thread *th = &e->thr[t];
         int bad = geom_feature_query_init(&th->fq, maxv, maxe, maxf);
+        th->emid = malloc(sizeof(vec3) * (size_t)alle);
+        th->ehalf = malloc(sizeof(double) * (size_t)alle);
+        bad |= !th->emid || !th->ehalf;
         for (int sd = 0; sd < 2; sd++) {
             th->keep[sd][0] = malloc(sizeof(int) * (size_t)allv);
             th->keep[sd][1] = malloc(sizeof(int) * (size_t)alle);
@@ -1245,6 +1280,32 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
             snprintf(err, errlen, "spheropoly: out of memory");
             goto fail;
         }
+    }
+    /* Pre-size the per-step arrays for a dense pile (about 3 contacts and 4 pairs per body, up to
+     * 4 points for a face on a face) so that the steady state never grows them; they still double
+     * when a scene needs more (test_dem_noalloc checks that advance allocates nothing). */
+    int ccap = 4 * nb + 64, pcap = 8 * e->nfree + 64;
+    e->pairs = malloc(sizeof(int[2]) * (size_t)pcap);
+    e->cur = malloc(sizeof(sp_contact) * (size_t)ccap);
+    e->prev = malloc(sizeof(sp_contact) * (size_t)ccap);
+    int hcap = 16;
+    while (hcap < 2 * ccap) hcap *= 2;
+    e->hash = malloc(sizeof(int) * (size_t)hcap);
+    e->vhash = malloc(sizeof(int) * (size_t)hcap);
+    if (!e->pairs || !e->cur || !e->prev || !e->hash || !e->vhash) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        goto fail;
+    }
+    e->pair_cap = pcap;
+    e->contact_cap = ccap;
+    e->hash_cap = hcap;
+    for (int t = 0; t < e->nthr; t++) { /* one static block of pairs may hold most contacts */
+        e->thr[t].c = malloc(sizeof(sp_contact) * (size_t)ccap);
+        if (!e->thr[t].c) {
+            snprintf(err, errlen, "spheropoly: out of memory");
+            goto fail;
+        }
+        e->thr[t].cap = ccap;
     }
     e->dt_stable = stable_dt_of(e, c);
     if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;

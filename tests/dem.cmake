@@ -15,3 +15,22 @@ lahar_dem_test(test_dem_freebody fast)
 lahar_dem_test(test_dem_stack fast)
 lahar_dem_test(test_dem_restart fast)
 lahar_dem_test(test_dem_prescribed fast)
+
+# The settling pile of the benchmark (tests/bench/dem_pile.h), also used by test_dem_noalloc.
+add_library(lahar_dem_pile STATIC ${LAHAR_TEST_DIR}/bench/dem_pile.c ${LAHAR_TEST_DIR}/dem_test_util.c)
+target_include_directories(lahar_dem_pile PUBLIC ${LAHAR_TEST_DIR} ${LAHAR_TEST_DIR}/bench)
+target_link_libraries(lahar_dem_pile PUBLIC lahar_dem)
+
+# No allocation inside advance() in the steady state: malloc & co. wrapped by the linker.
+add_executable(test_dem_noalloc ${LAHAR_TEST_DIR}/test_dem_noalloc.c)
+target_link_libraries(test_dem_noalloc PRIVATE lahar_dem_pile
+  -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
+add_test(NAME test_dem_noalloc COMMAND test_dem_noalloc)
+set_tests_properties(test_dem_noalloc PROPERTIES LABELS "fast;dem" TIMEOUT 300)
+
+# Benchmarks (tests/bench/, not ctest tests: they print a table and never fail on time).
+# `cmake --build <dir> --target bench` builds and runs bench_dem with its default sizes.
+add_executable(bench_dem EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem.c)
+target_link_libraries(bench_dem PRIVATE lahar_dem_pile)
+add_custom_target(bench COMMAND bench_dem DEPENDS bench_dem WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} USES_TERMINAL
+  COMMENT "bench_dem: DEM step cost for 500/2000/8000 bodies on 1 and 2 threads")
