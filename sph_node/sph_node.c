@@ -36,78 +36,53 @@
 
 #define ROLE LAHAR_ROLE_SPH
 
-/* Append the lattice points inside every block (lahar_particle_block_lattice: the order of
- * sph_particles_add_box for boxes) at rest density with mass rho0 dx^D. 0, or -1 when out of
- * memory or when p has no room. */
-static int sph_node_add_blocks(sph_particles *p, int dim, double dx, double rest_density, int nblock,
-                               const lahar_particle_block *blocks)
+/* Append the particles of every block at rest density with mass rho0 dx^D: the lattice points
+ * of lahar_case_block_lattice, i.e. inside the block and outside every body (a particle that starts
+ * inside a body would be a crossing at step 0). 0, or -1 when out of memory or p has no room. */
+static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
 {
     int64_t most = 0;
-    for (int b = 0; b < nblock; b++) {
-        int64_t n = lahar_particle_block_lattice(&blocks[b], dim, dx, NULL, 0);
+    for (int b = 0; b < c->nblock; b++) {
+        int64_t n = lahar_case_block_lattice(c, b, NULL, 0);
         most = n > most ? n : most;
     }
     double(*pts)[3] = malloc((size_t)(most > 0 ? most : 1) * sizeof *pts);
     if (!pts)
         return -1;
-    const double m = rest_density * pow(dx, dim);
+    const double m = c->sph_density * pow(c->sph_dx, c->dim);
     int rc = 0;
-    for (int b = 0; b < nblock && !rc; b++) {
-        int64_t n = lahar_particle_block_lattice(&blocks[b], dim, dx, pts, most);
+    for (int b = 0; b < c->nblock && !rc; b++) {
+        int64_t n = lahar_case_block_lattice(c, b, pts, most);
+        rc = n < 0 ? -1 : 0;
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], blocks[b].v, m, rest_density, 0) < 0 ? -1 : 0;
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, c->sph_density, 0) < 0 ? -1 : 0;
     }
     free(pts);
     return rc;
 }
 
-static int64_t sph_node_count(int dim, double dx, int nblock, const lahar_particle_block *blocks)
+static int64_t sph_node_count(const lahar_case *c)
 {
     int64_t total = 0;
-    for (int b = 0; b < nblock; b++)
-        total += lahar_particle_block_lattice(&blocks[b], dim, dx, NULL, 0);
+    for (int b = 0; b < c->nblock; b++) {
+        int64_t n = lahar_case_block_lattice(c, b, NULL, 0);
+        if (n < 0)
+            return -1;
+        total += n;
+    }
     return total;
 }
 
-int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
-                            const lahar_particle_block *blocks)
+int64_t lahar_sph_node_fill(sph_particles *p, const lahar_case *c)
 {
-    int64_t total = sph_node_count(dim, dx, nblock, blocks);
-    if (sph_particles_init(p, total > 0 ? total : 1) != 0)
+    int64_t total = sph_node_count(c);
+    if (total < 0 || sph_particles_init(p, total > 0 ? total : 1) != 0)
         return -1;
-    if (sph_node_add_blocks(p, dim, dx, rest_density, nblock, blocks) != 0) {
+    if (sph_node_add_blocks(p, c) != 0) {
         sph_particles_free(p);
         return -1;
     }
     return p->n;
-}
-
-void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt)
-{
-    const int64_t n = p->n;
-#pragma omp parallel for schedule(static) if (n > 8192)
-    for (int64_t i = 0; i < n; i++) {
-        p->vx[i] += g[0] * dt;
-        p->vy[i] += g[1] * dt;
-        p->vz[i] += g[2] * dt;
-        p->x[i] += p->vx[i] * dt;
-        p->y[i] += p->vy[i] * dt;
-        p->z[i] += p->vz[i] * dt;
-    }
-}
-
-double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double dx)
-{
-    double vmax2 = 0.0;
-    const int64_t n = p->n;
-#pragma omp parallel for reduction(max : vmax2) schedule(static) if (n > 8192)
-    for (int64_t i = 0; i < n; i++) {
-        double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i];
-        if (v2 > vmax2)
-            vmax2 = v2;
-    }
-    double gn = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    return 0.25 * dx / (sqrt(vmax2) + sqrt(gn * dx));
 }
 
 int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen)
@@ -482,11 +457,11 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
     }
     if (lahar_sph_node_params(c, &prm, err, errlen) != 0)
         return -1;
-    int64_t total = sph_node_count(c->dim, c->sph_dx, c->nblock, c->blocks);
+    int64_t total = sph_node_count(c);
     if (sph_fluid_init(&s->f, &prm, total > 0 ? total : 1, err, (int)errlen) != 0)
         return -1;
     s->fluid_ready = 1;
-    if (sph_node_add_blocks(&s->f.p, c->dim, c->sph_dx, c->sph_density, c->nblock, c->blocks) != 0) {
+    if (total < 0 || sph_node_add_blocks(&s->f.p, c) != 0) {
         snprintf(err, errlen, "out of memory for %lld particles", (long long)total);
         return -1;
     }

@@ -23,17 +23,10 @@ typedef struct {
  * implement yet (SPS, a halo other than dx/2, a coupling range other than the kernel support). */
 int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen);
 
-/* Allocate and fill the lattice points of spacing dx inside every block
- * (lahar_particle_block_lattice: centres at lo + (i + 1/2) dx, one layer at z = 0 in 2D; boxes in
- * the order of sph_particles_add_box), mass rho0 dx^D. Returns the number of particles, or -1
- * when out of memory. */
-int64_t lahar_sph_node_fill(sph_particles *p, int dim, double dx, double rest_density, int nblock,
-                            const lahar_particle_block *blocks);
-/* Free fall without forces (the node before the WCSPH core; kept for test_sph_particles):
- * semi-implicit Euler under gravity only: v += g dt, then x += v dt. */
-void lahar_sph_node_fall(sph_particles *p, const double g[3], double dt);
-/* CFL-like step of a free fall: 0.25 dx / (|v|max + sqrt(|g| dx)). */
-double lahar_sph_node_fall_dt(const sph_particles *p, const double g[3], double dx);
+/* Allocate and fill the particles of the case's blocks (lahar_case_block_lattice: centres at
+ * lo + (i + 1/2) dx, one layer at z = 0 in 2D, points inside bodies left out), mass rho0 dx^D.
+ * Returns the number of particles, or -1 when out of memory. */
+int64_t lahar_sph_node_fill(sph_particles *p, const lahar_case *c);
 
 int lahar_sph_node_run(const lahar_sph_node_options *o);
 
