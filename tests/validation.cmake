@@ -41,13 +41,7 @@ lahar_validation_test(floating_box_2d floating_box_2d dx=0.01)
 # Sinking disc: lahar check's floor_penetration = 0, and what its metrics cannot state: the disc
 # sinks most of the way (its bottom starts 0.1275 m above the floor), turns, stops (speed < 5 % of
 # its largest) and rests at the floor (gap < its radius: a film of fluid particles stays under it).
-# DISABLED: the SPH node fills the blocks without cutting the bodies out (sph_node/sph_node.c uses
-# lahar_particle_block_lattice, not lahar_case_block_lattice as the loader and `lahar validate`
-# do), so a disc inside a box of water stops at step 0 with "particle ... starts inside body".
-# Measured with that one change (cases/README.md); enable once the node cuts bodies out.
 lahar_validation_test(cylinder_array_2d_c0.1 cylinder_array_2d dx=0.004 c=0.1)
 lahar_validation_test(cylinder_array_2d_c0.4 cylinder_array_2d dx=0.004 c=0.4)
 lahar_validation_test(sinking_disc_2d sinking_disc_2d dx=0.005
   "sink_distance>=0.1" "rotation_deg>=10" "final_speed_rel<=0.05" "rest_gap_rel<=1")
-set_tests_properties(validation_cylinder_array_2d_c0.1 validation_cylinder_array_2d_c0.4
-  validation_sinking_disc_2d PROPERTIES DISABLED TRUE)
