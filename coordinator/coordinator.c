@@ -696,6 +696,7 @@ out:
         if (co.node[LAHAR_ROLE_DEM].needed)
             printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
                    LAHAR_TOOLS_DIR, co.outdir);
+        printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co.outdir);
         printf("  run summary: %s/summary.json\n", co.outdir);
     }
     lahar_link_destroy(co.link);
