@@ -2,6 +2,7 @@
 #include "sph_fluid.h"
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void fluid_defaults(sph_params *p)
@@ -18,6 +19,8 @@ static void fluid_defaults(sph_params *p)
         p->cfl_force = 0.25;
     if (p->cfl_visc <= 0.0)
         p->cfl_visc = 0.125;
+    if (p->sps_cs <= 0.0)
+        p->sps_cs = 0.12;
 }
 
 int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, int errlen)
@@ -41,6 +44,19 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
     if (sph_cells_init(&f->cells, p->dim, f->k.support, p->periodic, p->lo, p->hi, f->p.cap, err, errlen) != 0) {
         sph_particles_free(&f->p);
         return -1;
+    }
+    if (p->sps) {
+        /* nu_t and the six stress components in one block, only when SPS is on */
+        double *buf = calloc((size_t)f->p.cap * 7, sizeof(double));
+        if (!buf) {
+            sph_cells_free(&f->cells);
+            sph_particles_free(&f->p);
+            snprintf(err, (size_t)errlen, "out of memory for the SPS stress of %lld particles", (long long)cap);
+            return -1;
+        }
+        f->sps_nut = buf;
+        for (int a = 0; a < 6; a++)
+            f->sps_tau[a] = buf + (size_t)f->p.cap * (size_t)(a + 1);
     }
     return 0;
 }
@@ -67,6 +83,7 @@ void sph_fluid_free(sph_fluid *f)
 {
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
+    free(f->sps_nut);
     sph_cells_free(&f->cells);
     sph_particles_free(&f->p);
     memset(f, 0, sizeof *f);
@@ -81,7 +98,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
 
 /* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
  * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
-static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, int64_t i, double out[4])
+static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, int64_t i,
+                                  double out[4])
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
@@ -97,6 +115,12 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, in
     const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
                  hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
                  hz = prm->periodic[2] ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
+    /* SPS stress of i over rho_i^2 (003 eq. 10); unused when sps is 0 */
+    double ti[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    double *const *tau = f->sps_tau;
+    if (sps)
+        for (int a = 0; a < 6; a++)
+            ti[a] = tau[a][i] / (rhoi * rhoi);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
         double r = sqrt(r2);
@@ -118,6 +142,14 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, in
         ax += gp * rx + gv * vx;
         ay += gp * ry + gv * vy;
         az += gp * rz + gv * vz;
+        if (sps) { /* 003 eq. 10, third term: sum_j m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
+            double irj2 = 1.0 / (rhoj * rhoj), mf = mj * fij;
+            double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2, txz = ti[2] + tau[2][j] * irj2;
+            double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2, tzz = ti[5] + tau[5][j] * irj2;
+            ax += mf * (txx * rx + txy * ry + txz * rz);
+            ay += mf * (txy * rx + tyy * ry + tyz * rz);
+            az += mf * (txz * rx + tyz * ry + tzz * rz);
+        }
     });
     out[0] = drho;
     out[1] = ax + prm->body_force[0];
@@ -125,18 +157,73 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, in
     out[3] = az + prm->body_force[2];
 }
 
+/* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, 003 eq. 11). */
+static inline void fluid_sps_particle(sph_fluid *f, const kernel_kind kind, int64_t i)
+{
+    const sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
+    const double inv_h = f->k.inv_h, dnorm = f->k.dnorm, s2 = f->k.support * f->k.support;
+    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
+    double g[3][3] = {{0.0}}; /* g[a][b] = d v_a / d x_b */
+    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        double r = sqrt(r2);
+        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
+        double w = p->m[j] / p->rho[j] * fij; /* V_j F_ij; grad_i W_ij = F_ij x_ij */
+        double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
+        double xr[3] = {rx, ry, rz};
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                g[a][b] += w * dv[a] * xr[b];
+    });
+    double sxx = g[0][0], syy = g[1][1], szz = g[2][2];
+    double sxy = 0.5 * (g[0][1] + g[1][0]), sxz = 0.5 * (g[0][2] + g[2][0]), syz = 0.5 * (g[1][2] + g[2][1]);
+    double ss = sxx * sxx + syy * syy + szz * szz + 2.0 * (sxy * sxy + sxz * sxz + syz * syz); /* S:S */
+    double smag = sqrt(2.0 * ss), delta = f->prm.dx, csd = f->prm.sps_cs * delta;
+    double nut = csd * csd * smag;
+    double tr3 = (sxx + syy + szz) / 3.0;
+    double iso = 2.0 / 3.0 * SPH_SPS_CI * delta * delta * smag * smag;
+    double rho = p->rho[i];
+    f->sps_nut[i] = nut;
+    f->sps_tau[0][i] = rho * (2.0 * nut * (sxx - tr3) - iso);
+    f->sps_tau[1][i] = rho * 2.0 * nut * sxy;
+    f->sps_tau[2][i] = rho * 2.0 * nut * sxz;
+    f->sps_tau[3][i] = rho * (2.0 * nut * (syy - tr3) - iso);
+    f->sps_tau[4][i] = rho * 2.0 * nut * syz;
+    f->sps_tau[5][i] = rho * (2.0 * nut * (szz - tr3) - iso);
+}
+
+static void fluid_sps_pass(sph_fluid *f)
+{
+    const int64_t n = f->p.n;
+    const kernel_kind kind = f->k.kind;
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        switch (kind) {
+        case KERNEL_QUINTIC: fluid_sps_particle(f, KERNEL_QUINTIC, i); break;
+        case KERNEL_WENDLAND2: fluid_sps_particle(f, KERNEL_WENDLAND2, i); break;
+        default: fluid_sps_particle(f, KERNEL_CUBIC, i); break;
+        }
+    }
+}
+
 static void fluid_pass(sph_fluid *f)
 {
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
+    const int sps = f->prm.sps != 0;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
-        switch (kind) {
-        case KERNEL_QUINTIC: fluid_particle(f, KERNEL_QUINTIC, i, out); break;
-        case KERNEL_WENDLAND2: fluid_particle(f, KERNEL_WENDLAND2, i, out); break;
-        default: fluid_particle(f, KERNEL_CUBIC, i, out); break;
+        /* kind and sps constant per call site: the pair loop inlines without their branches */
+        switch (kind * 2 + sps) {
+        case KERNEL_QUINTIC * 2: fluid_particle(f, KERNEL_QUINTIC, 0, i, out); break;
+        case KERNEL_QUINTIC * 2 + 1: fluid_particle(f, KERNEL_QUINTIC, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 2: fluid_particle(f, KERNEL_WENDLAND2, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 2 + 1: fluid_particle(f, KERNEL_WENDLAND2, 1, i, out); break;
+        case KERNEL_CUBIC * 2 + 1: fluid_particle(f, KERNEL_CUBIC, 1, i, out); break;
+        default: fluid_particle(f, KERNEL_CUBIC, 0, i, out); break;
         }
         p->drho[i] = out[0];
         p->ax[i] = out[1];
@@ -168,7 +255,8 @@ void sph_fluid_shepard(sph_fluid *f)
         p->rho[i] = p->rhoh[i];
 }
 
-int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
+/* EOS, SPS and the particle-particle sums: everything of the rates that does not need the bodies. */
+static void fluid_rates_particles(sph_fluid *f)
 {
     sph_particles *p = &f->p;
     const int64_t n = p->n;
@@ -176,7 +264,16 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++)
         p->p[i] = sph_fluid_pressure(&prm, p->rho[i]);
+    if (prm.sps)
+        fluid_sps_pass(f);
     fluid_pass(f);
+}
+
+/* The coupling with the bodies at `states`, and vmax/amax: the rest of the rates. */
+static int64_t fluid_rates_bodies(sph_fluid *f, const lahar_body_state *states, double dt)
+{
+    sph_particles *p = &f->p;
+    const int64_t n = p->n;
     int64_t cross = 0;
     if (f->has_bodies) {
         cross = sph_coupling_apply(&f->cpl, p, states, dt);
@@ -197,11 +294,17 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
     return cross;
 }
 
-int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
+int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
+{
+    fluid_rates_particles(f);
+    return fluid_rates_bodies(f, states, dt);
+}
+
+int sph_fluid_step_begin(sph_fluid *f, double dt)
 {
     sph_particles *p = &f->p;
     if (!f->primed) {
-        if (sph_cells_sort(&f->cells, p) != 0 || sph_fluid_rates(f, states, dt) < 0)
+        if (sph_cells_sort(&f->cells, p) != 0 || sph_fluid_rates(f, NULL, dt) < 0)
             return -1;
     }
     const int64_t n = p->n;
@@ -224,9 +327,23 @@ int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
     }
     if (sph_cells_sort(&f->cells, p) != 0)
         return -1;
-    int64_t cross = sph_fluid_rates(f, states, dt);
+    fluid_rates_particles(f);
+    f->begun = 1;
+    return 0;
+}
+
+int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *states)
+{
+    sph_particles *p = &f->p;
+    if (!f->begun)
+        return -1;
+    f->begun = 0;
+    int64_t cross = fluid_rates_bodies(f, states, dt);
     if (cross < 0)
         return -1;
+    const int64_t n = p->n;
+    const double hdt = 0.5 * dt;
+    const int d3 = f->prm.dim == 3;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         /* kick (half) with the new rates */
@@ -241,6 +358,19 @@ int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
         sph_fluid_shepard(f);
     f->crossings = cross;
     return cross;
+}
+
+int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states)
+{
+    /* never evaluated: the first rates see the bodies at `states` (step_begin alone would use
+     * their own fields) */
+    if (!f->primed) {
+        if (sph_cells_sort(&f->cells, &f->p) != 0 || sph_fluid_rates(f, states, dt) < 0)
+            return -1;
+    }
+    if (sph_fluid_step_begin(f, dt) != 0)
+        return -1;
+    return sph_fluid_step_end(f, dt, states);
 }
 
 double sph_fluid_dt(const sph_fluid *f)

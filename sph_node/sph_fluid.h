@@ -65,6 +65,8 @@ typedef struct {
     double lo[3], hi[3];
     sph_wall_viscous wall_viscous;
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
+    int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
+    double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
 } sph_params;
 
 typedef struct {
@@ -79,6 +81,12 @@ typedef struct {
     int64_t step;
     double vmax, amax;      /* of the last evaluation */
     int64_t crossings;      /* of the last step */
+    int begun;              /* sph_fluid_step_begin done, sph_fluid_step_end due */
+    /* SPS only (NULL when prm.sps is off): per particle, in the sorted order of the last
+     * evaluation, the eddy viscosity nu_t and the SPS stress tau (003 eq. 11, with density:
+     * xx, xy, xz, yy, yz, zz) */
+    double *sps_nut;
+    double *sps_tau[6];
 } sph_fluid;
 
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the
@@ -92,6 +100,18 @@ void sph_fluid_free(sph_fluid *f);
 /* Pressure from density by the EOS of the parameters. */
 double sph_fluid_pressure(const sph_params *prm, double rho);
 
+/* SPS turbulence (003 eq. 10-11, Dalrymple & Rogers 2006), when prm.sps is on. Before the
+ * particle-particle sums, one gather pass takes the velocity gradient
+ *   (grad v)_ab,i = sum_j V_j (v_j - v_i)_a (grad_i W_ij)_b,
+ * the strain rate S = (grad v + grad v^T)/2, |S| = sqrt(2 S:S), the eddy viscosity
+ * nu_t = (C_s Delta)^2 |S| with Delta = dx, and the SPS stress (003 eq. 11; the delta term of the
+ * printed equation is the trace S_kk)
+ *   tau_i / rho_i = 2 nu_t (S - tr(S)/3 I) - 2/3 C_I Delta^2 |S|^2 I,   C_I = 0.0066.
+ * The momentum equation gains the symmetric term of 003 eq. 10:
+ *   dv_i/dt += sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij.
+ * Off: no pass, no arrays, and the pair loop is compiled without the term. */
+#define SPH_SPS_CI 0.0066
+
 /* Evaluate the rates (p.ax, ay, az, drho) at the current state: EOS, the particle-particle sums
  * and, with bodies, the coupling for a step dt with bodies at `states` (NULL: their own fields).
  * Particles must be sorted (sph_cells_sort). Returns crossings, or -1 (out of memory). */
@@ -101,6 +121,19 @@ int64_t sph_fluid_rates(sph_fluid *f, const lahar_body_state *states, double dt)
  * Returns the number of particles that crossed a body surface in this step (0 normally), or -1
  * (out of memory). */
 int64_t sph_fluid_step(sph_fluid *f, double dt, const lahar_body_state *states);
+
+/* The same step in two parts, so that a caller can do the particle work while it waits for the
+ * body states: sph_fluid_step(f, dt, s) is bitwise sph_fluid_step_begin(f, dt) followed by
+ * sph_fluid_step_end(f, dt, s) (tests/test_sph_split.c).
+ * step_begin: kick (half), drift, predict, sort, EOS, SPS and the particle-particle sums at the
+ *   end of the step. On a state whose rates were never evaluated it first evaluates them with the
+ *   bodies at their own fields (sph_fluid_step primes with its `states` instead). Returns 0 or -1
+ *   (out of memory).
+ * step_end: the coupling with the bodies at `states` (the end of the step; NULL: their own
+ *   fields), vmax/amax, the second half kick, the Shepard filter when due. Returns the crossings
+ *   of sph_fluid_step, or -1 (out of memory, or no step_begin before). */
+int sph_fluid_step_begin(sph_fluid *f, double dt);
+int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *states);
 
 /* Apply the Shepard density filter now (particles sorted, cells valid). */
 void sph_fluid_shepard(sph_fluid *f);

@@ -6,18 +6,19 @@
  *   [DEM node] send LOADS(k): per body near particles the resultant force and torque at t_k
  *          (from the evaluation that ended step k-1, which used BODY_STATE(k-1), the bodies at t_k)
  *          and, for moving bodies and bodies marked record_contacts, the contact points
+ *   sph_fluid_step_begin(dt_k): kick, drift, sort, EOS, SPS, particle-particle sums at t_{k+1}
+ *          (no body state needed: this overlaps the DEM node's advance and the BODY_STATE latency)
  *   [DEM node, moving bodies] wait BODY_STATE(k): the bodies at t_{k+1}, after the DEM node's
  *          advance with LOADS(k)
- *   sph_fluid_step(dt_k, bodies at t_{k+1}): kick, drift, sort, rates at t_{k+1} (with the
- *          coupling forces at t_{k+1}, sent as LOADS(k+1)), kick
+ *   sph_fluid_step_end(dt_k, bodies at t_{k+1}): coupling forces at t_{k+1} (sent as LOADS(k+1)),
+ *          vmax/amax, kick
  *   snapshot if write_output (or if a particle crossed a body surface), STATUS(k) with the
  *   solver's dt proposal for step k+1.
  *
  * So the forces the DEM node applies over step k are those of the bodies and particles at t_k,
  * and the fluid integrated over step k sees the bodies at t_k and t_{k+1} (KDK, both ends): a
- * staggered explicit coupling. The DEM node's advance of step k overlaps the SPH node's wait
- * only; splitting sph_fluid_step into a particle-particle part (before the BODY_STATE wait) and
- * the coupling part would hide it behind computation. */
+ * staggered explicit coupling. The split step is bitwise the one-call sph_fluid_step
+ * (tests/test_sph_split.c), so the overlap changes timing only, never results. */
 #include "sph_node.h"
 #include <math.h>
 #include <omp.h>
@@ -111,11 +112,9 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->cfl_visc = o->cfl_visc;
     prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
     prm->shepard_every = o->shepard_interval;
+    prm->sps = o->sps;
+    prm->sps_cs = o->sps_cs;
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
-    if (o->sps) {
-        snprintf(err, errlen, "sph.sps: the SPS turbulence model is not implemented by the solver yet");
-        return -1;
-    }
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {
         snprintf(err, errlen, "sph.halo: the coupling uses eps = dx/2 = %g m; another halo (%g m) is not implemented yet",
                  0.5 * c->sph_dx, o->halo);
@@ -393,6 +392,17 @@ static int sph_node_loop(sph_node *s)
             st.error = 1;
             snprintf(err, sizeof err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
         }
+        /* the particle work of step k needs no body states: do it before waiting for them, so
+         * the DEM node's advance and the BODY_STATE latency hide behind it */
+        int begun = 0;
+        if (!st.error) {
+            if (sph_fluid_step_begin(&s->f, step.dt) != 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "out of memory in the SPH step");
+            } else {
+                begun = 1;
+            }
+        }
         compute += lahar_now() - c0;
         if (has_dem && s->nmoving > 0) {
             /* the moving bodies at t_{k+1}, after the DEM node's advance with LOADS(k) */
@@ -410,9 +420,11 @@ static int sph_node_loop(sph_node *s)
             }
         }
         c0 = lahar_now();
-        int stepped = !st.error;
+        /* a failed BODY_STATE after step_begin leaves the particles drifted but not kicked: that
+         * state is neither t_k nor t_{k+1}, so no snapshot is written for it (see below) */
+        int stepped = begun && !st.error;
         if (stepped) {
-            cross = sph_fluid_step(&s->f, step.dt, has_dem ? s->states : NULL);
+            cross = sph_fluid_step_end(&s->f, step.dt, has_dem ? s->states : NULL);
             if (cross < 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH step");
@@ -426,7 +438,7 @@ static int sph_node_loop(sph_node *s)
         if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
-        } else if (!stepped && s->last_snapshot != k) {
+        } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
         st.dt_proposed = sph_fluid_dt(&s->f);

@@ -34,3 +34,10 @@ add_executable(test_sph_couette ${LAHAR_TEST_DIR}/test_sph_couette.c)
 target_link_libraries(test_sph_couette PRIVATE lahar_sph)
 add_test(NAME sph_couette COMMAND test_sph_couette)
 set_tests_properties(sph_couette PROPERTIES LABELS "fast;sph" TIMEOUT 120)
+
+# SPS turbulence (brief L): nu_t of a uniform shear, zero force of a constant stress, a shear wave
+# against the analytic divergence, a dam break that stays stable.
+add_executable(test_sph_sps ${LAHAR_TEST_DIR}/test_sph_sps.c)
+target_link_libraries(test_sph_sps PRIVATE lahar_sph)
+add_test(NAME sph_sps COMMAND test_sph_sps)
+set_tests_properties(sph_sps PROPERTIES LABELS "fast;sph" TIMEOUT 120)
