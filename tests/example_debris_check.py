@@ -10,19 +10,20 @@ tests/example_debris.sh:
 2. The barrier is loaded toward the downstream side (+x) once the water arrives: before the
    first particle comes within 2 dx of its upstream face the force stream (forces.h5) shows
    |Fx| < 1 N/m, after it the largest Fx is > 0 and the mean Fx over the arrival window is > 0.
-3. The peak horizontal fluid force on the barrier is within a factor 2 of the momentum flux of
-   the arriving surge, F ~ rho u^2 h (per unit width). Reasoning: the surge is stopped by (or
-   turned up along) the barrier, so by a momentum balance over a control volume just upstream
-   of it the horizontal force equals the horizontal momentum flux it brings, rho * sum(u^2) over
-   the depth = rho <u^2> h, plus the hydrostatic part rho g h^2 / 2 (a few % here; included).
-   u and h come from the particle snapshots: the particles in a section 3 to 10 cm upstream of
-   the face and below the barrier's top (what flies over it does not load it), h = their area
-   (n dx^2) / section length, rho <u^2> h = rho sum(max(u_x, 0)^2) dx^2 / section length; the
-   estimate is the largest over the snapshots of the arrival window. The fluid force is the
-   SPH resultant on the barrier at each snapshot (contacts.h5, fluid only: boulders hitting the
-   barrier would add DEM contact spikes to forces.h5 that are not part of this estimate). Impact
-   experiments and SPH studies of surges on walls give peak / (rho u^2 h) of about 1 to 2 plus
-   the hydrostatic load, hence the band [0.5, 2].
+3. The water's load on the barrier matches a momentum balance within a factor 2. Over a control
+   volume from a section just upstream to the barrier's face, the horizontal force on the face is
+   the horizontal momentum flux the surge brings in, rho <u^2> h (per unit width; the barrier
+   stops it or turns it upward), plus the hydrostatic load of the water piled against the face,
+   rho g h_b^2 / 2 with h_b capped at the barrier height P (what is higher flows over it).
+   From the particle snapshots: in the section 3 to 10 cm upstream of the face, below the
+   barrier's top, h = n dx^2 / section length and rho <u^2> h = rho sum(max(u_x, 0)^2) dx^2 /
+   section length; h_b = particle area in the 3 dx strip before the face / 3 dx. Both are
+   averaged over the snapshots of the window [arrival, arrival + 0.2 s] and compared with the
+   mean of the force stream's Fx over the same window (no boulder touches the barrier then:
+   asserted, so the force is the water's). The mean, not the peak: the 1 ms rows hold the
+   WCSPH impact spike (10x the mean, reported as information), which no steady balance predicts.
+   Unsteadiness (the front's impact, water landing from the jet) adds to the measured force, so
+   the ratio sits above 1 (1.71 in the full 1.5 s run at dx = 5 mm).
 Exit 0 when all hold, 1 otherwise (each check printed with its numbers)."""
 import os
 import sys
@@ -32,7 +33,7 @@ import numpy as np
 
 TOL = 0.002  # m: DEM overlaps stay well below (static m g / kn = 0.05 mm, impacts ~0.5 mm)
 RHO, G = 1000.0, 9.81
-WINDOW = 0.15  # s after the water's arrival at the barrier in which the peak is sought
+WINDOW = 0.2  # s after the water's arrival at the barrier: the surge and the pile-up behind it
 
 
 def names(ds):
@@ -87,12 +88,14 @@ def main():
     for k in bsnaps:
         v = bf["snapshots"][k]["vertices"][()].astype(np.float64)[:, :2]
         v = v[np.isin(mov_id, free)]
-        # distance to the bed's core, signed by the side (above = +)
-        best = np.full(len(v), np.inf)
+        # distance to the nearest segment of the bed's core, signed by its side (above = +)
+        best, signed = np.full(len(v), np.inf), np.zeros(len(v))
         for a, b in zip(bed[:-1], bed[1:]):
             d, side = seg_dist(v, a, b)
-            best = np.minimum(best, np.where(side > 0, d, -d))
-        worst_bed = min(worst_bed, np.min(best) - r_bed)
+            nearer = d < best
+            best = np.where(nearer, d, best)
+            signed = np.where(nearer, np.where(side > 0, d, -d), signed)
+        worst_bed = min(worst_bed, np.min(signed) - r_bed)
         inside = np.minimum.reduce([v[:, 0] - blo[0], bhi[0] - v[:, 0], v[:, 1] - blo[1], bhi[1] - v[:, 1]])
         worst_bar = max(worst_bar, np.max(inside))
         worst_wall = max(worst_wall, np.max(np.maximum(wl - v[:, 0], v[:, 0] - wr)))
@@ -109,6 +112,8 @@ def main():
     flux = np.zeros(len(psnaps))
     depth = np.zeros(len(psnaps))
     speed = np.zeros(len(psnaps))
+    depth_b = np.zeros(len(psnaps))
+    P = bhi[1] - 0.005  # barrier height above the bed surface
     for j, k in enumerate(psnaps):
         s = pf["snapshots"][k]
         x, y, vx = s["x"][()], s["y"][()], s["vx"][()]
@@ -119,6 +124,8 @@ def main():
         depth[j] = sel.sum() * dx * dx / (x1 - x0)
         flux[j] = RHO * np.sum(u * u) * dx * dx / (x1 - x0)
         speed[j] = np.sqrt(np.mean(u * u)) if sel.any() else 0.0
+        # water depth against the face: area of the strip 3 dx wide in front of it / its width
+        depth_b[j] = np.sum((x >= blo[0] - 3 * dx) & (x < blo[0])) * dx / 3.0
     if t_arr is None:
         report(False, "the water never reaches the barrier (run too short?)")
         return 1
@@ -136,24 +143,21 @@ def main():
            f"barrier pushed downstream after arrival: forces.h5 Fx max {np.max(fx[win]):.1f} N/m, "
            f"mean {np.mean(fx[win]):.1f} N/m over [{t_arr:.2f}, {t_arr + WINDOW:.2f}] s (> 0)")
 
-    # 3. peak fluid force vs rho u^2 h (+ rho g h^2 / 2)
-    csnaps = sorted(cf["snapshots"].keys())
-    ct = np.array([cf["snapshots"][k].attrs["time"] for k in csnaps])
-    cfx = np.array([cf["snapshots"][k]["barrier"].attrs["force"][0] for k in csnaps])
-    cw = (ct >= t_arr - 1e-9) & (ct <= t_arr + WINDOW)
-    pw = (pt >= t_arr - 0.04 - 1e-9) & (pt <= t_arr + WINDOW)
-    if not cw.any() or not pw.any():
-        report(False, "no snapshots in the arrival window")
-        return 1
+    # 3. mean horizontal force over the loaded window vs the momentum balance estimate
+    nc = ff["ncontacts"][: len(t), ib]
+    report(not np.any(nc[win]), f"no boulder touches the barrier in the window (DEM contacts {int(np.max(nc[win]))}): "
+           "the force there is the water's")
+    pw = (pt >= t_arr - 1e-9) & (pt <= t_arr + WINDOW + 1e-9)
+    est = flux + 0.5 * RHO * G * np.minimum(depth_b, P) ** 2
+    e_mean, f_mean = np.mean(est[pw]), np.mean(fx[win])
+    ratio = f_mean / e_mean if e_mean > 0 else np.inf
     jf = int(np.argmax(np.where(pw, flux, -np.inf)))
-    estimate = flux[jf] + 0.5 * RHO * G * depth[jf] ** 2
-    jc = int(np.argmax(np.where(cw, cfx, -np.inf)))
-    ratio = cfx[jc] / estimate if estimate > 0 else np.inf
-    print(f"info: surge at t = {pt[jf]:.3f} s: h = {depth[jf] * 1e3:.1f} mm, u_rms = {speed[jf]:.2f} m/s, "
-          f"rho u^2 h = {flux[jf]:.1f} N/m, + rho g h^2/2 = {estimate:.1f} N/m")
-    print(f"info: forces.h5 peak Fx in the window {np.max(fx[win]):.1f} N/m (boulder contacts included)")
-    report(0.5 <= ratio <= 2.0, f"peak fluid force on the barrier {cfx[jc]:.1f} N/m at t = {ct[jc]:.3f} s "
-           f"= {ratio:.2f} x (rho u^2 h + rho g h^2 / 2) (band [0.5, 2])")
+    print(f"info: strongest surge at t = {pt[jf]:.3f} s: h = {depth[jf] * 1e3:.1f} mm, u_rms = {speed[jf]:.2f} m/s, "
+          f"rho u^2 h = {flux[jf]:.1f} N/m; depth at the face up to {np.max(depth_b[pw]) * 1e3:.1f} mm (P = {P * 1e3:.0f} mm)")
+    print(f"info: forces.h5 peak Fx {np.max(fx[win]):.1f} N/m (1 ms rows: the impact spike), "
+          f"largest 10 ms mean {np.max(np.convolve(fx[win], np.ones(10) / 10, 'valid')):.1f} N/m")
+    report(0.5 <= ratio <= 2.0, f"mean Fx on the barrier over [{t_arr:.2f}, {t_arr + WINDOW:.2f}] s = {f_mean:.1f} N/m "
+           f"= {ratio:.2f} x the mean of rho <u^2> h + rho g h_b^2 / 2 = {e_mean:.1f} N/m (band [0.5, 2])")
     for f in (bf, pf, cf, ff):
         f.close()
     return 0 if ok else 1
