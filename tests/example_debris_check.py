@@ -18,12 +18,14 @@ tests/example_debris.sh:
    From the particle snapshots: in the section 3 to 10 cm upstream of the face, below the
    barrier's top, h = n dx^2 / section length and rho <u^2> h = rho sum(max(u_x, 0)^2) dx^2 /
    section length; h_b = particle area in the 3 dx strip before the face / 3 dx. Both are
-   averaged over the snapshots of the window [arrival, arrival + 0.2 s] and compared with the
-   mean of the force stream's Fx over the same window (no boulder touches the barrier then:
-   asserted, so the force is the water's). The mean, not the peak: the 1 ms rows hold the
-   WCSPH impact spike (10x the mean, reported as information), which no steady balance predicts.
-   Unsteadiness (the front's impact, water landing from the jet) adds to the measured force, so
-   the ratio sits above 1 (1.71 in the full 1.5 s run at dx = 5 mm).
+   averaged over the snapshots of the quasi-steady window [arrival + 0.1 s, arrival + 0.3 s]
+   and compared with the mean of the force stream's Fx over the same window (no boulder touches
+   the barrier then: asserted, so the force is the water's). The first 0.1 s after arrival is
+   the impact: the front and the water of the jet landing on the barrier give WCSPH pressure
+   spikes (1 ms rows up to ~1.3 kN/m, 10x the mean; reported as information) and a mean 1.7-2x
+   the estimate, which no steady balance predicts; the quasi-steady window gave 0.99 and 1.18
+   in two full runs (geometry differing only by the back wall's height: the flow is chaotic,
+   hence a factor-2 band, not a tighter one).
 Exit 0 when all hold, 1 otherwise (each check printed with its numbers)."""
 import os
 import sys
@@ -33,7 +35,8 @@ import numpy as np
 
 TOL = 0.002  # m: DEM overlaps stay well below (static m g / kn = 0.05 mm, impacts ~0.5 mm)
 RHO, G = 1000.0, 9.81
-WINDOW = 0.2  # s after the water's arrival at the barrier: the surge and the pile-up behind it
+IMPACT = 0.1  # s after the water's arrival: the impact (front, water landing from the jet)
+WINDOW = 0.2  # s after the impact phase: the quasi-steady load of the surge and the pile-up
 
 
 def names(ds):
@@ -136,27 +139,32 @@ def main():
     t = ff["t"][()]
     fx = ff["force"][: len(t), ib, 0]
     before = t < t_arr - 0.02
-    win = (t >= t_arr) & (t <= t_arr + WINDOW)
+    win = (t >= t_arr) & (t <= t_arr + IMPACT + WINDOW)
+    steady = (t >= t_arr + IMPACT) & (t <= t_arr + IMPACT + WINDOW)
     report(before.any() and np.max(np.abs(fx[before])) < 1.0,
            f"barrier unloaded before the water: max |Fx| = {np.max(np.abs(fx[before])) if before.any() else np.nan:.3g} N/m (< 1)")
     report(win.any() and np.max(fx[win]) > 0 and np.mean(fx[win]) > 0,
            f"barrier pushed downstream after arrival: forces.h5 Fx max {np.max(fx[win]):.1f} N/m, "
-           f"mean {np.mean(fx[win]):.1f} N/m over [{t_arr:.2f}, {t_arr + WINDOW:.2f}] s (> 0)")
+           f"mean {np.mean(fx[win]):.1f} N/m over [{t_arr:.2f}, {t_arr + IMPACT + WINDOW:.2f}] s (> 0)")
 
     # 3. mean horizontal force over the loaded window vs the momentum balance estimate
     nc = ff["ncontacts"][: len(t), ib]
-    report(not np.any(nc[win]), f"no boulder touches the barrier in the window (DEM contacts {int(np.max(nc[win]))}): "
+    report(steady.any() and not np.any(nc[steady]),
+           f"no boulder touches the barrier in the window (DEM contacts {int(np.max(nc[steady], initial=0))}): "
            "the force there is the water's")
-    pw = (pt >= t_arr - 1e-9) & (pt <= t_arr + WINDOW + 1e-9)
+    pw = (pt >= t_arr + IMPACT - 1e-9) & (pt <= t_arr + IMPACT + WINDOW + 1e-9)
     est = flux + 0.5 * RHO * G * np.minimum(depth_b, P) ** 2
-    e_mean, f_mean = np.mean(est[pw]), np.mean(fx[win])
+    if not pw.any() or not steady.any():
+        report(False, "no snapshots or force rows in the window (run too short?)")
+        return 1
+    e_mean, f_mean = np.mean(est[pw]), np.mean(fx[steady])
     ratio = f_mean / e_mean if e_mean > 0 else np.inf
     jf = int(np.argmax(np.where(pw, flux, -np.inf)))
-    print(f"info: strongest surge at t = {pt[jf]:.3f} s: h = {depth[jf] * 1e3:.1f} mm, u_rms = {speed[jf]:.2f} m/s, "
+    print(f"info: strongest surge in the window at t = {pt[jf]:.3f} s: h = {depth[jf] * 1e3:.1f} mm, u_rms = {speed[jf]:.2f} m/s, "
           f"rho u^2 h = {flux[jf]:.1f} N/m; depth at the face up to {np.max(depth_b[pw]) * 1e3:.1f} mm (P = {P * 1e3:.0f} mm)")
     print(f"info: forces.h5 peak Fx {np.max(fx[win]):.1f} N/m (1 ms rows: the impact spike), "
           f"largest 10 ms mean {np.max(np.convolve(fx[win], np.ones(10) / 10, 'valid')):.1f} N/m")
-    report(0.5 <= ratio <= 2.0, f"mean Fx on the barrier over [{t_arr:.2f}, {t_arr + WINDOW:.2f}] s = {f_mean:.1f} N/m "
+    report(0.5 <= ratio <= 2.0, f"mean Fx on the barrier over [{t_arr + IMPACT:.2f}, {t_arr + IMPACT + WINDOW:.2f}] s = {f_mean:.1f} N/m "
            f"= {ratio:.2f} x the mean of rho <u^2> h + rho g h_b^2 / 2 = {e_mean:.1f} N/m (band [0.5, 2])")
     for f in (bf, pf, cf, ff):
         f.close()

@@ -135,6 +135,9 @@ def draw(out_png, pf, psnap, bf, bsnap, dim, view, color, clim, limits, dx):
             x = x[order]
             val = val[order] if val is not None else None
         if val is not None:
+            if color == "pressure" and clim == (None, None) and len(val):
+                # one impact spike would wash out the rest: scale to the 1st..99th percentile
+                clim = tuple(np.percentile(val, [1.0, 99.0]))
             sc = ax.scatter(x[:, ax2[0]], x[:, ax2[1]], c=val, s=size, cmap="viridis" if color == "speed" else "coolwarm",
                             vmin=clim[0], vmax=clim[1], linewidths=0, zorder=2)
             fig.colorbar(sc, ax=ax, label=label, shrink=0.8)
@@ -213,13 +216,16 @@ def main():
             os.makedirs(outdir, exist_ok=True)
             clim = (None, None)
             if psnaps:  # one colour scale for the whole series
-                hi = lo = None
+                lows, highs = [], []
                 for name, _, _ in psnaps:
                     _, v, _ = particle_data(pf, name, args.color)
                     if v is not None and len(v):
-                        lo = np.min(v) if lo is None else min(lo, np.min(v))
-                        hi = np.max(v) if hi is None else max(hi, np.max(v))
-                clim = (0.0 if args.color == "speed" else lo, hi)
+                        lows.append(np.min(v) if args.color == "speed" else np.percentile(v, 1.0))
+                        highs.append(np.max(v) if args.color == "speed" else np.percentile(v, 99.0))
+                if highs:
+                    # speed: 0 to the fastest particle of the run; pressure: the median frame's 1st..99th
+                    # percentile (impact spikes and the first frames would wash out the scale)
+                    clim = (0.0, max(highs)) if args.color == "speed" else (np.median(lows), np.median(highs))
             for i, s in enumerate(snaps):
                 png = os.path.join(outdir, f"snapshot_{i:06d}.png")
                 draw(png, pf, s if psnaps else None, bf, body_at(s[1]), dim, args.view, args.color, clim, limits, dx)
