@@ -99,7 +99,10 @@ def nearest(snaps, args):
 
 def draw(out_png, pf, psnap, bf, bsnap, dim, view, color, clim, limits, dx):
     ax2 = AXES["xy" if dim == 2 else view]
-    fig, ax = plt.subplots(figsize=(11, 5.5), dpi=110)
+    # figure height from the scene's aspect ratio (axes about 8.5 in wide), so tall or flat scenes
+    # fill the picture
+    aspect = (limits[3] - limits[2]) / max(limits[1] - limits[0], 1e-12)
+    fig, ax = plt.subplots(figsize=(11, min(max(8.5 * aspect + 1.2, 3.5), 10.0)), dpi=110)
     ax.set_aspect("equal")
     ax.set_xlim(limits[0], limits[1])
     ax.set_ylim(limits[2], limits[3])
