@@ -290,6 +290,13 @@ static int64_t fluid_rates_bodies(sph_fluid *f, const lahar_body_state *states, 
     }
     f->vmax = sqrt(vmax2);
     f->amax = sqrt(amax2);
+    if (f->prm.sps) { /* the eddy viscosity joins the viscous step limit */
+        double nutmax = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : nutmax) if (n >= SPH_OMP_MIN_LIGHT)
+        for (int64_t i = 0; i < n; i++)
+            nutmax = f->sps_nut[i] > nutmax ? f->sps_nut[i] : nutmax;
+        f->nut_max = nutmax;
+    }
     f->primed = 1;
     return cross;
 }
@@ -380,7 +387,9 @@ double sph_fluid_dt(const sph_fluid *f)
     double dt = prm->cfl * h / (prm->c0 + f->vmax);
     if (f->amax > 0.0)
         dt = fmin(dt, prm->cfl_force * sqrt(h / f->amax));
-    if (prm->mu > 0.0)
+    if (f->nut_max > 0.0) /* SPS: the eddy viscosity adds to the laminar one */
+        dt = fmin(dt, prm->cfl_visc * h * h / (prm->mu / prm->rho0 + f->nut_max));
+    else if (prm->mu > 0.0)
         dt = fmin(dt, prm->cfl_visc * h * h * prm->rho0 / prm->mu);
     return dt;
 }

@@ -34,7 +34,8 @@
  *   predict v = v_h + dt/2 a, rho = rho_h + dt/2 D;  sort;  evaluate a, D at (x, v, rho);
  *   v = v_h + dt/2 a;  rho = rho_h + dt/2 D.
  * Step proposal (003 eq. 20 split in its three parts, plus the viscous limit):
- *   dt = min(C_cfl h/(c0 + |v|max), C_f sqrt(h/|a|max), C_v h^2/nu).
+ *   dt = min(C_cfl h/(c0 + |v|max), C_f sqrt(h/|a|max), C_v h^2/(nu + nu_t,max)),
+ *   nu_t,max the largest SPS eddy viscosity (0 without SPS).
  * Every loop over particles is an OpenMP loop in gather form (each particle sums over its own
  * neighbours in cell order): no races, and bitwise the same result for any number of threads. */
 #ifndef LAHAR_SPH_FLUID_H
@@ -86,6 +87,7 @@ typedef struct {
      * evaluation, the eddy viscosity nu_t and the SPS stress tau (003 eq. 11, with density:
      * xx, xy, xz, yy, yz, zz) */
     double *sps_nut;
+    double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
     double *sps_tau[6];
 } sph_fluid;
 
@@ -109,7 +111,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho);
  *   tau_i / rho_i = 2 nu_t (S - tr(S)/3 I) - 2/3 C_I Delta^2 |S|^2 I,   C_I = 0.0066.
  * The momentum equation gains the symmetric term of 003 eq. 10:
  *   dv_i/dt += sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij.
- * Off: no pass, no arrays, and the pair loop is compiled without the term. */
+ * Off: no pass, no arrays, and the pair loop is compiled without the term. The largest nu_t joins
+ * the viscous limit of the step proposal. */
 #define SPH_SPS_CI 0.0066
 
 /* Evaluate the rates (p.ax, ay, az, drho) at the current state: EOS, the particle-particle sums
