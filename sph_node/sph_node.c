@@ -545,8 +545,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
     char desc[256];
     if (s.fluid_ready)
-        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled",
-                 (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody);
+        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s",
+                 (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody,
+                 s.f.prm.sps ? ", SPS turbulence" : "");
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;
