@@ -260,24 +260,14 @@ static int dem_node_loop(dem_node *d)
 int lahar_dem_node_run(const lahar_dem_node_options *o)
 {
     char err[2048];
-    if (o->threads > 0)
-        omp_set_num_threads(o->threads);
-    lahar_transport *t = lahar_transport_open(o->lcm_url, err, sizeof err);
-    if (!t) {
-        fprintf(stderr, "lahar-dem: %s\n", err);
-        return 2;
-    }
     dem_node d;
     memset(&d, 0, sizeof d);
     unsigned want = LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_SCENE) |
                     LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STEP) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_LOADS) |
                     LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STOP);
-    d.link = lahar_link_create(t, ROLE, o->run_id, want, err, sizeof err);
-    if (!d.link) {
-        fprintf(stderr, "lahar-dem: %s\n", err);
-        lahar_transport_close(t);
+    lahar_transport *t;
+    if (lahar_node_connect(o, "lahar-dem", ROLE, want, &t, &d.link) != 0)
         return 2;
-    }
     static const char *const caps[] = {"dim2", "dim3", "hertz", "linear", "subcycle", "restart"};
     int status = 0;
     int rc = lahar_node_join(d.link, ROLE, lahar_dem_engine_names(), LAHAR_VERSION, caps, 6,

@@ -5,12 +5,10 @@
 #define LAHAR_DEM_NODE_H
 #include <stdint.h>
 
-typedef struct {
-    const char *lcm_url; /* udpm://... or memq:// */
-    int64_t run_id;      /* 0: join the first run announced */
-    int threads;         /* OpenMP threads for the engine; 0 = OpenMP default */
-    double join_wait_s;  /* how long to wait for the coordinator's HELLO */
-} lahar_dem_node_options;
+#include "node_cli.h"
+
+/* The node's options: the command line every node takes (common/node_cli.h). */
+typedef lahar_node_options lahar_dem_node_options;
 
 /* Runs until the coordinator stops the run. Returns the process exit status: 0 normal stop,
  * 1 engine/output error, 3 coordinator lost, 2 setup error. */

@@ -502,24 +502,14 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
 int lahar_sph_node_run(const lahar_sph_node_options *o)
 {
     char err[2048];
-    if (o->threads > 0)
-        omp_set_num_threads(o->threads);
-    lahar_transport *t = lahar_transport_open(o->lcm_url, err, sizeof err);
-    if (!t) {
-        fprintf(stderr, "lahar-sph: %s\n", err);
-        return 2;
-    }
     sph_node s;
     memset(&s, 0, sizeof s);
     unsigned want = LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_SCENE) |
                     LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STEP) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_BODY_STATE) |
                     LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STOP);
-    s.link = lahar_link_create(t, ROLE, o->run_id, want, err, sizeof err);
-    if (!s.link) {
-        fprintf(stderr, "lahar-sph: %s\n", err);
-        lahar_transport_close(t);
+    lahar_transport *t;
+    if (lahar_node_connect(o, "lahar-sph", ROLE, want, &t, &s.link) != 0)
         return 2;
-    }
     static const char *const caps[] = {"dim2", "dim3", "gravity", "wcsph", "coupling"};
     int status = 0;
     int rc = lahar_node_join(s.link, ROLE, "lahar-sph/wcsph", LAHAR_VERSION, caps, 5,

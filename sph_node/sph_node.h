@@ -7,12 +7,10 @@
 #include <stdint.h>
 #include "scene.h"
 
-typedef struct {
-    const char *lcm_url; /* udpm://... or memq:// */
-    int64_t run_id;      /* 0: join the first run announced */
-    int threads;         /* OpenMP threads; 0 = OpenMP default */
-    double join_wait_s;  /* how long to wait for the coordinator's HELLO */
-} lahar_sph_node_options;
+#include "node_cli.h"
+
+/* The node's options: the command line every node takes (common/node_cli.h). */
+typedef lahar_node_options lahar_sph_node_options;
 
 #include <stddef.h>
 #include "sph_fluid.h"

@@ -1,0 +1,78 @@
+#include "node_cli.h"
+#include <getopt.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include "netns.h"
+
+static void node_usage(FILE *f, const char *prog, const char *about, const char *exit_codes)
+{
+    fprintf(f,
+            "usage: %s [--lcm-url URL] [--run-id ID] [--threads N] [--wait S]\n"
+            "%s\n"
+            "`lahar run` starts it by itself; start it by hand only with `lahar run --no-spawn`.\n\n"
+            "  --lcm-url URL   LCM URL of the run (default: $LCM_DEFAULT_URL, else\n"
+            "                  %s, which must only be used inside a private network\n"
+            "                  namespace; give ttl=1 to reach another host on an isolated link)\n"
+            "  --run-id ID     join only this run (default: the first run announced)\n"
+            "  --threads N     OpenMP threads of the node's loops (default: OpenMP's default)\n"
+            "  --wait S        seconds to wait for the coordinator's announcement (default 30)\n"
+            "  -h, --help      this help\n"
+            "%s\n",
+            prog, about, LAHAR_NETNS_URL, exit_codes);
+}
+
+int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *about, const char *exit_codes,
+                          lahar_node_options *o)
+{
+    o->lcm_url = getenv("LCM_DEFAULT_URL");
+    o->run_id = 0;
+    o->threads = 0;
+    o->join_wait_s = 0.0;
+    static const struct option opts[] = {
+        {"lcm-url", required_argument, NULL, 'u'}, {"run-id", required_argument, NULL, 'r'},
+        {"threads", required_argument, NULL, 't'}, {"wait", required_argument, NULL, 'w'},
+        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+    };
+    int c;
+    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        switch (c) {
+        case 'u': o->lcm_url = optarg; break;
+        case 'r': o->run_id = strtoll(optarg, NULL, 0); break;
+        case 't': o->threads = atoi(optarg); break;
+        case 'w': o->join_wait_s = atof(optarg); break;
+        case 'h': node_usage(stdout, prog, about, exit_codes); return 0;
+        default: node_usage(stderr, prog, about, exit_codes); return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "%s: unexpected argument '%s'\n", prog, argv[optind]);
+        node_usage(stderr, prog, about, exit_codes);
+        return 2;
+    }
+    if (!o->lcm_url)
+        o->lcm_url = LAHAR_NETNS_URL;
+    return -1;
+}
+
+int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, unsigned want,
+                       lahar_transport **t, lahar_link **l)
+{
+    char err[1024];
+    if (o->threads > 0)
+        omp_set_num_threads(o->threads);
+    *l = NULL;
+    *t = lahar_transport_open(o->lcm_url, err, sizeof err);
+    if (!*t) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        return 2;
+    }
+    *l = lahar_link_create(*t, role, o->run_id, want, err, sizeof err);
+    if (!*l) {
+        fprintf(stderr, "%s: %s\n", prog, err);
+        lahar_transport_close(*t);
+        *t = NULL;
+        return 2;
+    }
+    return 0;
+}

@@ -1,0 +1,29 @@
+/* What the node processes (lahar-dem, lahar-sph) share: their command line, and connecting to a
+ * run (transport + link). One place, so that every node takes the same options. */
+#ifndef LAHAR_NODE_CLI_H
+#define LAHAR_NODE_CLI_H
+#include <stdint.h>
+#include "link.h"
+#include "transport.h"
+
+typedef struct {
+    const char *lcm_url; /* udpm://... or memq:// */
+    int64_t run_id;      /* 0: join the first run announced */
+    int threads;         /* OpenMP threads of the node's loops; 0 = OpenMP's default */
+    double join_wait_s;  /* how long to wait for the coordinator's HELLO (0: 30 s) */
+} lahar_node_options;
+
+/* Parse a node's command line into o (URL default: $LCM_DEFAULT_URL, else LAHAR_NETNS_URL).
+ * `prog` is the program name, `about` a paragraph on what the node does and `exit_codes` the
+ * line on its exit statuses, both for --help. Returns -1 to go on, or the exit status to return
+ * from main (0 after --help, 2 on a bad option). */
+int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *about, const char *exit_codes,
+                          lahar_node_options *o);
+
+/* Open the transport of o->lcm_url and a link for `role` that reassembles the message types in
+ * `want` (LAHAR_MSG_BIT mask); applies o->threads. Returns 0, or 2 (the setup-error exit status)
+ * after printing "prog: reason". */
+int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, unsigned want,
+                       lahar_transport **t, lahar_link **l);
+
+#endif
