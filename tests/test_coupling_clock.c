@@ -5,16 +5,7 @@
 #include <stdio.h>
 #include "coordinator.h"
 
-static int failures;
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
-            fprintf(stderr, __VA_ARGS__);                                                          \
-            fputc('\n', stderr);                                                                   \
-            failures++;                                                                            \
-        }                                                                                          \
-    } while (0)
+#include "test_util.h"
 
 /* Run a whole simulation; dt_of(k) gives the allowed dt of step k. Returns steps taken. */
 static long run(double t_end, double out, double (*dt_of)(long), long *outputs_hit)

@@ -17,16 +17,7 @@
 #include "shape_build.h"
 #include "sph_fluid.h"
 
-static int failures;
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
-            fprintf(stderr, __VA_ARGS__);                                                          \
-            fputc('\n', stderr);                                                                   \
-            failures++;                                                                            \
-        }                                                                                          \
-    } while (0)
+#include "test_util.h"
 
 static const double H = 0.1, A = 1e-4, RHO = 1000.0, MU = 0.1, NU = 1e-4, PERIOD = 0.04;
 
