@@ -1059,7 +1059,7 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
 
 /* The solver core does not have these yet (sph_node/sph_fluid.h): a case asking for them is
  * rejected instead of silently running without them. Flip when the solver grows them. */
-#define LAHAR_SPH_HAVE_SHEPARD 0
+#define LAHAR_SPH_HAVE_SHEPARD 1
 #define LAHAR_SPH_HAVE_SPS 1
 /* the coupling (sph_node/sph_coupling.h) uses eps = dx/2 and the kernel's support */
 #define LAHAR_SPH_HAVE_HALO 0

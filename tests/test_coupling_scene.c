@@ -83,7 +83,7 @@ static void compare(const char *path, const lahar_case *a, const lahar_case *b)
 }
 
 /* off_default: also set the options the loader only accepts at their defaults (halo, kappa,
- * Shepard, SPS: not implemented by the solver yet) to other values, so the message carries
+ * not implemented by the solver yet) and Shepard and SPS to other values, so the message carries
  * them too */
 static void round_trip(const char *path, int off_default)
 {
