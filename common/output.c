@@ -65,6 +65,16 @@ static hid_t out_fapl_unlocked(void)
     return fapl;
 }
 
+/* Open (or create) one of lahar's HDF5 files without HDF5's file locking (see above). */
+static hid_t out_file_open(const char *path, unsigned flags, int create)
+{
+    hid_t fapl = out_fapl_unlocked();
+    hid_t f = lahar_h5_file_open(path, flags, fapl, create);
+    H5Pclose(fapl);
+    return f;
+}
+
+
 static hid_t out_str_type(void)
 {
     hid_t t = H5Tcopy(H5T_C_S1);
@@ -92,6 +102,24 @@ static int out_attr_string(hid_t loc, const char *name, const char *s)
     int rc = out_attr(loc, name, t, 0, &s);
     H5Tclose(t);
     return rc;
+}
+
+/* The /header group every lahar file starts with: dimensions, units, version, case. Returns the
+ * open group (the caller adds its own attributes and closes it), or -1. */
+static hid_t out_header_group(hid_t f, const lahar_case *c)
+{
+    hid_t h = out_group(f, "header");
+    if (h < 0)
+        return -1;
+    int rc = out_attr_int64(h, "dimensions", c->dim);
+    rc |= out_attr_string(h, "units", "SI");
+    rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
+    rc |= out_attr_string(h, "case_path", c->path);
+    if (rc) {
+        H5Gclose(h);
+        return -1;
+    }
+    return h;
 }
 
 /* Write a whole dataset (rank 1 or 2); file type = memory type except float32 display data. */
@@ -202,13 +230,9 @@ static int out_write_mesh_set(hid_t g, const lahar_body_output *o, const lahar_c
 static int out_write_header(hid_t f, const lahar_case *c)
 {
     int rc = 0, nb = c->nbody, nm = c->nmaterial;
-    hid_t h = out_group(f, "header");
+    hid_t h = out_header_group(f, c);
     if (h < 0)
         return -1;
-    rc |= out_attr_int64(h, "dimensions", c->dim);
-    rc |= out_attr_string(h, "units", "SI");
-    rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
-    rc |= out_attr_string(h, "case_path", c->path);
     rc |= out_attr_int64(h, "nbody", nb);
     rc |= out_attr(h, "gravity", H5T_NATIVE_DOUBLE, 3, c->gravity);
     rc |= out_attr_double(h, "t_end", c->t_end);
@@ -525,9 +549,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     char stale[OUT_PATH_MAX + 16];
     snprintf(stale, sizeof stale, "%s/lahar.xmf", outdir); /* a previous run's, rebuilt at close */
     unlink(stale);
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
         lahar_body_output_close(o);
@@ -586,9 +608,7 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
             o->vvel[3 * iv + 0] = (float)u.x, o->vvel[3 * iv + 1] = (float)u.y, o->vvel[3 * iv + 2] = (float)u.z;
         }
     }
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
         return -1;
@@ -705,23 +725,17 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     o->fields = fields & LAHAR_PFIELD_ALL;
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
         lahar_particle_output_close(o);
         return NULL;
     }
     int rc = 0;
-    hid_t h = out_group(f, "header");
+    hid_t h = out_header_group(f, c);
     if (h < 0)
         rc = -1;
     else {
-        rc |= out_attr_int64(h, "dimensions", c->dim);
-        rc |= out_attr_string(h, "units", "SI");
-        rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
-        rc |= out_attr_string(h, "case_path", c->path);
         rc |= out_attr_int64(h, "fields", o->fields);
         rc |= out_attr_string(h, "field_bits", "1 velocity (vx,vy,vz), 2 density, 4 pressure, 8 phase, 16 id");
         rc |= out_attr_double(h, "dx", c->sph_dx);
@@ -749,9 +763,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
 
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
 {
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
         return -1;
@@ -861,9 +873,7 @@ static int64_t out_read_snapshot_list(const char *path, out_snap_entry **list)
     if (!probe)
         return 0;
     fclose(probe);
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(path, H5F_ACC_RDONLY, fapl, 0);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(path, H5F_ACC_RDONLY, 0);
     if (f < 0)
         return -1;
     hid_t g = H5Gopen2(f, "snapshots", H5P_DEFAULT);
@@ -944,9 +954,7 @@ static int out_xdmf_combine(const char *outdir, char *err, size_t n)
     lahar_xdmf_bodies xb = {"bodies.h5", 0, 3, 0, 0, 0, 0};
     lahar_xdmf_particles xp = {"particles.h5", 0};
     if (nbs > 0) {
-        hid_t fapl = out_fapl_unlocked();
-        hid_t f = lahar_h5_file_open(bpath, H5F_ACC_RDONLY, fapl, 0);
-        H5Pclose(fapl);
+        hid_t f = out_file_open(bpath, H5F_ACC_RDONLY, 0);
         int64_t v[6] = {0};
         if (f >= 0) {
             out_read_attr_int64(f, "header", "nbody", &v[0]);
@@ -961,9 +969,7 @@ static int out_xdmf_combine(const char *outdir, char *err, size_t n)
         xb.fixed_vertices = v[4], xb.fixed_cells = v[5];
     }
     if (nps > 0) {
-        hid_t fapl = out_fapl_unlocked();
-        hid_t f = lahar_h5_file_open(ppath, H5F_ACC_RDONLY, fapl, 0);
-        H5Pclose(fapl);
+        hid_t f = out_file_open(ppath, H5F_ACC_RDONLY, 0);
         int64_t v = 0;
         if (f >= 0) {
             out_read_attr_int64(f, "header", "fields", &v);
@@ -1071,23 +1077,17 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
                 snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
         }
     snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
-    hid_t fapl = out_fapl_unlocked();
-    hid_t f = lahar_h5_file_open(o->h5path, H5F_ACC_TRUNC, fapl, 1);
-    H5Pclose(fapl);
+    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
         lahar_contact_output_close(o);
         return NULL;
     }
     int rc = 0;
-    hid_t h = out_group(f, "header");
+    hid_t h = out_header_group(f, c);
     if (h < 0)
         rc = -1;
     else {
-        rc |= out_attr_int64(h, "dimensions", c->dim);
-        rc |= out_attr_string(h, "units", "SI");
-        rc |= out_attr_string(h, "lahar_version", LAHAR_VERSION);
-        rc |= out_attr_string(h, "case_path", c->path);
         rc |= out_attr_string(h, "contents",
                               "per snapshot and marked body: points (virtual particles on the surface, world frame, m) "
                               "and forces on the body at them (N, N/m in 2D); attributes force and torque (about the "
@@ -1134,9 +1134,7 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         }
         off += npoints[i];
     }
-    hid_t fapl = out_fapl_unlocked();
-    hid_t file = lahar_h5_file_open(o->h5path, H5F_ACC_RDWR, fapl, 0);
-    H5Pclose(fapl);
+    hid_t file = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (file < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for contacts at step %" PRId64 "\n", o->h5path, step);
         return -1;
