@@ -85,6 +85,7 @@ typedef struct {
  * sph_node/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
 typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
+typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
 
 typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
@@ -105,6 +106,8 @@ typedef struct {
     double halo;           /* m, coupling halo eps (paper 000 eq. 14; default dx/2) */
     double kappa;          /* coupling range in units of h (default: the kernel's support radius) */
     lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/sph_coupling.h) */
+    lahar_sph_initial_pressure initial_pressure; /* block densities at t = 0: rest (none, default) or
+                                                   hydrostatic per block (lahar_sph_node_fill) */
 } lahar_sph_options;
 
 typedef struct {

@@ -34,11 +34,50 @@
 #include "scene_msg.h"
 #include "shape_build.h"
 #include "transport.h"
+#include "vec.h"
 
 #define ROLE LAHAR_ROLE_SPH
 
-/* Append the particles of every block at rest density with mass rho0 dx^D: the lattice points
- * of lahar_case_block_lattice, i.e. inside the block and outside every body (a particle that starts
+/* Density of pressure p by the inverse of the case's EOS: linear rho = rho0 + p / c0^2 (paper 000
+ * eq. 3), Tait rho = rho0 (1 + gamma p / (rho0 c0^2))^(1/gamma) (paper 003 eq. 19). */
+static double sph_node_eos_density(const lahar_case *c, double p)
+{
+    const double rho0 = c->sph_density, c2 = c->sph.c0 * c->sph.c0;
+    if (c->sph.eos == LAHAR_SPH_EOS_TAIT)
+        return rho0 * pow(1.0 + c->sph.gamma * p / (rho0 * c2), 1.0 / c->sph.gamma);
+    return rho0 + p / c2;
+}
+
+/* Initial densities of the n particles pts of one block into rho. none: rest density. hydrostatic:
+ * the density whose EOS pressure is p = rho0 |g| (h_free - s), s = -x.g/|g| the height along
+ * gravity (the case's gravity only, not sph.body_force, which drives flows like Poiseuille's) and
+ * h_free the block's free surface, half a spacing above its highest particle centre (the top face
+ * of that particle's lattice cell: exact for a box with gravity along an axis). Assumes a block is
+ * one connected water body whose free surface is its top; two blocks stacked along gravity each
+ * get their own surface. Without gravity the densities stay at rest. */
+static void sph_node_block_density(const lahar_case *c, const double (*pts)[3], int64_t n, double *rho)
+{
+    const vec3 g = v3_load(c->gravity);
+    const double gmag = v3_norm(g);
+    if (c->sph.initial_pressure != LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC || !(gmag > 0.0)) {
+        for (int64_t i = 0; i < n; i++)
+            rho[i] = c->sph_density;
+        return;
+    }
+    const vec3 up = v3_scale(g, -1.0 / gmag);
+    double top = -HUGE_VAL;
+    for (int64_t i = 0; i < n; i++) {
+        const double s = v3_dot(v3_load(pts[i]), up);
+        top = s > top ? s : top;
+    }
+    const double h_free = top + 0.5 * c->sph_dx;
+    for (int64_t i = 0; i < n; i++)
+        rho[i] = sph_node_eos_density(c, c->sph_density * gmag * (h_free - v3_dot(v3_load(pts[i]), up)));
+}
+
+/* Append the particles of every block with mass rho0 dx^D at the density of sph.initial_pressure
+ * (sph_node_block_density; the volume m / rho follows): the lattice points of
+ * lahar_case_block_lattice, i.e. inside the block and outside every body (a particle that starts
  * inside a body would be a crossing at step 0). 0, or -1 when out of memory or p has no room. */
 static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
 {
@@ -48,17 +87,24 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         most = n > most ? n : most;
     }
     double(*pts)[3] = malloc((size_t)(most > 0 ? most : 1) * sizeof *pts);
-    if (!pts)
+    double *rho = malloc((size_t)(most > 0 ? most : 1) * sizeof *rho);
+    if (!pts || !rho) {
+        free(pts);
+        free(rho);
         return -1;
+    }
     const double m = c->sph_density * pow(c->sph_dx, c->dim);
     int rc = 0;
     for (int b = 0; b < c->nblock && !rc; b++) {
         int64_t n = lahar_case_block_lattice(c, b, pts, most);
         rc = n < 0 ? -1 : 0;
+        if (n > 0)
+            sph_node_block_density(c, (const double(*)[3])pts, n, rho);
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, c->sph_density, 0) < 0 ? -1 : 0;
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, rho[i], 0) < 0 ? -1 : 0;
     }
     free(pts);
+    free(rho);
     return rc;
 }
 

@@ -22,7 +22,9 @@ typedef lahar_node_options lahar_sph_node_options;
 int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_t errlen);
 
 /* Allocate and fill the particles of the case's blocks (lahar_case_block_lattice: centres at
- * lo + (i + 1/2) dx, one layer at z = 0 in 2D, points inside bodies left out), mass rho0 dx^D.
+ * lo + (i + 1/2) dx, one layer at z = 0 in 2D, points inside bodies left out), mass rho0 dx^D,
+ * density rho0, or with sph.initial_pressure: hydrostatic the EOS inverse of
+ * rho0 |g| (h_free - height) per block, h_free half a spacing above the block's top particle.
  * Returns the number of particles, or -1 when out of memory. */
 int64_t lahar_sph_node_fill(sph_particles *p, const lahar_case *c);
 
