@@ -9,7 +9,7 @@
  *  - the pressure of those densities by the solver's own EOS (sph_fluid_pressure) is
  *    rho0 g (h - y) to 1e-9 of rho0 g H (round trip);
  *  - initial_pressure: none (the default) keeps rho0 exactly; the option survives the scene
- *    message (common/scene_msg.c).
+ *    message (common/scene_msg.c); a misspelt value is refused with the closest name.
  * usage: test_sph_initial_pressure TMP_DIR */
 #include <math.h>
 #include <stdio.h>
@@ -163,12 +163,32 @@ static void test_none(const char *dir)
     lahar_case_free(&c);
 }
 
+/* A misspelt value is refused with the closest name. */
+static void test_bad_value(const char *dir)
+{
+    static const char *const text = "dimensions: 2\n"
+                                    "gravity: [0, -9.81]\n"
+                                    "time: {end: 0.1}\n"
+                                    "sph:\n"
+                                    "  dx: 0.01\n"
+                                    "  initial_pressure: hydrostatik\n"
+                                    "  blocks:\n"
+                                    "    - {name: water, box: {lo: [0, 0], hi: [0.1, 0.1]}}\n";
+    char path[1024], err[512] = "";
+    snprintf(path, sizeof path, "%s/ip_bad.yaml", dir);
+    CHECK(write_case(path, text) == 0, "cannot write %s", path);
+    lahar_case c;
+    CHECK(lahar_case_load_err(path, &c, err, sizeof err) == LAHAR_EXIT_BAD_INPUT, "a bad initial_pressure loads");
+    CHECK(strstr(err, "initial_pressure") && strstr(err, "'hydrostatic'"), "unhelpful message: %s", err);
+}
+
 int main(int argc, char **argv)
 {
     const char *dir = argc > 1 ? argv[1] : ".";
     test_linear_2d(dir);
     test_tait_3d(dir);
     test_none(dir);
+    test_bad_value(dir);
     if (failures)
         printf("%d failure(s)\n", failures);
     else
