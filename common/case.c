@@ -1346,58 +1346,45 @@ int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
     return 0;
 }
 
+/* The bodies a lattice point must stay out of, with the bounding sphere of each about its x to skip
+ * the exact test for most points (fixed bodies keep world coordinates with x = 0: the sphere
+ * still covers them). */
+typedef struct {
+    const lahar_case *c;
+    double *reach;
+} case_lattice_cut;
+
+static int case_lattice_outside_bodies(const double x[3], void *ctx)
+{
+    const case_lattice_cut *k = ctx;
+    for (int m = 0; m < k->c->nbody; m++) {
+        const lahar_body *bd = &k->c->bodies[m];
+        double d2 = 0;
+        for (int a = 0; a < 3; a++)
+            d2 += (x[a] - bd->x[a]) * (x[a] - bd->x[a]);
+        if (d2 <= k->reach[m] * k->reach[m] && lahar_body_contains(bd, k->c->dim, x))
+            return 0;
+    }
+    return 1;
+}
+
 /* As lahar_case_block_lattice; first_only: stop at the first particle (the loader only needs to
  * know a block is not empty). */
 static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap, int first_only)
 {
-    const lahar_particle_block *b = &c->blocks[block];
-    const int dim = c->dim;
-    const double dx = c->sph_dx;
-    /* bounding sphere of every body about its x, to skip the exact test for most points (fixed
-     * bodies keep world coordinates with x = 0: the sphere still covers them) */
-    double *reach = malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof *reach);
-    if (!reach)
+    case_lattice_cut k = {c, malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof(double))};
+    if (!k.reach)
         return -1;
     for (int m = 0; m < c->nbody; m++) {
         const lahar_body *bd = &c->bodies[m];
-        reach[m] = 0.0;
+        k.reach[m] = 0.0;
         for (int v = 0; v < bd->shape.nv; v++)
-            reach[m] = fmax(reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
-        reach[m] += bd->shape.radius;
+            k.reach[m] = fmax(k.reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
+        k.reach[m] += bd->shape.radius;
     }
-    int64_t n[3];
-    for (int a = 0; a < 3; a++) {
-        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
-        if (n[a] < 0)
-            n[a] = 0;
-    }
-    int64_t count = 0;
-    for (int64_t i = 0; i < n[0]; i++)
-        for (int64_t j = 0; j < n[1]; j++)
-            for (int64_t k = 0; k < n[2]; k++) {
-                double x[3] = {b->lo[0] + ((double)i + 0.5) * dx, b->lo[1] + ((double)j + 0.5) * dx,
-                               dim == 2 ? 0.0 : b->lo[2] + ((double)k + 0.5) * dx};
-                if (b->kind != LAHAR_BLOCK_BOX && !lahar_particle_block_contains(b, dim, x))
-                    continue;
-                int cut = 0;
-                for (int m = 0; m < c->nbody && !cut; m++) {
-                    const lahar_body *bd = &c->bodies[m];
-                    double d2 = 0;
-                    for (int a = 0; a < 3; a++)
-                        d2 += (x[a] - bd->x[a]) * (x[a] - bd->x[a]);
-                    if (d2 <= reach[m] * reach[m])
-                        cut = lahar_body_contains(bd, dim, x);
-                }
-                if (cut)
-                    continue;
-                if (out && count < cap)
-                    memcpy(out[count], x, sizeof x);
-                count++;
-                if (first_only)
-                    goto done;
-            }
-done:
-    free(reach);
+    int64_t count = lahar_particle_block_lattice_keep(&c->blocks[block], c->dim, c->sph_dx, case_lattice_outside_bodies,
+                                                      &k, first_only ? 1 : -1, out, cap);
+    free(k.reach);
     return count;
 }
 

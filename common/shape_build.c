@@ -1257,7 +1257,9 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
     }
 }
 
-int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap)
+int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
+                                          int (*keep)(const double x[3], void *ctx), void *ctx, int64_t most,
+                                          double (*out)[3], int64_t cap)
 {
     int64_t n[3];
     for (int a = 0; a < 3; a++) {
@@ -1275,11 +1277,19 @@ int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, dou
                  * the last one a hair past hi) */
                 if (b->kind != LAHAR_BLOCK_BOX && !lahar_particle_block_contains(b, dim, x))
                     continue;
+                if (keep && !keep(x, ctx))
+                    continue;
                 if (out && count < cap)
                     memcpy(out[count], x, sizeof x);
-                count++;
+                if (++count == most)
+                    return count;
             }
     return count;
+}
+
+int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap)
+{
+    return lahar_particle_block_lattice_keep(b, dim, dx, NULL, NULL, -1, out, cap);
 }
 
 void lahar_particle_block_bounds(lahar_particle_block *b, int dim)

@@ -101,6 +101,11 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
  * inside it. Writes the first `cap` of them to out (out may be NULL to count) and returns how
  * many lie inside (which may exceed cap). */
 int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap);
+/* As lahar_particle_block_lattice, keeping only the points for which keep(x, ctx) is non-zero
+ * (keep may be NULL) and stopping after `most` points (-1: no limit). */
+int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
+                                          int (*keep)(const double x[3], void *ctx), void *ctx, int64_t most,
+                                          double (*out)[3], int64_t cap);
 
 /* lo/hi of a polygon or mesh block from its vertices (z = 0 .. 0 in 2D). */
 void lahar_particle_block_bounds(lahar_particle_block *b, int dim);
