@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "netns.h"
+#include "scene_msg.h"
 
 static void node_usage(FILE *f, const char *prog, const char *about, const char *exit_codes)
 {
@@ -75,4 +76,19 @@ int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, 
         return 2;
     }
     return 0;
+}
+
+int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_msg *msg, lahar_step_t *step)
+{
+    int rc = lahar_link_wait(l, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, msg);
+    if (rc == LAHAR_LINK_STOP)
+        return 0;
+    if (rc == LAHAR_LINK_LOST) {
+        fprintf(stderr, "%s: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n", prog,
+                LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
+        return 3;
+    }
+    if (rc != LAHAR_LINK_OK || lahar_step_t_decode(msg->data, 0, msg->size, step) < 0)
+        return 1;
+    return -1;
 }

@@ -3,6 +3,7 @@
 #ifndef LAHAR_NODE_CLI_H
 #define LAHAR_NODE_CLI_H
 #include <stdint.h>
+#include "lahar_step_t.h"
 #include "link.h"
 #include "transport.h"
 
@@ -25,5 +26,10 @@ int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *a
  * after printing "prog: reason". */
 int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, unsigned want,
                        lahar_transport **t, lahar_link **l);
+
+/* Wait for the coordinator's STEP(k) and decode it into *step. Returns -1 when the step is there,
+ * otherwise the node's exit status: 0 the run was stopped, 3 the coordinator went silent
+ * (reported as "prog: ..."), 1 a broken message. `msg` is the caller's receive slot. */
+int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_msg *msg, lahar_step_t *step);
 
 #endif

@@ -187,19 +187,10 @@ static int dem_node_loop(dem_node *d)
     int at_output_time = 1; /* t_0 */
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(d->link);
-        int rc = lahar_link_wait(d->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, &msg);
-        if (rc == LAHAR_LINK_STOP)
-            return 0;
-        if (rc == LAHAR_LINK_LOST) {
-            fprintf(stderr, "lahar-dem: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n",
-                    LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
-            return 3;
-        }
-        if (rc != LAHAR_LINK_OK)
-            return 1;
         lahar_step_t step;
-        if (lahar_step_t_decode(msg.data, 0, msg.size, &step) < 0)
-            return 1;
+        int rc = lahar_node_wait_step(d->link, "lahar-dem", k, &msg, &step);
+        if (rc >= 0)
+            return rc;
         lahar_status_t st = {0};
         err[0] = '\0';
         if (has_sph) {

@@ -406,19 +406,10 @@ static int sph_node_loop(sph_node *s)
     const int has_dem = s->ns.has_dem && s->nbody > 0;
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
-        int rc = lahar_link_wait(s->link, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, &msg);
-        if (rc == LAHAR_LINK_STOP)
-            return 0;
-        if (rc == LAHAR_LINK_LOST) {
-            fprintf(stderr, "lahar-sph: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n",
-                    LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
-            return 3;
-        }
-        if (rc != LAHAR_LINK_OK)
-            return 1;
         lahar_step_t step;
-        if (lahar_step_t_decode(msg.data, 0, msg.size, &step) < 0)
-            return 1;
+        int rc = lahar_node_wait_step(s->link, "lahar-sph", k, &msg, &step);
+        if (rc >= 0)
+            return rc;
         lahar_status_t st = {0};
         err[0] = '\0';
         double compute = 0.0, c0 = lahar_now();
