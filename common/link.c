@@ -554,6 +554,12 @@ void lahar_link_watch(lahar_link *l, int role, double silence_s)
     }
 }
 
+void lahar_link_heard_now(lahar_link *l, int role)
+{
+    if (role >= 0 && role < LAHAR_NROLES)
+        l->last_heard[role] = lahar_now();
+}
+
 void lahar_link_unwatch(lahar_link *l, int role)
 {
     if (role >= 0 && role < LAHAR_NROLES)

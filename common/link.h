@@ -78,6 +78,9 @@ int lahar_link_republish(lahar_link *l, int type, int64_t step);
  * heard, heartbeats included; the clock starts at the call). */
 void lahar_link_watch(lahar_link *l, int role, double silence_s);
 void lahar_link_unwatch(lahar_link *l, int role);
+/* Restart the silence clock of a watched peer that the caller knows by other means to be alive
+ * (the coordinator: a node it started whose CPU time is advancing). */
+void lahar_link_heard_now(lahar_link *l, int role);
 int lahar_link_lost_role(const lahar_link *l);
 /* Last step a peer reported done in its heartbeats (-1 if none). */
 int64_t lahar_link_peer_step(const lahar_link *l, int role);

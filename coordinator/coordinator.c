@@ -31,6 +31,11 @@
 #include "transport.h"
 
 #define COORD_NODE_SILENCE 2.0   /* s without a frame from a node: node lost */
+/* A node the coordinator started itself (process or thread) that is silent but whose CPU time is
+ * still advancing is starved by an overloaded machine, not lost: its silence is forgiven, with one
+ * warning, for at most this long in all (a node spinning without ever answering still ends). */
+#define COORD_NODE_STARVED_MAX 120.0
+#define COORD_STARVED_PROBE_MS 500 /* CPU time must advance within this to count as computing */
 #define COORD_HELLO_PERIOD_MS 100
 #define COORD_STOP_WAIT 3.0      /* s the nodes get to exit after STOP */
 #define COORD_STEP_RESEND_MS 250 /* re-publish STEP(k) while STATUS(k) is missing */
@@ -53,6 +58,7 @@ typedef struct {
     int64_t substeps, last_step;
     double dt_proposed, dt_stable, kinetic_energy;
     int ncontacts;
+    double starved_s;            /* silence forgiven so far (COORD_NODE_STARVED_MAX) */
 } coord_node;
 
 typedef struct {
@@ -188,6 +194,58 @@ static int coord_node_ended(coord_node *n)
     return n->exited;
 }
 
+/* CPU seconds used so far by a node this coordinator started (process: /proc/PID/stat utime +
+ * stime; thread: its CPU clock), or -1 when it cannot be read (node started by hand). */
+static double coord_node_cpu_seconds(const coord_node *n)
+{
+    if (n->pid > 0) {
+        char path[64], buf[1024];
+        snprintf(path, sizeof path, "/proc/%d/stat", (int)n->pid);
+        FILE *fp = fopen(path, "r");
+        if (!fp)
+            return -1.0;
+        size_t len = fread(buf, 1, sizeof buf - 1, fp);
+        fclose(fp);
+        buf[len] = '\0';
+        /* fields after the command name "(...)": state is field 3, utime 14, stime 15 */
+        const char *q = strrchr(buf, ')');
+        unsigned long long ut = 0, st = 0;
+        if (!q || sscanf(q + 1, " %*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &st) != 2)
+            return -1.0;
+        return (double)(ut + st) / (double)sysconf(_SC_CLK_TCK);
+    }
+    if (n->thread_started && !atomic_load(&n->thread_done)) {
+        clockid_t cid;
+        struct timespec ts;
+        if (pthread_getcpuclockid(n->thread, &cid) != 0 || clock_gettime(cid, &ts) != 0)
+            return -1.0;
+        return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    }
+    return -1.0;
+}
+
+/* A watched node went silent: 1 if it is one of ours, still running and using CPU over a short
+ * probe (starved by the machine, not dead or hung), so that its silence is forgiven. The link is
+ * pumped during the probe, so nothing that arrives meanwhile is missed. */
+static int coord_node_starved(coord *co, coord_node *n)
+{
+    if (n->starved_s >= COORD_NODE_STARVED_MAX || coord_node_ended(n))
+        return 0;
+    double before = coord_node_cpu_seconds(n);
+    if (before < 0.0)
+        return 0;
+    lahar_link_poll(co->link, COORD_STARVED_PROBE_MS);
+    double after = coord_node_cpu_seconds(n);
+    if (coord_node_ended(n) || !(after > before))
+        return 0;
+    if (n->starved_s == 0.0)
+        fprintf(stderr, "\nlahar: warning: the %s has been silent for %.1f s but is still computing (the machine "
+                        "is overloaded?); waiting up to %.0f s more\n",
+                lahar_link_role_name(n->role), COORD_NODE_SILENCE, COORD_NODE_STARVED_MAX);
+    n->starved_s += COORD_NODE_SILENCE + 1e-3 * COORD_STARVED_PROBE_MS;
+    return 1;
+}
+
 /* ---- messages ------------------------------------------------------------------------------ */
 
 static void coord_send_stop(coord *co, int reason, const char *message)
@@ -302,10 +360,17 @@ static int coord_collect_status(coord *co, int64_t k)
         /* Requests are idempotent: besides the NACKs of both sides, STEP(k) goes out again every
          * 250 ms until STATUS(k) is in (a node that has it already drops the duplicate, and its
          * kept STATUS(k) answers the coordinator's NACK). */
-        while ((rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, COORD_STEP_RESEND_MS, &m)) ==
-               LAHAR_LINK_TIMEOUT)
-            if (k >= 0)
-                lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
+        for (;;) {
+            rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, COORD_STEP_RESEND_MS, &m);
+            if (rc == LAHAR_LINK_TIMEOUT) {
+                if (k >= 0)
+                    lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
+            } else if (rc == LAHAR_LINK_LOST && coord_node_starved(co, &co->node[lahar_link_lost_role(co->link)])) {
+                lahar_link_heard_now(co->link, lahar_link_lost_role(co->link));
+            } else {
+                break;
+            }
+        }
         if (rc == LAHAR_LINK_LOST) {
             int lost = lahar_link_lost_role(co->link);
             coord_node *ln = &co->node[lost];
@@ -318,7 +383,7 @@ static int coord_collect_status(coord *co, int64_t k)
             snprintf(co->message, sizeof co->message,
                      "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
                      "(t = %.9g s); stopping the run",
-                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE, how,
+                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE + ln->starved_s, how,
                      (long long)last, co->sim_time);
             co->status = "node lost";
             return LAHAR_EXIT_NODE_LOST;

@@ -6,7 +6,7 @@
 # 224.0.0.0/4 via lo, ttl=0 or ttl=1 on an isolated veth link). Nothing leaves the host.
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: inprocess_both | processes | packet_loss | node_killed | coordinator_killed | concurrent |
+#   TEST: inprocess_both | processes | packet_loss | node_killed | node_stopped | coordinator_killed | concurrent |
 #         cross_host | no_namespace | engine_error | cli
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
@@ -175,6 +175,33 @@ node_killed)
     grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
     h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
     [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
+    ;;
+node_stopped)
+    # SIGSTOP the DEM node mid-run: a node that is alive but hung (its CPU time does not advance)
+    # is still lost after 2 s; only a silent node that keeps computing is waited for (starved by
+    # an overloaded machine). Exit 3, the node named, "hangs" in the reason.
+    write_case long.yaml 30
+    "$bin/lahar" run long.yaml -o stopped -q 2> stderr.txt &
+    lahar_pid=$!
+    dem_pid=""
+    for _ in $(seq 100); do
+        dem_pid=$(child_pid "$lahar_pid" lahar-dem)
+        [ -n "$dem_pid" ] && [ -e stopped/bodies.h5 ] && break
+        sleep 0.05
+    done
+    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found"; }
+    sleep 0.5
+    kill -STOP "$dem_pid"
+    t0=$(date +%s.%N)
+    wait "$lahar_pid"
+    rc=$?
+    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+    kill -9 "$dem_pid" 2>/dev/null
+    cat stderr.txt
+    echo "coordinator exited with $rc after ${elapsed} s"
+    [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
+    "$python" -c "import sys; sys.exit(0 if $elapsed < 6.0 else 1)" || fail "took ${elapsed} s to notice (limit 6 s)"
+    grep -q "DEM node.*hangs" stderr.txt || fail "message does not name the DEM node as hung"
     ;;
 coordinator_killed)
     # A node started by hand (--no-spawn: no PR_SET_PDEATHSIG) gives up 5 s after the coordinator
