@@ -236,7 +236,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             else /* eq. 17 as printed */
                 coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
                        kernel_dwdr(&c->k, dv) / w0;
-            vec3 ft = v3_scale(urel, p->m[i] * coef); /* m_i a_tau (eq. 19) */
+            /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
+            vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
             vec3 f = v3_add(fn, ft);
             ftot = v3_add(ftot, f);
             int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;

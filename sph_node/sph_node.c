@@ -93,15 +93,20 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         free(rho);
         return -1;
     }
-    const double m = c->sph_density * pow(c->sph_dx, c->dim);
     int rc = 0;
     for (int b = 0; b < c->nblock && !rc; b++) {
         int64_t n = lahar_case_block_lattice(c, b, pts, most);
         rc = n < 0 ? -1 : 0;
-        if (n > 0)
+        /* soil blocks (sph_soil.h): at the rest density of their material, stress-free */
+        const int soil = c->blocks[b].phase == SPH_SOIL_PHASE;
+        const double rho_b = soil ? c->materials[c->blocks[b].material].density : c->sph_density;
+        const double m = rho_b * pow(c->sph_dx, c->dim);
+        if (n > 0 && !soil)
             sph_node_block_density(c, (const double(*)[3])pts, n, rho);
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, rho[i], 0) < 0 ? -1 : 0;
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, soil ? rho_b : rho[i], soil ? SPH_SOIL_PHASE : 0) < 0
+                     ? -1
+                     : 0;
     }
     free(pts);
     free(rho);
@@ -160,6 +165,15 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->shepard_every = o->shepard_interval;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
+    for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */
+        if (c->blocks[b].phase == SPH_SOIL_PHASE && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial) {
+            const lahar_material *mt = &c->materials[c->blocks[b].material];
+            prm->soil = 1;
+            prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
+                                                .phi = mt->friction_angle, .cohesion = mt->cohesion,
+                                                .psi = mt->dilatancy, .kh = mt->permeability, .mu_phi = mt->friction,
+                                                .damping = mt->damping};
+        }
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {
         snprintf(err, errlen, "sph.halo: the coupling uses eps = dx/2 = %g m; another halo (%g m) is not implemented yet",
@@ -201,6 +215,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
     lahar_particles_view v = {
         .n = p->n, .x = p->x, .y = p->y, .z = p->z, .vx = p->vx, .vy = p->vy, .vz = p->vz,
         .density = p->rho, .pressure = p->p, .phase = p->phase, .id = p->id,
+        .stress = {p->sig[0], p->sig[1], p->sig[2], p->sig[3], p->sig[4], p->sig[5]}, /* NULL without soil */
     };
     s->last_snapshot = step;
     return lahar_particle_output_snapshot(s->out, step, t, &v);
@@ -572,9 +587,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
     char desc[256];
     if (s.fluid_ready)
-        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s",
+        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s%s",
                  (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody,
-                 s.f.prm.sps ? ", SPS turbulence" : "");
+                 s.f.prm.sps ? ", SPS turbulence" : "", s.f.has_soil ? ", Drucker-Prager soil" : "");
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;

@@ -1,0 +1,194 @@
+/* `lahar check` references of the SPH soil (sph_node/sph_soil.h; cases/README.md).
+ *
+ * soil_geostatic: a soil layer at rest under gravity, laterally confined (periodic sides or
+ * frictionless walls), loaded by its own weight from a stress-free start. One-dimensional
+ * (confined) elastic compression gives, at depth z below the surface (tension positive stress,
+ * gravity along the last axis):
+ *   sigma_v = -rho g z,  sigma_h = K0 sigma_v,  K0 = nu / (1 - nu)
+ * (plane strain and 3D alike: the lateral strains vanish). Measured: the soil particles binned in
+ * rows of dx by depth below the current surface (the highest particle + dx/2), each row's mean
+ * stress averaged over the snapshots of the last quarter of the run (the start-up oscillation
+ * averages out). Metrics over pairs of rows (bins of 2 dx) deeper than H/4 (relative errors near
+ * the free surface divide by ~0), without the row resting on the floor (its kernel is cut by the
+ * wall):
+ *   sigma_v_rel_error  max |mean sigma_v - (-rho g z)| / (rho g z)
+ *   K0_rel_error       max |sigma_h / sigma_v - K0| / K0
+ * Pairs of rows, because the symmetric SPH divergence sum_j m_j (sigma_i/rho_i^2 + sigma_j/rho_j^2)
+ * . grad W cannot see a stress alternating row by row (sigma_k + sigma_(k+-d) cancels in the
+ * difference of the two sides of particle k): the start-up leaves such a mode of a few per cent
+ * in the layer, and its row-by-row size is reported as sigma_v_row_max_rel_error (info).
+ *   creep_rel          |mean height at t_end - mean height at the start of the last quarter|
+ *                      / (rho g H^2 / (3 M)), the elastic settlement of the column's mean height
+ *                      (M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) the constrained modulus): ~0 when the
+ *                      column has stopped settling.
+ * Info: the mean settlement against rho g H^2 / (3 M). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "check.h"
+#include "output.h"
+
+/* The soil material of the case (the first soil block's), or NULL. */
+static const lahar_material *soil_material(const lahar_case *c)
+{
+    for (int b = 0; b < c->nblock; b++)
+        if (c->blocks[b].phase == 1 && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial)
+            return &c->materials[c->blocks[b].material];
+    return NULL;
+}
+
+static double soil_up(const lahar_check_particles *p, int dim, int64_t i)
+{
+    return dim == 3 ? p->z[i] : p->y[i];
+}
+
+/* Height of the surface (highest soil particle + dx/2), bottom (lowest - dx/2) and mean height of
+ * the soil particles of the snapshot in p's buffers. Returns the number of soil particles. */
+static int64_t soil_extent(const lahar_check_particles *p, int dim, double dx, double *top, double *bottom,
+                           double *mean)
+{
+    int64_t n = 0;
+    double hi = -INFINITY, lo = INFINITY, sum = 0.0;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        if (p->phase[i] != 1)
+            continue;
+        double u = soil_up(p, dim, i);
+        hi = u > hi ? u : hi;
+        lo = u < lo ? u : lo;
+        sum += u;
+        n++;
+    }
+    *top = hi + 0.5 * dx;
+    *bottom = lo - 0.5 * dx;
+    *mean = n ? sum / (double)n : 0.0;
+    return n;
+}
+
+int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    if (!p || !p->phase || !p->stress || !mat) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: needs a soil block and the particle fields phase and stress "
+                 "(output: fields)");
+        return -1;
+    }
+    const int dim = c->dim, up = dim - 1; /* gravity along the last axis */
+    double g = -c->gravity[up];
+    const double dx = c->sph_dx, rho = mat->density, nu = mat->poisson;
+    for (int a = 0; a < dim; a++)
+        if (a != up && c->gravity[a] != 0.0)
+            g = NAN;
+    if (!(g > 0.0) || !(dx > 0.0) || p->nsnap < 2) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: needs gravity along -%c only, sph.dx > 0 and >= 2 snapshots",
+                 "xyz"[up]);
+        return -1;
+    }
+    const double k0 = nu / (1.0 - nu);
+    const double M = mat->young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    double top0, bot0, mean0;
+    if (lahar_check_particles_read(p, 0, r->err, sizeof r->err) ||
+        soil_extent(p, dim, dx, &top0, &bot0, &mean0) == 0) {
+        if (!r->err[0])
+            snprintf(r->err, sizeof r->err, "soil_geostatic: no soil particles at t = 0");
+        return -1;
+    }
+    const double H = top0 - bot0;
+    const int nrow = (int)ceil(H / dx) + 2;
+    double *sv = calloc((size_t)nrow, sizeof *sv), *sh = calloc((size_t)nrow, sizeof *sh);
+    int64_t *cnt = calloc((size_t)nrow, sizeof *cnt);
+    if (!sv || !sh || !cnt) {
+        free(sv), free(sh), free(cnt);
+        snprintf(r->err, sizeof r->err, "out of memory");
+        return -1;
+    }
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+    int64_t kfirst = kl;
+    double mean_first = 0.0, mean_last = 0.0;
+    int rc = 0;
+    /* the stress of component a along axis e: xx, yy or zz */
+    const int comp_v = up == 1 ? 3 : 5, comp_h = 0;
+    for (int64_t k = kl; k >= 0 && (k == kl || p->t[k] >= t_from); k--) {
+        double top, bot, mean;
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err)) {
+            rc = -1;
+            break;
+        }
+        soil_extent(p, dim, dx, &top, &bot, &mean);
+        if (k == kl)
+            mean_last = mean;
+        kfirst = k;
+        mean_first = mean;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            if (p->phase[i] != 1)
+                continue;
+            int row = (int)floor((top - soil_up(p, dim, i)) / dx);
+            if (row < 0 || row >= nrow)
+                continue;
+            sv[row] += p->stress[i * 6 + comp_v];
+            sh[row] += p->stress[i * 6 + comp_h];
+            cnt[row]++;
+        }
+    }
+    if (rc) {
+        free(sv), free(sh), free(cnt);
+        return -1;
+    }
+    double ev = 0.0, ek = 0.0;
+    int nused = 0;
+    int pv = lahar_check_panel(r, "soil column at rest: stress vs depth (late-window mean per row)", "depth z (m)",
+                               "stress (kPa, compression positive)");
+    lahar_check_curve(r, pv, 1, "sigma_v (lahar)");
+    for (int row = 0; row < nrow; row++)
+        if (cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sv[row] / (double)cnt[row]);
+    lahar_check_curve(r, pv, 1, "sigma_h (lahar)");
+    for (int row = 0; row < nrow; row++)
+        if (cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sh[row] / (double)cnt[row]);
+    lahar_check_curve(r, pv, 0, "rho g z");
+    lahar_check_point(r, 0.0, 0.0);
+    lahar_check_point(r, H, 1e-3 * rho * g * H);
+    lahar_check_curve(r, pv, 0, "K0 rho g z");
+    lahar_check_point(r, 0.0, 0.0);
+    lahar_check_point(r, H, 1e-3 * k0 * rho * g * H);
+    double erow = 0.0;
+    for (int row = 0; row < nrow; row++) {
+        double z = (row + 0.5) * dx;
+        if (cnt[row] > 0 && z >= 0.25 * H && z <= H) /* every row, the one on the floor too */
+            erow = fmax(erow, fabs(sv[row] / (double)cnt[row] + rho * g * z) / (rho * g * z));
+    }
+    for (int row = 0; row + 1 < nrow; row += 2) { /* bins of two rows, centred at depth (row + 1) dx */
+        double z = (row + 1) * dx;
+        int64_t nb = cnt[row] + cnt[row + 1];
+        if (cnt[row] == 0 || cnt[row + 1] == 0 || z < 0.25 * H || z + dx > H - dx * (1.0 - 1e-6))
+            continue; /* (the row on the floor lacks half its neighbours: left out, its error is in the info) */
+        double v = (sv[row] + sv[row + 1]) / (double)nb, h = (sh[row] + sh[row + 1]) / (double)nb;
+        double ref = -rho * g * z;
+        ev = fmax(ev, fabs(v - ref) / fabs(ref));
+        ek = fmax(ek, fabs(h / v - k0) / k0);
+        nused++;
+    }
+    free(sv), free(sh), free(cnt);
+    if (nused == 0) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: no soil rows below H/4 (H = %g m, dx = %g m)", H, dx);
+        return -1;
+    }
+    const double settle_ref = rho * g * H * H / (3.0 * M);
+    lahar_check_value(r, "sigma_v_rel_error", ev);
+    lahar_check_value(r, "K0_rel_error", ek);
+    lahar_check_value(r, "creep_rel", fabs(mean_last - mean_first) / settle_ref);
+    lahar_check_value(r, "sigma_v_row_max_rel_error", erow);
+    lahar_check_value(r, "K0_reference", k0);
+    lahar_check_value(r, "settlement_m", mean0 - mean_last);
+    lahar_check_value(r, "settlement_elastic_m", settle_ref);
+    lahar_check_value(r, "height_m", H);
+    lahar_check_value(r, "window_start_s", p->t[kfirst]);
+    snprintf(r->convention, sizeof r->convention,
+             "stress tension positive; rows of dx by depth below the surface, mean over t >= %.3g s; bins of "
+             "two rows deeper than H/4 enter the metrics", p->t[kfirst]);
+    snprintf(r->note, sizeof r->note, "K0 = nu/(1-nu) = %.4f, H = %.4g m, 2-row bins used %d", k0, H, nused);
+    return 0;
+}
