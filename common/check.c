@@ -739,6 +739,8 @@ static const lahar_check_reference check_references[] = {
      "escaped_particles", 0.0, lahar_check_dam_break},
     {"soil_geostatic", "soil column at rest under gravity: sigma_v vs rho g z, sigma_h vs K0 sigma_v, no creep",
      "sigma_v_rel_error", 0.05, lahar_check_soil_geostatic},
+    {"soil_slide", "soil block on a fixed floor under tilted gravity: sliding acceleration vs g (sin - mu_phi cos)",
+     "accel_rel_error", 0.05, lahar_check_soil_slide},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

@@ -192,3 +192,89 @@ int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, l
     snprintf(r->note, sizeof r->note, "K0 = nu/(1-nu) = %.4f, H = %.4g m, 2-row bins used %d", k0, H, nused);
     return 0;
 }
+
+/* soil_slide: a soil block resting on a fixed floor whose normal is +y (2D) / +z (3D), gravity
+ * tilted by theta from the normal (the same as a block on a plane inclined by theta). With the
+ * soil-DEM friction mu_phi (paper 000 eq. 22-25) the block slides when tan(theta) > mu_phi with
+ *   a = g (sin theta - mu_phi cos theta)
+ * and stays put otherwise (a = 0). Measured: the mean velocity of the soil particles along the
+ * tangential part of gravity, fitted by a straight line over the snapshots after the first
+ * quarter of the run (the block first settles onto the floor). Metric:
+ *   accel_rel_error = |a - a_ref| / a_ref when it slides, |a| / (g sin theta) when it should stick. */
+int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    if (!p || !p->phase || !p->vx || !mat || p->nsnap < 4) {
+        snprintf(r->err, sizeof r->err, "soil_slide: needs a soil block, >= 4 snapshots and the particle fields "
+                 "velocity and phase");
+        return -1;
+    }
+    const int dim = c->dim, up = dim - 1;
+    double gt[3] = {c->gravity[0], c->gravity[1], c->gravity[2]};
+    const double gn = -gt[up];
+    gt[up] = 0.0;
+    const double gtm = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
+    if (!(gn > 0.0) || !(gtm > 0.0)) {
+        snprintf(r->err, sizeof r->err, "soil_slide: gravity must point into the floor (-%c) with a tangential part",
+                 "xyz"[up]);
+        return -1;
+    }
+    const double mu = mat->friction, theta = atan2(gtm, gn), g = hypot(gtm, gn);
+    const double a_ref = gtm - mu * gn > 0.0 ? gtm - mu * gn : 0.0;
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[0] + 0.25 * (p->t[kl] - p->t[0]);
+    double st = 0, sv = 0, stt = 0, stv = 0, x0 = 0, x1 = 0;
+    int nfit = 0;
+    for (int64_t k = 0; k <= kl; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
+        double v = 0.0, x = 0.0;
+        int64_t n = 0;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            if (p->phase[i] == 1) {
+                const double vv[3] = {p->vx[i], p->vy[i], p->vz[i]}, xx[3] = {p->x[i], p->y[i], p->z[i]};
+                for (int a = 0; a < 3; a++)
+                    v += vv[a] * gt[a] / gtm, x += xx[a] * gt[a] / gtm;
+                n++;
+            }
+        if (n == 0)
+            continue;
+        v /= (double)n, x /= (double)n;
+        if (k == 0)
+            x0 = x;
+        x1 = x;
+        if (r->nseries < LAHAR_CHECK_MAX_SERIES) {
+            r->series_t[r->nseries] = p->t[k];
+            r->series_measured[r->nseries] = v;
+            r->series_reference[r->nseries] = 0.0; /* set after the fit */
+            r->nseries++;
+        }
+        if (p->t[k] >= t_from) {
+            st += p->t[k], sv += v, stt += p->t[k] * p->t[k], stv += p->t[k] * v;
+            nfit++;
+        }
+    }
+    if (nfit < 3) {
+        snprintf(r->err, sizeof r->err, "soil_slide: fewer than 3 snapshots after t = %g s", t_from);
+        return -1;
+    }
+    const double a = (nfit * stv - st * sv) / (nfit * stt - st * st), v0 = (sv - a * st) / nfit;
+    for (int k = 0; k < r->nseries; k++) /* the reference slope through the fitted velocity at t_from */
+        r->series_reference[k] = v0 + a * t_from + a_ref * (r->series_t[k] - t_from);
+    lahar_check_value(r, "accel_rel_error", a_ref > 0.0 ? fabs(a - a_ref) / a_ref : fabs(a) / gtm);
+    lahar_check_value(r, "accel_measured", a);
+    lahar_check_value(r, "accel_reference", a_ref);
+    lahar_check_value(r, "theta_deg", theta * 180.0 / acos(-1.0));
+    lahar_check_value(r, "mu_phi", mu);
+    lahar_check_value(r, "g_sin_theta", g * sin(theta));
+    lahar_check_value(r, "displacement_m", x1 - x0);
+    snprintf(r->title, sizeof r->title, "soil block on a %.1f deg slope, mu_phi = %.3g: %s", theta * 180.0 / acos(-1.0),
+             mu, a_ref > 0.0 ? "slides" : "sticks");
+    snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
+    snprintf(r->ylabel, sizeof r->ylabel, "mean soil velocity down the slope (m/s)");
+    snprintf(r->convention, sizeof r->convention,
+             "a fitted to the mean velocity along the slope for t >= %.3g s; reference g (sin theta - mu_phi cos theta)",
+             t_from);
+    return 0;
+}

@@ -16,3 +16,16 @@ add_test(NAME soil_geostatic_2d
           ${CMAKE_CURRENT_BINARY_DIR}/soil/geostatic_2d)
 set_tests_properties(soil_geostatic_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Soil-DEM friction (paper 000 eq. 22-27): a soil block on a 30 deg plane with mu_phi = 0.3 slides
+# at g (sin - mu_phi cos) within 5 %; on a 15 deg plane with mu_phi = 0.5 it stays put (|a| within
+# 5 % of g sin theta), and moves less than 1 mm in 0.4 s.
+add_test(NAME soil_block_incline_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_block_incline_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/block_incline_2d)
+add_test(NAME soil_block_incline_stick_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar>
+          ${CMAKE_SOURCE_DIR}/cases/soil_block_incline_stick_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/soil/block_incline_stick_2d
+          displacement_m<=0.001 displacement_m>=-0.001)
+set_tests_properties(soil_block_incline_2d soil_block_incline_stick_2d PROPERTIES LABELS "validation;slow;soil"
+  TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
