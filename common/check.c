@@ -741,6 +741,8 @@ static const lahar_check_reference check_references[] = {
      "sigma_v_rel_error", 0.05, lahar_check_soil_geostatic},
     {"soil_slide", "soil block on a fixed floor under tilted gravity: sliding acceleration vs g (sin - mu_phi cos)",
      "accel_rel_error", 0.05, lahar_check_soil_slide},
+    {"granular_collapse", "soil column collapsing from a wall onto a floor: run-out, deposit profile, settled at or "
+     "below the angle of repose", "escaped_particles", 0.0, lahar_check_granular_collapse},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

@@ -29,3 +29,11 @@ add_test(NAME soil_block_incline_stick_2d
           displacement_m<=0.001 displacement_m>=-0.001)
 set_tests_properties(soil_block_incline_2d soil_block_incline_stick_2d PROPERTIES LABELS "validation;slow;soil"
   TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Granular collapse (Bui 2008 aluminium bars, reference 04a) at dx = 10 mm: no particle through the
+# floor or the wall, settled, deposit at or below the angle of repose; the run-out is reported.
+add_test(NAME soil_granular_collapse_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_collapse_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_collapse_2d dx=0.01 runout_m>=0.25)
+set_tests_properties(soil_granular_collapse_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
