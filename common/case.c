@@ -1510,8 +1510,8 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
             }
         for (int j = 0; j < i; j++) {
             const lahar_particle_block *o = &c->blocks[j];
-            if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX)
-                continue;
+            if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX || b->phase != o->phase)
+                continue; /* water may fill the pores of a soil block (paper 000 section 2.3) */
             int overlap = 1;
             for (int a = 0; a < dim; a++)
                 overlap = overlap && b->lo[a] < o->hi[a] - 1e-9 * dx && o->lo[a] < b->hi[a] - 1e-9 * dx;

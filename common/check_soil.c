@@ -392,3 +392,66 @@ int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d
              "slope fitted to the column tops between 10 %% and 90 %% of the height at the wall");
     return 0;
 }
+
+/* darcy: water driven through a soil by sph.body_force b (fluid only; hydraulic gradient
+ * i = |b| / g with g = |gravity|, 9.81 m/s^2 without gravity, the g of k = k_h mu / (rho_w g)).
+ * Darcy's law gives the seepage (superficial) velocity u = k_h i along b relative to the soil
+ * (paper 000 eq. 10). Measured: mean water velocity minus mean soil velocity along b, averaged
+ * over the snapshots of the last quarter of the run. Metric:
+ *   darcy_velocity_rel_error = |u - k_h i| / (k_h i). */
+int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    const double *b = c->sph.body_force;
+    const double bm = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    const double gg = sqrt(c->gravity[0] * c->gravity[0] + c->gravity[1] * c->gravity[1] + c->gravity[2] * c->gravity[2]);
+    if (!p || !p->phase || !p->vx || !mat || !(mat->permeability > 0.0) || !(bm > 0.0) || p->nsnap < 2) {
+        snprintf(r->err, sizeof r->err, "darcy: needs a soil with permeability > 0, water, sph.body_force != 0, >= 2 "
+                 "snapshots and the particle fields velocity and phase");
+        return -1;
+    }
+    const double g = gg > 0.0 ? gg : 9.81, i_h = bm / g, u_ref = mat->permeability * i_h;
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+    double usum = 0.0;
+    int nwin = 0;
+    for (int64_t k = 0; k <= kl; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
+        double uw = 0.0, us = 0.0;
+        int64_t nw = 0, ns = 0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            double u = (p->vx[i] * b[0] + p->vy[i] * b[1] + p->vz[i] * b[2]) / bm;
+            if (p->phase[i] == 1)
+                us += u, ns++;
+            else
+                uw += u, nw++;
+        }
+        if (nw == 0 || ns == 0) {
+            snprintf(r->err, sizeof r->err, "darcy: snapshot %lld lacks water or soil particles", (long long)k);
+            return -1;
+        }
+        double u = uw / (double)nw - us / (double)ns;
+        if (r->nseries < LAHAR_CHECK_MAX_SERIES) {
+            r->series_t[r->nseries] = p->t[k];
+            r->series_measured[r->nseries] = u;
+            r->series_reference[r->nseries] = u_ref;
+            r->nseries++;
+        }
+        if (p->t[k] >= t_from)
+            usum += u, nwin++;
+    }
+    const double u = usum / nwin;
+    lahar_check_value(r, "darcy_velocity_rel_error", fabs(u - u_ref) / u_ref);
+    lahar_check_value(r, "darcy_velocity", u);
+    lahar_check_value(r, "darcy_velocity_reference", u_ref);
+    lahar_check_value(r, "hydraulic_gradient", i_h);
+    lahar_check_value(r, "k_h", mat->permeability);
+    snprintf(r->title, sizeof r->title, "Darcy flow through a soil: k_h = %g m/s, i = %.3g", mat->permeability, i_h);
+    snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
+    snprintf(r->ylabel, sizeof r->ylabel, "mean water - mean soil velocity along b (m/s)");
+    snprintf(r->convention, sizeof r->convention, "i = |sph.body_force| / g; velocities averaged over t >= %.3g s",
+             t_from);
+    return 0;
+}

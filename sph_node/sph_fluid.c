@@ -296,8 +296,10 @@ static void fluid_rates_particles(sph_fluid *f)
     if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
         sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k);
     fluid_pass(f);
-    if (f->has_soil)
-        sph_soil_momentum(&f->soil, p, &f->cells, &f->k, prm.body_force);
+    if (f->has_soil) {
+        sph_soil_momentum(&f->soil, p, &f->cells, &f->k);
+        sph_soil_water_seepage(&f->soil, p, &f->cells, &f->k); /* 000 eq. 8, when k_h > 0 */
+    }
 }
 
 /* The soil stress in the leapfrog (sph_soil.h): begin = the half kick and the prediction, else the
@@ -439,6 +441,8 @@ double sph_fluid_dt(const sph_fluid *f)
     double dt = prm->cfl * h / (prm->c0 + f->vmax);
     if (f->has_soil) /* the soil's P-wave speed (sph_soil.h) */
         dt = fmin(dt, prm->cfl * h / (f->soil.cs + f->vmax));
+    if (f->has_soil && f->soil.seep > 0.0) /* the seepage drag rate g / k_h (sph_soil.h) */
+        dt = fmin(dt, 0.25 * f->soil.mat.kh / f->soil.mat.g_ref);
     if (f->amax > 0.0)
         dt = fmin(dt, prm->cfl_force * sqrt(h / f->amax));
     if (f->nut_max > 0.0) /* SPS: the eddy viscosity adds to the laminar one */

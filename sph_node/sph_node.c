@@ -172,7 +172,11 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
             prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
                                                 .phi = mt->friction_angle, .cohesion = mt->cohesion,
                                                 .psi = mt->dilatancy, .kh = mt->permeability, .mu_phi = mt->friction,
-                                                .damping = mt->damping};
+                                                .damping = mt->damping, .rho_water = c->sph_density,
+                                                .gravity = {c->gravity[0], c->gravity[1], c->gravity[2]},
+                                                .g_ref = v3_norm(v3_load(c->gravity)) > 0.0
+                                                             ? v3_norm(v3_load(c->gravity))
+                                                             : 9.81};
         }
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {

@@ -28,6 +28,7 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
     s->dim = dim;
     sph_soil_constants(m, &s->G, &s->K, &s->cs, &s->alpha_phi, &s->kc, &s->alpha_psi);
     s->w_dx = kernel_w(k, dx);
+    s->seep = m->kh > 0.0 ? m->rho_water * m->g_ref / m->kh : 0.0;
     s->cap = p->cap;
     if (sph_particles_alloc_stress(p) != 0)
         return -1;
@@ -191,9 +192,9 @@ void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, co
             soil_stress_particle(s, p, c, k, i);
 }
 
-static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
-                                   const double g[3], int64_t i)
+static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int64_t i)
 {
+    const double *g = s->mat.gravity;
     const double h = k->h, inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
     const kernel_kind kind = k->kind;
     const double eta2 = 0.01 * h * h, cs = s->cs, inv_wdx = 1.0 / s->w_dx;
@@ -206,9 +207,20 @@ static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sp
         ri[a] = s->rart[a][i];
     }
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    const double seep = s->seep, wnorm = k->norm;
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
-        if (p->phase[j] != SPH_SOIL_PHASE)
+        if (p->phase[j] != SPH_SOIL_PHASE) {
+            if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
+                double r = sqrt(r2), q = r * inv_h;
+                double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
+                double c1 = p->m[j] / (p->rho[j] * rhoi);
+                double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = -c1 * p->p[j] * fij;
+                ax += sw * (p->vx[j] - vxi) + pw * rx;
+                ay += sw * (p->vy[j] - vyi) + pw * ry;
+                az += sw * (p->vz[j] - vzi) + pw * rz;
+            }
             continue;
+        }
         double r = sqrt(r2);
         double q = r * inv_h;
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
@@ -238,13 +250,43 @@ static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sp
     p->az[i] = az + g[2] - cd * vzi;
 }
 
-void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, const double g[3])
+void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
 {
     const int64_t n = p->n;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE)
-            soil_momentum_particle(s, p, c, k, g, i);
+            soil_momentum_particle(s, p, c, k, i);
+}
+
+void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+{
+    const int64_t n = p->n;
+    const double seep = s->seep, inv_h = k->inv_h, dnorm = k->dnorm, wnorm = k->norm, s2 = k->support * k->support;
+    const kernel_kind kind = k->kind;
+    if (!(seep > 0.0))
+        return;
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        if (p->phase[i] == SPH_SOIL_PHASE)
+            continue;
+        const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i], rhoi = p->rho[i], pi_ = p->p[i];
+        double ax = 0.0, ay = 0.0, az = 0.0;
+        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
+            if (p->phase[j] != SPH_SOIL_PHASE)
+                continue;
+            double r = sqrt(r2), q = r * inv_h;
+            double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0; /* grad_f W_fs = F x_fs */
+            double c1 = p->m[j] / (rhoi * p->rho[j]);
+            double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = c1 * pi_ * fij;
+            ax -= sw * (vxi - p->vx[j]) + pw * rx;
+            ay -= sw * (vyi - p->vy[j]) + pw * ry;
+            az -= sw * (vzi - p->vz[j]) + pw * rz;
+        });
+        p->ax[i] += ax;
+        p->ay[i] += ay;
+        p->az[i] += az;
+    }
 }
 
 void sph_soil_kick_begin(const sph_soil *s, sph_particles *p, int64_t i, double hdt)

@@ -37,7 +37,16 @@
  *     conservative equations above would otherwise reach only after their elastic waves die out.
  *   The mean pressure -tr(sigma)/3 goes to p->p of soil particles (for output).
  * Water particles are not neighbours of soil particles in these sums (and the water pass skips
- * soil neighbours); the fluid-soil interaction is paper 000 section 2.3.
+ * soil neighbours). Water and soil interact (paper 000 section 2.3) when the soil has k_h > 0:
+ *   seepage force (eq. 10): f_ij = (mu / k) (u_f - u_s) = (rho_w g / k_h) (u_f - u_s), since
+ *     k = k_h mu / (rho_w g) (rho_w the water's rest density, g = |gravity|, 9.81 without gravity)
+ *   on soil particle s (eq. 9):  a_s += sum_f m_f / (rho_f rho_s) [f_sf W_sf - p_f grad_s W_sf]
+ *   on water particle f (eq. 8, the reaction, equal and opposite pair by pair):
+ *                                a_f -= sum_s m_s / (rho_f rho_s) [f_sf W_sf + p_f grad_f W_fs]
+ *   eq. 8 prints the water's term with the same sign as the soil's; pair by pair the forces must
+ *   cancel (Newton's third law), which fixes it. In a soil filling the space (sum_s V_s W = 1)
+ *   the water then obeys a = b - (g / k_h) (u_f - u_s): Darcy, u = k_h i for b = g i.
+ *   The drag rate g / k_h joins the step limit: dt <= 0.25 k_h / g.
  * Time integration: sigma in the same kick-drift-kick leapfrog as v and rho (sph_fluid.h); step
  * limit C_cfl h / (c_s + |v|max).
  * Every pass is a gather over the particle's own neighbours: bitwise the same for any thread count. */
@@ -60,6 +69,9 @@ typedef struct {
     double kh;             /* Darcy hydraulic conductivity, m/s (0: none) */
     double mu_phi;         /* soil-DEM friction coefficient (paper 000 eq. 24) */
     double damping;        /* c_d, 1/s: dv/dt += -c_d v (0 = off) */
+    double g_ref;          /* g of k = k_h mu / (rho_w g), m/s^2 */
+    double gravity[3];     /* m/s^2: the soil's body force (sph.body_force drives the water only) */
+    double rho_water;      /* rho_w of the same, kg/m^3 */
 } sph_soil_material;
 
 typedef struct {
@@ -71,6 +83,7 @@ typedef struct {
     int64_t cap;
     double *dsig[SPH_NSTRESS];     /* stress rate of the last evaluation (sorted order) */
     double *rart[SPH_NSTRESS];     /* artificial stress R_i (already divided by rho_i^2) */
+    double seep;                   /* rho_w g / k_h (kg/(m^3 s)), 0 without seepage (k_h = 0) */
 } sph_soil;
 
 /* Derived constants (G, K, c_s, alpha_phi, k_c, alpha_psi) of a material. */
@@ -84,13 +97,17 @@ void sph_soil_free(sph_soil *s);
 /* Pass 1 (before the momentum pass): per soil particle, the stress rate, the artificial stress and
  * p = -tr(sigma)/3. Particles sorted, cells valid. */
 void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
-/* Pass 2: per soil particle, drho/dt and dv/dt (with the body force g) into p->drho, ax, ay, az.
- * Water particles are left alone. */
-void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, const double g[3]);
+/* Pass 2: per soil particle, drho/dt and dv/dt (with the material's gravity) into p->drho, ax, ay,
+ * az. Water particles are left alone. */
+void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
 
 /* Tension cracking and the return to the yield surface (Bui 2008 section 3.3) of one stress
  * (xx, xy, xz, yy, yz, zz), in place. */
 void sph_soil_return(const sph_soil *s, double sig[SPH_NSTRESS]);
+
+/* Seepage (sph_soil.h, paper 000 eq. 8-10) on the water particles: their reaction to every soil
+ * neighbour, added to p->ax.. after the water pass. No-op when s->seep is 0. */
+void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
 
 /* The integrator's stress updates of soil particle i (the other phases are skipped by the
  * caller): begin: sigh = sig + hdt dsig, predicted sig = sigh + hdt dsig; end: sig = sigh + hdt dsig;

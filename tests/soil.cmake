@@ -37,3 +37,10 @@ add_test(NAME soil_granular_collapse_2d
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_collapse_2d dx=0.01 runout_m>=0.25)
 set_tests_properties(soil_granular_collapse_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Darcy (paper 000 eq. 8-10): water driven through a soil at i = 0.5 flows at k_h i within 5 %.
+add_test(NAME soil_darcy_column_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/darcy_column_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/darcy_column_2d)
+set_tests_properties(soil_darcy_column_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
