@@ -10,7 +10,10 @@
  *  3. Jaumann rate of a rigid rotation v = w x (-y, x) of a pre-stressed soil (sigma_xx = -s0):
  *     dsigma = W sigma - sigma W, dsigma_xy = -s0 w, no elastic part, within 1 %;
  *  4. a uniform stress exerts no force on an interior particle: |a - g| < 1e-9 s0/(rho dx);
- *  5. a water-only fluid allocates no stress arrays. */
+ *  5. a water-only fluid allocates no stress arrays;
+ *  6. seepage (000 eq. 8-10): water moving at u through a resting soil on the same periodic
+ *     lattice: the water's acceleration is -(g/k_h) u (sum_s V_s W = 1) within 1 %, and the
+ *     water-soil forces cancel pair by pair: |sum_i m_i (a_i - b_i)| < 1e-12 of sum_water m |a - b|. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -177,12 +180,63 @@ static void test_water_only(void)
     sph_fluid_free(&f);
 }
 
+static void test_seepage(void)
+{
+    const int n = 10;
+    const double kh = 0.01, g = 9.81, u = 2e-3;
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    prm.periodic[0] = prm.periodic[1] = 1;
+    prm.hi[0] = prm.hi[1] = n * DX;
+    prm.soil = 1;
+    prm.soil_mat = sand(30.0, 1e4);
+    prm.soil_mat.kh = kh;
+    prm.soil_mat.g_ref = g;
+    prm.soil_mat.rho_water = 1000.0;
+    prm.soil_mat.gravity[1] = 0.0;
+    sph_fluid f;
+    char err[256];
+    if (sph_fluid_init(&f, &prm, 2 * n * n, err, sizeof err) != 0) {
+        CHECK(0, "init: %s", err);
+        return;
+    }
+    for (int ph = 0; ph < 2; ph++)
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double x[3] = {(i + 0.5) * DX, (j + 0.5) * DX, 0.0}, v[3] = {ph == 0 ? u : 0.0, 0.0, 0.0};
+                double rho = ph == 0 ? 1000.0 : RHO;
+                sph_particles_add(&f.p, x, v, rho * DX * DX, rho, ph == 0 ? 0 : SPH_SOIL_PHASE);
+            }
+    sph_cells_sort(&f.cells, &f.p);
+    sph_fluid_rates(&f, NULL, 1e-5);
+    double ref = -g / kh * u, worst = 0.0, mom[2] = {0.0, 0.0}, scale = 0.0;
+    for (int64_t i = 0; i < f.p.n; i++) {
+        mom[0] += f.p.m[i] * f.p.ax[i];
+        mom[1] += f.p.m[i] * f.p.ay[i];
+        if (f.p.phase[i] == 0) {
+            worst = fmax(worst, fabs(f.p.ax[i] - ref) / fabs(ref));
+            scale += f.p.m[i] * fabs(f.p.ax[i]);
+        }
+    }
+    CHECK(worst < 0.01, "water seepage acceleration: worst relative error %g (reference %g m/s^2)", worst, ref);
+    CHECK(hypot(mom[0], mom[1]) < 1e-12 * scale, "water-soil forces cancel: |sum m a| = %g of %g",
+          hypot(mom[0], mom[1]), scale);
+    printf("seepage: water acceleration within %.3g %% of -(g/k_h) u; net force %.3g of %.3g\n", 100.0 * worst,
+           hypot(mom[0], mom[1]), scale);
+    sph_fluid_free(&f);
+}
+
 int main(void)
 {
     test_return();
     test_elastic_rate();
     test_jaumann_and_uniform();
     test_water_only();
+    test_seepage();
     if (failures)
         fprintf(stderr, "%d check(s) failed\n", failures);
     return failures != 0;
