@@ -583,8 +583,9 @@ static int sph_node_loop(sph_node *s)
         err[0] = '\0';
         double compute = 0.0, c0 = lahar_now();
         int64_t cross = 0;
-        if (k == 0) {
-            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt) */
+        if (k == 0 && s->f.has_bodies) {
+            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt); without bodies
+             * the rates of the set-up do not depend on dt and stand */
             cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step.dt);
             sph_node_count_coupling(s);
             if (cross < 0) {
