@@ -274,12 +274,14 @@ engine_error)
     rc=$?
     cat stderr.txt
     [ "$rc" -eq 1 ] || fail "exit status $rc, expected 1"
-    grep -q "the DEM node reports at step [0-9]*: spheropoly" stderr.txt || fail "no engine message"
+    grep -q "the DEM node reports at step [0-9]*: body [0-9] '[a-z0-9]*' overlaps body [0-9] '[a-z0-9]*' by" stderr.txt ||
+        fail "no engine message"
     "$python" - bad <<'PY' || fail "summary or last snapshot wrong"
 import json, sys
 import h5py
 s = json.load(open(sys.argv[1] + "/summary.json"))
-assert s["status"] == "error" and s["exit_status"] == 1, s["status"]
+assert s["status"] == "unstable" and s["exit_status"] == 1, s["status"]
+assert s["instability"]["what"] == "overlap" and s["instability"]["where"]["kind"] == "body", s["instability"]
 failed_step = s["steps"]  # steps completed before the failing one
 with h5py.File(sys.argv[1] + "/bodies.h5", "r") as f:
     last = sorted(f["snapshots"])[-1]
