@@ -13,3 +13,8 @@ lahar_stress_test(density_band)
 lahar_stress_test(dt_collapse)
 lahar_stress_test(overlap)
 lahar_stress_test(stable)
+
+add_executable(test_instability ${LAHAR_TEST_DIR}/test_instability.c)
+target_link_libraries(test_instability PRIVATE lahar_common)
+add_test(NAME stress_instability_report COMMAND test_instability)
+set_tests_properties(stress_instability_report PROPERTIES LABELS "fast;stress")
