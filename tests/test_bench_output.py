@@ -93,14 +93,18 @@ def main(out, sections, cases):
         check(num(forced["steps"]) > num(sub["steps"]), "subcycle: the forced run takes more coordinator steps")
     if "overhead" in sections:
         _, rows = rows_of(os.path.join(out, "overhead.csv"))
-        modes = {r["mode"]: r for r in rows}
-        check(set(modes) == {"processes", "in-process"}, "overhead: one run per mode")
-        check(all(r["exit_status"] == "0" for r in rows), "overhead: both runs finished")
-        check(len({r["steps"] for r in rows}) == 1, "overhead: both modes take the same steps (same run)")
-        check(all(num(r["body_state_messages"]) > 0 for r in rows), "overhead: the boulders exchange BODY_STATE")
+        for size in ("large", "floor"):
+            sized = [r for r in rows if r["size"] == size]
+            check({r["mode"] for r in sized} == {"processes", "in-process"}, f"overhead/{size}: a run per mode")
+            check(all(r["exit_status"] == "0" for r in sized), f"overhead/{size}: the runs finished")
+            check(len({r["steps"] for r in sized}) == 1, f"overhead/{size}: both modes take the same steps (same run)")
+            check(all(num(r["body_state_messages"]) > 0 for r in sized), f"overhead/{size}: the boulders exchange BODY_STATE")
+        large = [num(r["particles"]) for r in rows if r["size"] == "large"]
+        floor = [num(r["particles"]) for r in rows if r["size"] == "floor"]
+        check(min(large) > 4 * max(floor), "overhead: the protocol-floor scene is much smaller than the large one")
         for r in rows:
             check(all(num(r[k]) >= 0 for k in ("sph_compute_ms_per_step", "sph_wait_ms_per_step",
-                                              "dem_wait_ms_per_step")), f"overhead/{r['mode']}: per-step times >= 0")
+                                              "dem_wait_ms_per_step")), f"overhead/{r['size']}/{r['mode']}: per-step times >= 0")
     print(f"{len(failures)} failures")
     return 1 if failures else 0
 

@@ -344,58 +344,92 @@ def per_step(s, node, key):
     return 1e3 * v / s["steps"] if isinstance(v, (int, float)) and s.get("steps") else float("nan")
 
 
+def overhead_row(args, case_path, out, mode, rep, size):
+    r = run_lahar(args.lahar, "run", case_path, out, args.threads, in_process=(mode == "in-process"),
+                  timeout=args.timeout)
+    s = summary_numbers(out)
+    sj = s["summary"]
+    row = dict(size=size, mode=mode, repeat=rep, particles=s["particles"], steps=s["steps"], wall_s=s["wall_s"],
+               wall_ms_per_step=(1e3 * s["wall_s"] / s["steps"]) if s["steps"] else float("nan"),
+               cpu_s=r["cpu_s"], peak_rss_mb=r["peak_rss_mb"],
+               sph_compute_ms_per_step=per_step(sj, "sph", "compute_s"),
+               sph_wait_ms_per_step=per_step(sj, "sph", "wait_s"),
+               dem_compute_ms_per_step=per_step(sj, "dem", "compute_s"),
+               dem_wait_ms_per_step=per_step(sj, "dem", "wait_s"),
+               coordinator_wait_ms_per_step=(1e3 * sj.get("coordinator_wait_s", float("nan")) / s["steps"]
+                                             if s["steps"] else float("nan")),
+               body_state_messages=sj.get("channels", {}).get("LAHAR_BODY_STATE", {}).get("messages", 0),
+               exit_status=r["exit_status"], load_avg=r["load_avg"])
+    log(f"  {size:5s} {mode:10s} n={row['particles']} steps={row['steps']} wall={fmt(row['wall_s'], 4)} s "
+        f"({fmt(row['wall_ms_per_step'], 3)} ms/step) cpu={fmt(row['cpu_s'], 4)} s "
+        f"sph wait {fmt(row['sph_wait_ms_per_step'], 3)} ms/step exit={r['exit_status']}")
+    if not args.keep:
+        for f in os.listdir(out) if os.path.isdir(out) else []:
+            if f.endswith(".h5"):
+                os.remove(os.path.join(out, f))
+    return row
+
+
+def median(xs):
+    xs = sorted(xs)
+    return float("nan") if not xs else (xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2]))
+
+
 def bench_overhead(args, outdir):
+    """Pairs of runs (processes, in-process; the order alternates) of the boulder pool: `large` at
+    >= 20,000 particles, and `floor` at dx 20 mm (about 400 particles), whose wall time per step is
+    almost all protocol: the difference of the two modes there is the per-step cost of LCM over
+    UDP multicast against the in-process queue."""
     src = os.path.join(BENCH_CASES_DIR, "boulder_pool_2d.yaml")
     dx, end = (0.004, 0.02) if args.quick else (0.0025, args.overhead_end)
     d = os.path.join(outdir, "runs", "overhead")
-    case_path = os.path.join(d, "pool.yaml")
-    case_override.override_case(src, case_path, {"sph.dx": dx, "time.end": end})
+    sizes = {"large": (dx, end), "floor": (0.02, 0.1 if args.quick else 0.5)}
     rows = []
-    log(f"== overhead: {src} at dx {dx}, end {end} s, {args.repeat} pair(s) of runs")
-    for rep in range(args.repeat):
-        for mode in ("processes", "in-process"):
-            out = os.path.join(d, f"{mode}_{rep}")
-            r = run_lahar(args.lahar, "run", case_path, out, args.threads, in_process=(mode == "in-process"),
-                          timeout=args.timeout)
-            s = summary_numbers(out)
-            sj = s["summary"]
-            row = dict(mode=mode, repeat=rep, particles=s["particles"], steps=s["steps"], wall_s=s["wall_s"],
-                       cpu_s=r["cpu_s"], peak_rss_mb=r["peak_rss_mb"],
-                       sph_compute_ms_per_step=per_step(sj, "sph", "compute_s"),
-                       sph_wait_ms_per_step=per_step(sj, "sph", "wait_s"),
-                       dem_compute_ms_per_step=per_step(sj, "dem", "compute_s"),
-                       dem_wait_ms_per_step=per_step(sj, "dem", "wait_s"),
-                       coordinator_wait_ms_per_step=(1e3 * sj.get("coordinator_wait_s", float("nan")) / s["steps"]
-                                                     if s["steps"] else float("nan")),
-                       body_state_messages=sj.get("channels", {}).get("LAHAR_BODY_STATE", {}).get("messages", 0),
-                       exit_status=r["exit_status"], load_avg=r["load_avg"])
-            rows.append(row)
-            log(f"  {mode:10s} n={row['particles']} steps={row['steps']} wall={fmt(row['wall_s'], 4)} s "
-                f"cpu={fmt(row['cpu_s'], 4)} s sph wait {fmt(row['sph_wait_ms_per_step'], 3)} ms/step "
-                f"exit={r['exit_status']}")
-            if not args.keep:
-                for f in os.listdir(out) if os.path.isdir(out) else []:
-                    if f.endswith(".h5"):
-                        os.remove(os.path.join(out, f))
-    cols = list(rows[0].keys())
-    write_csv(os.path.join(outdir, "overhead.csv"), rows, cols)
-    proc = [r["wall_s"] for r in rows if r["mode"] == "processes" and r["exit_status"] == 0]
-    inp = [r["wall_s"] for r in rows if r["mode"] == "in-process" and r["exit_status"] == 0]
-    ratio = (min(proc) / min(inp)) if proc and inp else float("nan")
-    md = ["| mode | particles | steps | wall [s] | CPU [s] | SPH compute / wait [ms/step] | "
-          "DEM compute / wait [ms/step] | coordinator wait [ms/step] | BODY_STATE msgs | load |",
-          "|---|---|---|---|---|---|---|---|---|---|"]
+    log(f"== overhead: {src} at dx {dx} (and {sizes['floor'][0]}), end {end} s, {args.repeat} pair(s) of runs")
+    for size, (sdx, send) in sizes.items():
+        case_path = os.path.join(d, f"pool_{size}.yaml")
+        case_override.override_case(src, case_path, {"sph.dx": sdx, "time.end": send})
+        for rep in range(args.repeat):
+            modes = ("processes", "in-process") if rep % 2 == 0 else ("in-process", "processes")
+            for mode in modes:
+                rows.append(overhead_row(args, case_path, os.path.join(d, f"{size}_{mode}_{rep}"), mode, rep, size))
+    write_csv(os.path.join(outdir, "overhead.csv"), rows, list(rows[0].keys()))
+
+    def ratios(size, key):
+        out = []
+        for rep in range(args.repeat):
+            pair = {r["mode"]: r for r in rows if r["size"] == size and r["repeat"] == rep and r["exit_status"] == 0}
+            if len(pair) == 2 and pair["in-process"][key] > 0:
+                out.append(pair["processes"][key] / pair["in-process"][key])
+        return out
+    wall_r, cpu_r = ratios("large", "wall_s"), ratios("large", "cpu_s")
+    fl = {m: median([r["wall_ms_per_step"] for r in rows if r["size"] == "floor" and r["mode"] == m
+                     and r["exit_status"] == 0]) for m in ("processes", "in-process")}
+    lg = median([r["wall_ms_per_step"] for r in rows if r["size"] == "large" and r["mode"] == "in-process"
+                 and r["exit_status"] == 0])
+    md = ["| scene | mode | pair | particles | steps | wall [s] | wall/step [ms] | CPU [s] | "
+          "SPH compute / wait [ms/step] | DEM compute / wait [ms/step] | coordinator wait [ms/step] | "
+          "BODY_STATE msgs | exit | load |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        md.append(f"| {r['mode']} | {r['particles']} | {r['steps']} | {fmt(r['wall_s'], 4)} | {fmt(r['cpu_s'], 4)} | "
+        md.append(f"| {r['size']} | {r['mode']} | {r['repeat']} | {r['particles']} | {r['steps']} | {fmt(r['wall_s'], 4)} | "
+                  f"{fmt(r['wall_ms_per_step'], 3)} | {fmt(r['cpu_s'], 4)} | "
                   f"{fmt(r['sph_compute_ms_per_step'], 3)} / {fmt(r['sph_wait_ms_per_step'], 3)} | "
                   f"{fmt(r['dem_compute_ms_per_step'], 3)} / {fmt(r['dem_wait_ms_per_step'], 3)} | "
-                  f"{fmt(r['coordinator_wait_ms_per_step'], 3)} | {r['body_state_messages']} | "
+                  f"{fmt(r['coordinator_wait_ms_per_step'], 3)} | {r['body_state_messages']} | {r['exit_status']} | "
                   f"{fmt(r['load_avg'], 2)} |")
-    md.append("")
-    md.append(f"Wall-time ratio processes / in-process (best of {args.repeat}): **{fmt(ratio, 3)}** (target <= 1.05)")
+    ratio = median(wall_r)
+    protocol = fl["processes"] - fl["in-process"]
+    md += ["", f"Wall-time ratio processes / in-process at {rows[0]['particles']} particles, median of "
+           f"{len(wall_r)} pair(s): **{fmt(ratio, 3)}** (pairs: {', '.join(fmt(x, 3) for x in wall_r)}; target <= 1.05); "
+           f"CPU-time ratio {fmt(median(cpu_r), 3)}.",
+           f"Protocol floor (dx {sizes['floor'][0]}): {fmt(fl['processes'], 3)} ms/step as processes, "
+           f"{fmt(fl['in-process'], 3)} ms/step in-process: LCM over UDP costs {fmt(protocol, 3)} ms/step more, "
+           f"{fmt(100.0 * protocol / lg, 2) if lg > 0 else 'nan'} % of the large scene's "
+           f"{fmt(lg, 3)} ms/step in-process."]
     with open(os.path.join(outdir, "overhead.md"), "w") as f:
         f.write("\n".join(md) + "\n")
-    log(f"  ratio processes / in-process: {fmt(ratio, 3)}")
+    log(f"  ratio processes / in-process: {fmt(ratio, 3)} (CPU {fmt(median(cpu_r), 3)}); "
+        f"protocol {fmt(protocol, 3)} ms/step")
     return ratio
 
 
@@ -464,8 +498,8 @@ def main(argv):
     ap.add_argument("--cases", default=",".join(BENCH), help="comma list of the cases of the pareto section")
     ap.add_argument("--threads", type=int, default=2, help="OpenMP threads per node (default 2)")
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds after which one run is stopped")
-    ap.add_argument("--repeat", type=int, default=1, help="pairs of runs of the overhead section (best is used)")
-    ap.add_argument("--overhead-end", type=float, default=0.05, help="simulated time of the overhead runs [s]")
+    ap.add_argument("--repeat", type=int, default=3, help="pairs of runs of the overhead section (median is used)")
+    ap.add_argument("--overhead-end", type=float, default=0.02, help="simulated time of the overhead runs [s]")
     ap.add_argument("--subcycle-end", type=float, default=0.1, help="simulated time of the subcycling runs [s]")
     ap.add_argument("--keep", action="store_true", help="keep the runs' HDF5 files (deleted by default)")
     ap.add_argument("--list", action="store_true", help="print the planned runs and exit")
@@ -478,6 +512,8 @@ def main(argv):
         sys.stderr.write(f"lahar bench: unknown {'section' if bad else 'case'} {', '.join(bad or badc)} "
                          f"(sections: pareto, overhead, subcycle; cases: {', '.join(BENCH)})\n")
         return 2
+    if args.quick:
+        args.repeat = 1
     specs = {}
     for c in cases:
         spec = dict(BENCH[c])
