@@ -114,8 +114,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
 
 /* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
  * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
-static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int soil,
-                                  int64_t i, double out[4])
+static inline int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int soil,
+                                     int64_t i, double out[4])
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
@@ -138,9 +138,11 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
         for (int a = 0; a < 6; a++)
             ti[a] = tau[a][i] / (rhoi * rhoi);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    int64_t nnb = 0; /* neighbours summed over (work counter) */
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
         if (soil && p->phase[j] != 0) /* soil neighbours: sph_soil.h (fluid-soil: paper 000 section 2.3) */
             continue;
+        nnb++;
         double r = sqrt(r2);
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
         double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
@@ -173,6 +175,7 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
     out[1] = ax + prm->body_force[0];
     out[2] = ay + prm->body_force[1];
     out[3] = az + prm->body_force[2];
+    return nnb;
 }
 
 /* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, 003 eq. 11). */
@@ -232,31 +235,34 @@ static void fluid_pass(sph_fluid *f)
     const kernel_kind kind = f->k.kind;
     const int sps = f->prm.sps != 0;
     const int soil = f->has_soil;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    int64_t neighbours = 0;
+#pragma omp parallel for schedule(static) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
         if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
             continue;
         /* kind, sps and soil constant per call site: the pair loop inlines without their branches */
         switch ((kind * 2 + sps) * 2 + soil) {
-        case KERNEL_QUINTIC * 4: fluid_particle(f, KERNEL_QUINTIC, 0, 0, i, out); break;
-        case KERNEL_QUINTIC * 4 + 1: fluid_particle(f, KERNEL_QUINTIC, 0, 1, i, out); break;
-        case KERNEL_QUINTIC * 4 + 2: fluid_particle(f, KERNEL_QUINTIC, 1, 0, i, out); break;
-        case KERNEL_QUINTIC * 4 + 3: fluid_particle(f, KERNEL_QUINTIC, 1, 1, i, out); break;
-        case KERNEL_WENDLAND2 * 4: fluid_particle(f, KERNEL_WENDLAND2, 0, 0, i, out); break;
-        case KERNEL_WENDLAND2 * 4 + 1: fluid_particle(f, KERNEL_WENDLAND2, 0, 1, i, out); break;
-        case KERNEL_WENDLAND2 * 4 + 2: fluid_particle(f, KERNEL_WENDLAND2, 1, 0, i, out); break;
-        case KERNEL_WENDLAND2 * 4 + 3: fluid_particle(f, KERNEL_WENDLAND2, 1, 1, i, out); break;
-        case KERNEL_CUBIC * 4 + 1: fluid_particle(f, KERNEL_CUBIC, 0, 1, i, out); break;
-        case KERNEL_CUBIC * 4 + 2: fluid_particle(f, KERNEL_CUBIC, 1, 0, i, out); break;
-        case KERNEL_CUBIC * 4 + 3: fluid_particle(f, KERNEL_CUBIC, 1, 1, i, out); break;
-        default: fluid_particle(f, KERNEL_CUBIC, 0, 0, i, out); break;
+        case KERNEL_QUINTIC * 4: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, 0, i, out); break;
+        case KERNEL_QUINTIC * 4 + 1: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, 1, i, out); break;
+        case KERNEL_QUINTIC * 4 + 2: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, 0, i, out); break;
+        case KERNEL_QUINTIC * 4 + 3: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 4: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 1: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 2: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 3: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, 1, i, out); break;
+        case KERNEL_CUBIC * 4 + 1: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, 1, i, out); break;
+        case KERNEL_CUBIC * 4 + 2: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, 0, i, out); break;
+        case KERNEL_CUBIC * 4 + 3: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, 1, i, out); break;
+        default: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, 0, i, out); break;
         }
         p->drho[i] = out[0];
         p->ax[i] = out[1];
         p->ay[i] = out[2];
         p->az[i] = out[3];
     }
+    f->work_passes++;
+    f->work_neighbours_fluid += neighbours; /* integer sum: exact in any order */
 }
 
 void sph_fluid_shepard(sph_fluid *f)
