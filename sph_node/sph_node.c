@@ -633,8 +633,10 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
     const sph_particles *p = &s->f.p;
     const int64_t n = p->n;
     const double rho_water = s->ns.scene.sph_density;
-    /* rho0 of particle I: the water's, or the soil's rest density (sph_soil.h) */
-#define SPH_NODE_RHO0(I) (s->f.has_soil && p->phase[I] == SPH_SOIL_PHASE ? s->f.soil.mat.density : rho_water)
+    /* rho0 of particle I: the water's; soil particles (sph_soil.h) have no EOS, so their density
+     * (from continuity, thinning where the soil spreads) cannot blow up a pressure: they are held
+     * to finite values only (an infinite band) */
+#define SPH_NODE_RHO0(I) (s->f.has_soil && p->phase[I] == SPH_SOIL_PHASE ? NAN : rho_water)
     const double *band = s->ns.scene.stability.density_band;
     int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad) if (n >= SPH_OMP_MIN_LIGHT)
@@ -642,7 +644,8 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
         /* a NaN or an infinity in any component makes the sum non-finite; a NaN density fails
          * the band test too */
         double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i], rho0 = SPH_NODE_RHO0(i);
-        bad += !(isfinite(sum) && p->rho[i] >= band[0] * rho0 && p->rho[i] <= band[1] * rho0);
+        bad += !(isfinite(sum) && isfinite(p->rho[i]) &&
+                 (isnan(rho0) || (p->rho[i] >= band[0] * rho0 && p->rho[i] <= band[1] * rho0)));
     }
     if (bad == 0)
         return 0;
@@ -653,7 +656,8 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
         if (!isfinite(sum) || !isfinite(p->rho[i])) {
             if (worst_nf < 0 || p->id[i] < p->id[worst_nf])
                 worst_nf = i;
-        } else if (!(p->rho[i] >= band[0] * SPH_NODE_RHO0(i) && p->rho[i] <= band[1] * SPH_NODE_RHO0(i))) {
+        } else if (!isnan(SPH_NODE_RHO0(i)) &&
+                   !(p->rho[i] >= band[0] * SPH_NODE_RHO0(i) && p->rho[i] <= band[1] * SPH_NODE_RHO0(i))) {
             double dev = fabs(log(p->rho[i] / SPH_NODE_RHO0(i)));
             if (dev > dev_max || (dev == dev_max && p->id[i] < p->id[worst])) {
                 dev_max = dev;
