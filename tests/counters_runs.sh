@@ -3,7 +3,7 @@
 # ("work", coordinator/README.md) against independent counts, through `lahar run --in-process`.
 #
 #   counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: water_only | fixed_bodies | output_fields | dem_contacts
+#   TEST: water_only | fixed_bodies | processes | output_fields | dem_contacts
 #
 # water_only    a block of water without bodies, one step, 2D and 3D: no DEM node, no soil or
 #               seepage work (soil-soil and fluid-soil pairs 0), no particle-body or body-body
@@ -19,6 +19,9 @@
 #               the DEM node back): particles.h5 and contacts.h5 bitwise equal, the walls' force
 #               rows in forces.h5 equal to 1e-12 (the DEM node averages them over its
 #               substeps), the same body poses; the far body adds no particle-body work.
+# processes     the one-step tank run as processes (lahar's private network namespace): only
+#               lahar-sph joins (HELLO from the coordinator and the SPH node only), the particles
+#               are bitwise those of the in-process run.
 # output_fields the tank with output fields [velocity] and with every field: particles.h5
 #               holds only the fields asked for, no value is computed for output without
 #               pressure (output_derived 0) and one pressure per particle and snapshot with it;
@@ -205,6 +208,27 @@ with h5py.File(a + "/bodies.h5", "r") as fa, h5py.File(b + "/bodies.h5", "r") as
             assert np.array_equal(x, y), (k, d, x, y)
 print("fixed_bodies: %d steps without a DEM node (0 LOADS) = with one (%d LOADS): particles.h5 and contacts.h5 "
       "bitwise, wall forces to 1e-12" % (sa["steps"], cb["LAHAR_LOADS"]["messages"]))
+PY
+    ;;
+processes)
+    # the same one-step tank as `lahar run` without --in-process: nodes as processes in lahar's
+    # own private network namespace; only lahar-sph is started
+    write_tank one.yaml 1e-4 1e-4
+    "$bin/lahar" run one.yaml -o proc -q --threads 1 || fail "lahar run (processes) failed"
+    run one.yaml ip
+    "$python" "$tools/h5_compare.py" --quiet ip/particles.h5 proc/particles.h5 || fail "processes and in-process differ"
+    "$python" - proc <<'PY' || fail "processes: a DEM node took part"
+import json, sys
+s = json.load(open(sys.argv[1] + "/summary.json"))
+w, ch = s["work"], s["work"]["channels"]
+assert s["status"] == "finished" and s["mode"] == "processes", (s["status"], s["mode"])
+assert list(s["nodes"]) == ["sph"] and not w["dem_node"], list(s["nodes"])
+# HELLO: the coordinator's announcement and the SPH node's answer, no DEM node's
+assert ch["LAHAR_HELLO"]["messages"] == 2, ch["LAHAR_HELLO"]
+assert ch["LAHAR_STATUS"]["messages"] == s["steps"] + 1, ch["LAHAR_STATUS"]
+assert ch["LAHAR_LOADS"]["messages"] == 0 and ch["LAHAR_BODY_STATE"]["messages"] == 0, ch
+print("processes: only lahar-sph joined (2 HELLO, %d STATUS for %d step), same particles as in-process"
+      % (ch["LAHAR_STATUS"]["messages"], s["steps"]))
 PY
     ;;
 output_fields)
