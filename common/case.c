@@ -491,9 +491,60 @@ static void read_dem(reader *r, yaml_node_t *n, lahar_case *c)
     rmap_check_keys(&m, keys);
     rmap_name(&m, "engine", 0, "spheropoly", c->dem_engine);
     c->dem_dt_safety = rmap_num(&m, "dt_safety", 0, 0.02, "0.02");
-    if (!r->failed && !(c->dem_dt_safety > 0 && c->dem_dt_safety <= 1))
+    if (!r->failed && !(c->dem_dt_safety > 0 && c->dem_dt_safety <= 1)) {
         rmap_fail(&m, "dt_safety", "must be in (0, 1] (got %g); it is the fraction of the contact period used as "
                   "the DEM step, 0.02 is safe", c->dem_dt_safety);
+        return;
+    }
+    /* Stability of the leapfrog on a damped contact spring (omega = 2 pi / T, damping ratio zeta):
+     * omega h < 2 (sqrt(1 + zeta^2) - zeta), i.e. h / T < (sqrt(1 + zeta^2) - zeta) / pi; above it a
+     * resting contact pumps energy into the body without bound (tests/stress: a disc resting on a
+     * floor jumps 7 cm at h / T = 0.29 with e = 0.5). zeta of the most damped pair (the smallest
+     * restitution, closed form of dem_node/README.md), 10 % margin for the engine's calibrated
+     * damping; the bound is that of the linear law, the Hertz period is defined alike. */
+    double e_min = 1.0;
+    for (int i = 0; i < c->nmaterial; i++)
+        e_min = fmin(e_min, c->materials[i].restitution);
+    if (!r->failed && c->nmaterial > 0 && e_min > 0.0 && e_min <= 1.0) {
+        double le = log(e_min), zeta = -le / sqrt(M_PI * M_PI + le * le);
+        double bound = 0.9 * (sqrt(1.0 + zeta * zeta) - zeta) / M_PI;
+        if (c->dem_dt_safety > bound)
+            rmap_fail(&m, "dt_safety", "%g is above the stability limit %.3g of the DEM contact integration for "
+                      "restitution %g (h / T < (sqrt(1 + zeta^2) - zeta) / pi with 10 %% margin: above it a resting "
+                      "contact gains energy); use at most %.2g (0.02 is accurate)", c->dem_dt_safety, bound, e_min,
+                      floor(bound * 100.0) / 100.0);
+    }
+}
+
+/* The instability checks (common/instability.h); defaults when the section is absent. */
+static void read_stability(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"density_band", "max_overlap", "dt_collapse", NULL};
+    lahar_stability *s = &c->stability;
+    s->density_band[0] = 0.5;
+    s->density_band[1] = 2.0;
+    s->max_overlap = 0.5;
+    s->dt_collapse = 1e-3;
+    if (!n)
+        return;
+    rmap m;
+    if (rmap_open(r, n, "stability", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    rmap_vec(&m, "density_band", 2, s->density_band, 0, "[0.5, 2.0]");
+    s->max_overlap = rmap_num(&m, "max_overlap", 0, 0.5, "0.5");
+    s->dt_collapse = rmap_num(&m, "dt_collapse", 0, 1e-3, "1e-3");
+    if (r->failed)
+        return;
+    if (!(s->density_band[0] > 0.0 && s->density_band[0] < 1.0 && s->density_band[1] > 1.0))
+        rmap_fail(&m, "density_band", "must be [lo, hi] with 0 < lo < 1 < hi (got [%g, %g]); it is the band of "
+                  "rho / rho0 every particle must stay in, e.g. [0.5, 2.0]", s->density_band[0], s->density_band[1]);
+    else if (!(s->max_overlap > 0.0 && s->max_overlap <= 1.0))
+        rmap_fail(&m, "max_overlap", "must be in (0, 1] (got %g); it is the largest body-body overlap as a fraction "
+                  "of the smaller sweep radius, e.g. 0.5", s->max_overlap);
+    else if (!(s->dt_collapse >= 0.0 && s->dt_collapse < 1.0))
+        rmap_fail(&m, "dt_collapse", "must be in [0, 1) (got %g); the run stops when the step falls below this "
+                  "fraction of the first step (0: only time.dt_min), e.g. 1e-3", s->dt_collapse);
 }
 
 /* --- bodies -------------------------------------------------------------------------------------- */
@@ -1710,7 +1761,7 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
 static void read_case(reader *r, lahar_case *c)
 {
     static const char *const keys[] = {"dimensions", "gravity", "time", "materials", "dem", "bodies", "output",
-                                       "check", "sph", NULL};
+                                       "check", "sph", "stability", NULL};
     yaml_node_t *root = yaml_document_get_root_node(r->doc);
     if (!root) {
         rd_fail(r, NULL, "", "the case file is empty; a case needs at least dimensions, time and bodies or sph");
@@ -1739,6 +1790,7 @@ static void read_case(reader *r, lahar_case *c)
     if (mat)
         read_materials(r, mat, c);
     read_dem(r, rmap_get(&m, "dem"), c);
+    read_stability(r, rmap_get(&m, "stability"), c);
     if (bodies && !r->failed) {
         int nb = bodies->type == YAML_SEQUENCE_NODE ? seq_len(bodies) : 0;
         int *line = calloc((size_t)(nb ? nb : 1), sizeof *line);

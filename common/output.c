@@ -1174,3 +1174,55 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
     o->nsnap++;
     return 0;
 }
+
+/* ---------------------------------------------------------------- final snapshot of a failed run -- */
+
+int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const char *name, const char *text)
+{
+    char path[OUT_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", outdir, file);
+    hid_t f = out_file_open(path, H5F_ACC_RDWR, 0);
+    if (f < 0)
+        return -1;
+    int rc = -1;
+    hid_t g = H5Gopen2(f, "snapshots", H5P_DEFAULT);
+    H5G_info_t info;
+    if (g >= 0 && H5Gget_info(g, &info) >= 0 && info.nlinks > 0) {
+        char sname[32];
+        snprintf(sname, sizeof sname, "%06" PRId64, (int64_t)info.nlinks - 1);
+        hid_t s = H5Gopen2(g, sname, H5P_DEFAULT);
+        if (s >= 0) {
+            if (H5Aexists(s, name) > 0)
+                H5Adelete(s, name);
+            rc = out_attr_string(s, name, text);
+            H5Gclose(s);
+        }
+    }
+    if (g >= 0)
+        H5Gclose(g);
+    if (H5Fclose(f) < 0)
+        rc = -1;
+    if (rc)
+        fprintf(stderr, "lahar: %s: cannot mark the last snapshot\n", path);
+    return rc;
+}
+
+int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t)
+{
+    char path[OUT_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", outdir, file);
+    out_snap_entry *list = NULL;
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int64_t cnt = out_read_snapshot_list(path, &list);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+    if (cnt > 0) {
+        snprintf(group, n, "/snapshots/%06" PRId64, list[cnt - 1].snap);
+        *step = list[cnt - 1].step;
+        *t = list[cnt - 1].t;
+    }
+    free(list);
+    return cnt > 0 ? 0 : -1;
+}

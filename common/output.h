@@ -83,6 +83,14 @@ void lahar_contact_output_close(lahar_contact_output *o);
  * of a run; the writers also call it from their close. Returns 0, or -1 with a message. */
 int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n);
 
+/* A run stopped by an instability or an error: mark the last snapshot of OUT/<file> (bodies.h5,
+ * particles.h5) with a string attribute `name` holding `text` (the report), so that whoever opens
+ * the final snapshot sees why the run ended there. 0, or -1 (message on stderr). */
+int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const char *name, const char *text);
+/* The last snapshot of OUT/<file>: its group ("/snapshots/NNNNNN"), step and time. 0, or -1 when
+ * the file is missing or has none. */
+int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t);
+
 /* Display mesh of a sphero-polyhedron for viewers (not used by the physics): a closed surface of
  * triangles in 3D (spheres: icospheres; polyhedra: core faces offset by the sweep radius plus
  * flat bevels along edges and fans at corners; rods: spheres + tubes), line segments in the

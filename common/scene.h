@@ -120,6 +120,16 @@ typedef struct {
     } metric[16];
 } lahar_check;
 
+/* Instability checks (section stability: of a case, see common/instability.h and cases/README.md).
+ * The loader fills every default. */
+typedef struct {
+    double density_band[2]; /* SPH: every particle keeps rho / rho0 in [lo, hi] (default [0.5, 2]) */
+    double max_overlap;     /* DEM: a body-body overlap above this fraction of the smaller sweep
+                               radius stops the run (default 0.5; the normal is lost at 1) */
+    double dt_collapse;     /* coordinator: a step below this fraction of the first step stops the
+                               run (default 1e-3; 0 = only time.dt_min) */
+} lahar_stability;
+
 typedef struct {
     char path[1024];       /* case file, for messages */
     int dim;               /* 2 or 3 */
@@ -147,6 +157,7 @@ typedef struct {
     double dem_dt_safety;  /* fraction of the contact period used as the DEM step, default 0.02 */
 
     lahar_check check;
+    lahar_stability stability; /* instability checks (stability: section) */
 
     /* output: section. output_fields: particle fields to write, bits in the order of the names
      * velocity, density, pressure, phase, id (= LAHAR_PFIELD_* in output.h); default all.

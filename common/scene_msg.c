@@ -86,6 +86,9 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->has_sph = (int8_t)(has_sph != 0);
     m->dem_engine = (char *)c->dem_engine;
     m->dem_dt_safety = c->dem_dt_safety;
+    memcpy(m->stability_density_band, c->stability.density_band, sizeof m->stability_density_band);
+    m->stability_max_overlap = c->stability.max_overlap;
+    m->stability_dt_collapse = c->stability.dt_collapse;
     m->sph_dx = c->sph_dx;
     m->sph_density = c->sph_density;
     scene_sph_to_msg(&c->sph, &m->sph);
@@ -216,6 +219,9 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
     c->forces_interval = m->forces_interval;
     scene_copy_name(c->dem_engine, m->dem_engine);
     c->dem_dt_safety = m->dem_dt_safety;
+    memcpy(c->stability.density_band, m->stability_density_band, sizeof c->stability.density_band);
+    c->stability.max_overlap = m->stability_max_overlap;
+    c->stability.dt_collapse = m->stability_dt_collapse;
     c->sph_dx = m->sph_dx;
     c->sph_density = m->sph_density;
     scene_sph_from_msg(&m->sph, &c->sph);

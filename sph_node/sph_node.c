@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "instability.h"
 #include "lahar_body_state_t.h"
 #include "lahar_loads_t.h"
 #include "lahar_step_t.h"
@@ -568,15 +569,131 @@ static void sph_node_crossing_message(const sph_node *s, int64_t k, double t, ch
              (long long)k, t, cp->cross_depth, (long long)cp->crossings, cp->crossings == 1 ? "" : "s");
 }
 
+/* Position of the particle with this id (a search: only after a failure), 0 if found. */
+static int sph_node_find_particle(const sph_particles *p, int64_t id, double x[3])
+{
+    for (int64_t i = 0; i < p->n; i++)
+        if (p->id[i] == id) {
+            x[0] = p->x[i], x[1] = p->y[i], x[2] = p->z[i];
+            return 0;
+        }
+    x[0] = x[1] = x[2] = NAN;
+    return -1;
+}
+
+/* The crossing of step k (sph_node_crossing_message) as an instability report. */
+static void sph_node_crossing_report(const sph_node *s, int64_t k, double t, lahar_instability *u)
+{
+    const sph_coupling *cp = &s->f.cpl;
+    int b = cp->cross_body;
+    memset(u, 0, sizeof *u);
+    snprintf(u->what, sizeof u->what, "crossing");
+    snprintf(u->kind, sizeof u->kind, "particle");
+    u->id = cp->cross_particle_id;
+    snprintf(u->name, sizeof u->name, "%s", b >= 0 && b < s->nbody ? s->ns.scene.bodies[b].name : "?");
+    sph_node_find_particle(&s->f.p, u->id, u->x);
+    u->step = k;
+    u->t = t;
+    u->value = cp->cross_depth;
+    u->limit = 0.0;
+    sph_node_crossing_message(s, k, t, u->text, sizeof u->text);
+}
+
+/* The particle checks of common/instability.h on the state after step k (time t): every
+ * position, velocity and density finite, and rho / rho0 within stability.density_band. One
+ * streaming pass counts the failures (a sum: the same for any thread count); only when there are
+ * some, a serial pass names the worst: the non-finite particle of lowest id, else the one
+ * farthest outside the band (largest |ln(rho / rho0)|, lowest id on a tie). Returns the count. */
+static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, lahar_instability *u)
+{
+    const sph_particles *p = &s->f.p;
+    const int64_t n = p->n;
+    const double rho0 = s->ns.scene.sph_density;
+    const double *band = s->ns.scene.stability.density_band;
+    const double lo = band[0] * rho0, hi = band[1] * rho0;
+    int64_t bad = 0;
+#pragma omp parallel for schedule(static) reduction(+ : bad) if (n >= SPH_OMP_MIN_LIGHT)
+    for (int64_t i = 0; i < n; i++) {
+        /* a NaN or an infinity in any component makes the sum non-finite; a NaN density fails
+         * the band test too */
+        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i];
+        bad += !(isfinite(sum) && p->rho[i] >= lo && p->rho[i] <= hi);
+    }
+    if (bad == 0)
+        return 0;
+    int64_t worst = -1, worst_nf = -1;
+    double dev_max = -1.0;
+    for (int64_t i = 0; i < n; i++) {
+        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i];
+        if (!isfinite(sum) || !isfinite(p->rho[i])) {
+            if (worst_nf < 0 || p->id[i] < p->id[worst_nf])
+                worst_nf = i;
+        } else if (!(p->rho[i] >= lo && p->rho[i] <= hi)) {
+            double dev = fabs(log(p->rho[i] / rho0));
+            if (dev > dev_max || (dev == dev_max && p->id[i] < p->id[worst])) {
+                dev_max = dev;
+                worst = i;
+            }
+        }
+    }
+    int64_t i = worst_nf >= 0 ? worst_nf : worst;
+    memset(u, 0, sizeof *u);
+    snprintf(u->kind, sizeof u->kind, "particle");
+    u->id = p->id[i];
+    u->x[0] = p->x[i], u->x[1] = p->y[i], u->x[2] = p->z[i];
+    u->step = k;
+    u->t = t;
+    const double r = p->rho[i] / rho0;
+    if (worst_nf >= 0) {
+        snprintf(u->what, sizeof u->what, "non-finite state");
+        u->value = NAN;
+        u->limit = NAN;
+        snprintf(u->text, sizeof u->text,
+                 "particle %lld has a non-finite state after step %lld (t = %.9g s): x = (%.4g, %.4g, %.4g) m, "
+                 "v = (%.3g, %.3g, %.3g) m/s, rho/rho0 = %.4g; %lld particle%s failed the checks; the last snapshot is "
+                 "that state",
+                 (long long)u->id, (long long)k, t, p->x[i], p->y[i], p->z[i], p->vx[i], p->vy[i], p->vz[i], r,
+                 (long long)bad, bad == 1 ? "" : "s");
+    } else {
+        snprintf(u->what, sizeof u->what, "density out of band");
+        u->value = r;
+        u->limit = r < band[0] ? band[0] : band[1];
+        snprintf(u->text, sizeof u->text,
+                 "particle %lld at (%.4g, %.4g, %.4g) m has rho/rho0 = %.4g outside stability.density_band [%g, %g] "
+                 "after step %lld (t = %.9g s); %lld particle%s outside; the last snapshot is that state",
+                 (long long)u->id, u->x[0], u->x[1], u->x[2], r, band[0], band[1], (long long)k, t, (long long)bad,
+                 bad == 1 ? "" : "s");
+    }
+    return bad;
+}
+
+/* The coordinator stopped the run before step k (the particles are at the end of step k - 1,
+ * time t): on a stop for an error (another node's instability, a time step collapse) the state
+ * reached is written as the final snapshot, marked with the coordinator's reason, unless a
+ * snapshot of it exists. */
+static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int64_t k, double t)
+{
+    char why[512];
+    int reason = lahar_node_stop_reason(stop, why, sizeof why);
+    if (reason <= 0 || s->f.begun)
+        return;
+    if (s->last_snapshot != k && sph_node_snapshot(s, k, t) != 0)
+        return;
+    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "stopped", why);
+}
+
 static int sph_node_loop(sph_node *s)
 {
     char err[2048];
     lahar_link_msg msg;
     const int has_dem = s->ns.has_dem && s->nbody > 0;
+    double t_now = 0.0; /* time of the state: the end of the last step taken */
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
         lahar_step_t step;
         int rc = lahar_node_wait_step(s->link, "lahar-sph", k, &msg, &step);
+        if (rc == 0)
+            sph_node_final_snapshot(s, &msg, k, t_now);
         if (rc >= 0)
             return rc;
         lahar_status_t st = {0};
@@ -632,7 +749,8 @@ static int sph_node_loop(sph_node *s)
         c0 = lahar_now();
         /* a failed BODY_STATE after step_begin leaves the particles drifted but not kicked: that
          * state is neither t_k nor t_{k+1}, so no snapshot is written for it (see below) */
-        int stepped = begun && !st.error;
+        int stepped = begun && !st.error, unstable = 0;
+        lahar_instability u;
         if (stepped) {
             cross = sph_fluid_step_end(&s->f, step.dt, has_dem ? s->states : NULL);
             sph_node_count_coupling(s);
@@ -640,8 +758,14 @@ static int sph_node_loop(sph_node *s)
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH step");
             } else if (cross > 0) {
+                sph_node_crossing_report(s, k, step.t_next, &u);
+                unstable = 1;
+            } else {
+                unstable = sph_node_check_particles(s, k, step.t_next, &u) > 0;
+            }
+            if (unstable) {
                 st.error = 1;
-                sph_node_crossing_message(s, k, step.t_next, err, sizeof err);
+                lahar_instability_encode(&u, err, sizeof err);
             }
         }
         /* on an error the state reached is kept as the last snapshot to look at: after the step,
@@ -658,6 +782,8 @@ static int sph_node_loop(sph_node *s)
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
         }
+        if (unstable && s->last_snapshot == k + 1)
+            lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
@@ -672,11 +798,13 @@ static int sph_node_loop(sph_node *s)
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
         lahar_node_send_status(s->link, ROLE, k, &st, err);
         if (st.error) {
-            fprintf(stderr, "lahar-sph: step %lld: %s\n", (long long)k, err);
+            fprintf(stderr, "lahar-sph: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
+                    unstable ? u.text : err);
             sph_node_wait_stop(s);
             return 1;
         }
         lahar_link_set_step(s->link, k);
+        t_now = step.t_next;
     }
 }
 

@@ -196,7 +196,7 @@ YAML
 import json, re, sys
 import h5py, numpy as np
 s = json.load(open(sys.argv[1] + "/summary.json"))
-assert s["status"] == "error" and s["exit_status"] == 1, s["status"]
+assert s["status"] == "unstable" and s["exit_status"] == 1, s["status"]
 m = re.search(r"particle (\d+) crossed the surface of body 0 'thin_wall' in step (\d+)", s["message"])
 assert m, s["message"]
 pid, k = int(m.group(1)), int(m.group(2))
