@@ -569,14 +569,15 @@ static double sph_node_kinetic_energy(const sph_particles *p)
 }
 
 /* The work counters of STATUS (cumulative since set-up; lcm_types/status_t.lcm). Pairs are the
- * solver's neighbour counts halved: the water pass visits each pair from both ends. No soil
- * phase yet: its pair counts stay 0 until a soil pass counts them. */
+ * solver's neighbour counts halved: every pass visits each pair from both ends (soil-soil: the
+ * soil pass; fluid-soil: the soil pass's water neighbours and the seepage pass's soil ones, both
+ * only when the soil has k_h > 0, i.e. there is seepage work). */
 static void sph_node_work(const sph_node *s, lahar_status_t *st)
 {
     st->work_passes = s->f.work_passes;
     st->work_pairs_fluid = s->f.work_neighbours_fluid / 2;
-    st->work_pairs_soil = 0;
-    st->work_pairs_fluid_soil = 0;
+    st->work_pairs_soil = s->f.work_neighbours_soil / 2;
+    st->work_pairs_fluid_soil = s->f.work_neighbours_fluid_soil / 2;
     st->work_particle_body = s->work_particle_body;
     st->work_body_body = 0;
     st->work_output_derived = s->work_output_derived;

@@ -3,7 +3,7 @@
 # ("work", coordinator/README.md) against independent counts, through `lahar run --in-process`.
 #
 #   counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: water_only | fixed_bodies | processes | output_fields | dem_contacts
+#   TEST: water_only | soil_water | fixed_bodies | processes | output_fields | dem_contacts
 #
 # water_only    a block of water without bodies, one step, 2D and 3D: no DEM node, no soil or
 #               seepage work (soil-soil and fluid-soil pairs 0), no particle-body or body-body
@@ -11,6 +11,8 @@
 #               than the kernel support (2 h) counted by brute force over the particle positions
 #               of the snapshots, summed over the particle-particle passes (the set-up pass at
 #               t_0 and the step's pass at t_1).
+# soil_water    a soil block with k_h > 0 beside a water block, one step: fluid-fluid, soil-soil
+#               and fluid-soil (seepage) pair counts each equal the brute-force count by phase.
 # fixed_bodies  water in a tank of fixed walls: no DEM node is started and no per-step body
 #               message is sent (no LOADS, BODY_STATE, and STATUS only from the SPH node); the
 #               particle-body count equals the particles within the support of each wall's
@@ -133,6 +135,48 @@ for out, support in zip(sys.argv[1::2], map(float, sys.argv[2::2])):
     assert w["pairs_fluid_fluid"] == expect, (out, w["pairs_fluid_fluid"], counts)
     print("%s: %d particles, %d + %d pairs within %.3f m by brute force = pairs_fluid_fluid %d; soil, seepage, "
           "body work 0" % (out, n, counts[0], counts[1], support, w["pairs_fluid_fluid"]))
+PY
+    ;;
+soil_water)
+    # a soil block (k_h > 0: seepage) beside a water block, one step
+    cat > sw.yaml <<'YAML'
+dimensions: 2
+gravity: [0, -9.81]
+time: {end: 1e-6, dt_max: 1e-3, output_interval: 1e-6}
+materials:
+  sand: {model: soil, density: 2000, young: 1.0e6, poisson: 0.3, friction_angle: 30, cohesion: 0, permeability: 0.01}
+sph:
+  dx: 0.01
+  kernel: cubic
+  h_over_dx: 1.3
+  c0: 15
+  blocks:
+    - {name: soil, phase: soil, material: sand, box: {lo: [0, 0], hi: [0.1, 0.06]}}
+    - {name: water, box: {lo: [0.1, 0], hi: [0.2, 0.06]}}
+YAML
+    run sw.yaml sw
+    "$python" - sw 0.026 <<'PY' || fail "soil and water work"
+import json, sys
+import h5py, numpy as np
+out, support = sys.argv[1], float(sys.argv[2])
+s = json.load(open(out + "/summary.json"))
+w = s["work"]
+assert s["status"] == "finished" and s["steps"] == 1, (s["status"], s["steps"], s["message"])
+def pairs(x, ph):
+    d2 = ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)
+    iu = np.triu_indices(len(x), 1)
+    near = d2[iu] < support * support
+    a, b = ph[iu[0]], ph[iu[1]]
+    return (int((near & (a == 0) & (b == 0)).sum()), int((near & (a != 0) & (b != 0)).sum()),
+            int((near & (a != b)).sum()))
+with h5py.File(out + "/particles.h5", "r") as f:
+    c = [pairs(np.stack([np.asarray(g[a]) for a in "xy"], axis=1), np.asarray(g["phase"]))
+         for g in (f["snapshots"][k] for k in sorted(f["snapshots"]))]
+assert len(c) == 2 and w["sph_passes"] == 2, (len(c), w["sph_passes"])
+got = (w["pairs_fluid_fluid"], w["pairs_soil_soil"], w["pairs_fluid_soil"])
+expect = tuple(c[0][i] + c[1][i] for i in range(3))
+assert got == expect and min(expect) > 0, (got, expect)
+print("soil_water: fluid-fluid %d, soil-soil %d, fluid-soil %d pairs = brute force over both states" % got)
 PY
     ;;
 fixed_bodies)
