@@ -303,8 +303,10 @@ static void fluid_rates_particles(sph_fluid *f)
         sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k);
     fluid_pass(f);
     if (f->has_soil) {
-        sph_soil_momentum(&f->soil, p, &f->cells, &f->k);
-        sph_soil_water_seepage(&f->soil, p, &f->cells, &f->k); /* 000 eq. 8, when k_h > 0 */
+        int64_t soil_water = 0;
+        f->work_neighbours_soil += sph_soil_momentum(&f->soil, p, &f->cells, &f->k, &soil_water);
+        /* 000 eq. 8, when k_h > 0 */
+        f->work_neighbours_fluid_soil += soil_water + sph_soil_water_seepage(&f->soil, p, &f->cells, &f->k);
     }
 }
 

@@ -100,9 +100,11 @@ typedef struct {
      * particle-particle passes, and the neighbours (i, j), j != i, within the kernel support that
      * the water pass summed over, counted once per particle i (each pair twice in gather form).
      * The count is a register increment in the pair loop summed by the pass's reduction: integer,
-     * so the same for any thread count. A soil pass adds its own counts next to these. */
+     * so the same for any thread count. The soil passes count theirs the same way. */
     int64_t work_passes;
     int64_t work_neighbours_fluid;
+    int64_t work_neighbours_soil;       /* soil pass: soil neighbours of soil particles */
+    int64_t work_neighbours_fluid_soil; /* seepage: water neighbours of soil + soil neighbours of water */
 } sph_fluid;
 
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the

@@ -228,6 +228,8 @@ typedef struct {
     double kinetic_energy;       /* of the last snapshot (J, J/m in 2D) */
 } sph_node;
 
+static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t);
+
 /* A particle snapshot of the fields the case writes (output.fields), nothing else: unselected
  * fields are neither gathered nor computed. The pressure written is the EOS of the density
  * written (000 eq. 3 / 003 eq. 19), computed here only when the case writes pressure: the
@@ -261,7 +263,19 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
         for (int a = 0; a < SPH_NSTRESS; a++)
             v.stress[a] = p->sig[a];
     s->last_snapshot = step;
-    return lahar_particle_output_snapshot(s->out, step, t, &v);
+    int rc = lahar_particle_output_snapshot(s->out, step, t, &v);
+    /* fixed bodies only: the body snapshot of the same step, as the DEM node would write it */
+    if (s->fixed_only && sph_node_fixed_snapshot(s, step, t) != 0)
+        rc = -1;
+    return rc;
+}
+
+/* Mark the last snapshot of the files this node writes (common/output.h). */
+static void sph_node_mark_last(const sph_node *s, const char *name, const char *text)
+{
+    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", name, text);
+    if (s->fixed_only)
+        lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", name, text);
 }
 
 static int sph_node_wait_stop(sph_node *s)
@@ -555,14 +569,15 @@ static double sph_node_kinetic_energy(const sph_particles *p)
 }
 
 /* The work counters of STATUS (cumulative since set-up; lcm_types/status_t.lcm). Pairs are the
- * solver's neighbour counts halved: the water pass visits each pair from both ends. No soil
- * phase yet: its pair counts stay 0 until a soil pass counts them. */
+ * solver's neighbour counts halved: every pass visits each pair from both ends (soil-soil: the
+ * soil pass; fluid-soil: the soil pass's water neighbours and the seepage pass's soil ones, both
+ * only when the soil has k_h > 0, i.e. there is seepage work). */
 static void sph_node_work(const sph_node *s, lahar_status_t *st)
 {
     st->work_passes = s->f.work_passes;
     st->work_pairs_fluid = s->f.work_neighbours_fluid / 2;
-    st->work_pairs_soil = 0;
-    st->work_pairs_fluid_soil = 0;
+    st->work_pairs_soil = s->f.work_neighbours_soil / 2;
+    st->work_pairs_fluid_soil = s->f.work_neighbours_fluid_soil / 2;
     st->work_particle_body = s->work_particle_body;
     st->work_body_body = 0;
     st->work_output_derived = s->work_output_derived;
@@ -709,7 +724,7 @@ static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int
         return;
     if (s->last_snapshot != k && sph_node_snapshot(s, k, t) != 0)
         return;
-    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "stopped", why);
+    sph_node_mark_last(s, "stopped", why);
 }
 
 static int sph_node_loop(sph_node *s)
@@ -802,18 +817,12 @@ static int sph_node_loop(sph_node *s)
          * or at t_k when the step was not taken (unless a snapshot of t_k exists) */
         if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
-            snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
+            snprintf(err, sizeof err, "cannot write a snapshot in %s", s->ns.output_dir);
         } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
-        /* fixed bodies only: their snapshots, as the DEM node writes them (after each step) */
-        if (s->fixed_only && (step.write_output || st.error) && sph_node_fixed_snapshot(s, k + 1, step.t_next) != 0 &&
-            !st.error) {
-            st.error = 1;
-            snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
-        }
         if (unstable && s->last_snapshot == k + 1)
-            lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
+            sph_node_mark_last(s, "instability", u.text);
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;

@@ -192,7 +192,9 @@ void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, co
             soil_stress_particle(s, p, c, k, i);
 }
 
-static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int64_t i)
+/* Returns the soil neighbours summed over; *nwater the water neighbours (seepage only). */
+static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                                      int64_t i, int64_t *nwater)
 {
     const double *g = s->mat.gravity;
     const double h = k->h, inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
@@ -208,9 +210,11 @@ static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sp
     }
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
     const double seep = s->seep, wnorm = k->norm;
+    int64_t nsoil = 0, nw = 0; /* work counters */
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
         if (p->phase[j] != SPH_SOIL_PHASE) {
             if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
+                nw++;
                 double r = sqrt(r2), q = r * inv_h;
                 double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
                 double c1 = p->m[j] / (p->rho[j] * rhoi);
@@ -221,6 +225,7 @@ static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sp
             }
             continue;
         }
+        nsoil++;
         double r = sqrt(r2);
         double q = r * inv_h;
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
@@ -248,25 +253,35 @@ static void soil_momentum_particle(const sph_soil *s, sph_particles *p, const sp
     p->ax[i] = ax + g[0] - cd * vxi;
     p->ay[i] = ay + g[1] - cd * vyi;
     p->az[i] = az + g[2] - cd * vzi;
+    *nwater = nw;
+    return nsoil;
 }
 
-void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                          int64_t *water_neighbours)
 {
     const int64_t n = p->n;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    int64_t nsoil = 0, nwater = 0; /* integer sums: exact in any order */
+#pragma omp parallel for schedule(static) reduction(+ : nsoil, nwater) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
-        if (p->phase[i] == SPH_SOIL_PHASE)
-            soil_momentum_particle(s, p, c, k, i);
+        if (p->phase[i] == SPH_SOIL_PHASE) {
+            int64_t nw = 0;
+            nsoil += soil_momentum_particle(s, p, c, k, i, &nw);
+            nwater += nw;
+        }
+    *water_neighbours = nwater;
+    return nsoil;
 }
 
-void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+int64_t sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
 {
     const int64_t n = p->n;
     const double seep = s->seep, inv_h = k->inv_h, dnorm = k->dnorm, wnorm = k->norm, s2 = k->support * k->support;
     const kernel_kind kind = k->kind;
     if (!(seep > 0.0))
-        return;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+        return 0;
+    int64_t nsoil = 0; /* work counter: soil neighbours of the water particles */
+#pragma omp parallel for schedule(static) reduction(+ : nsoil) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         if (p->phase[i] == SPH_SOIL_PHASE)
             continue;
@@ -275,6 +290,7 @@ void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells
         SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
             if (p->phase[j] != SPH_SOIL_PHASE)
                 continue;
+            nsoil++;
             double r = sqrt(r2), q = r * inv_h;
             double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0; /* grad_f W_fs = F x_fs */
             double c1 = p->m[j] / (rhoi * p->rho[j]);
@@ -287,6 +303,7 @@ void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells
         p->ay[i] += ay;
         p->az[i] += az;
     }
+    return nsoil;
 }
 
 void sph_soil_kick_begin(const sph_soil *s, sph_particles *p, int64_t i, double hdt)

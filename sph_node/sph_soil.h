@@ -98,8 +98,11 @@ void sph_soil_free(sph_soil *s);
  * p = -tr(sigma)/3. Particles sorted, cells valid. */
 void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
 /* Pass 2: per soil particle, drho/dt and dv/dt (with the material's gravity) into p->drho, ax, ay,
- * az. Water particles are left alone. */
-void sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
+ * az. Water particles are left alone. Returns the soil neighbours (i, j) within the support summed
+ * over (work counter, each soil-soil pair twice) and the water neighbours of the soil particles in
+ * *water_neighbours (0 without seepage). */
+int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                          int64_t *water_neighbours);
 
 /* Tension cracking and the return to the yield surface (Bui 2008 section 3.3) of one stress
  * (xx, xy, xz, yy, yz, zz), in place. */
@@ -107,7 +110,8 @@ void sph_soil_return(const sph_soil *s, double sig[SPH_NSTRESS]);
 
 /* Seepage (sph_soil.h, paper 000 eq. 8-10) on the water particles: their reaction to every soil
  * neighbour, added to p->ax.. after the water pass. No-op when s->seep is 0. */
-void sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
+int64_t sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
+/* (returns the soil neighbours of the water particles summed over: work counter, 0 without seepage) */
 
 /* The integrator's stress updates of soil particle i (the other phases are skipped by the
  * caller): begin: sigh = sig + hdt dsig, predicted sig = sigh + hdt dsig; end: sig = sigh + hdt dsig;
