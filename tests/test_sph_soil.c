@@ -13,11 +13,16 @@
  *  5. a water-only fluid allocates no stress arrays;
  *  6. seepage (000 eq. 8-10): water moving at u through a resting soil on the same periodic
  *     lattice: the water's acceleration is -(g/k_h) u (sum_s V_s W = 1) within 1 %, and the
- *     water-soil forces cancel pair by pair: |sum_i m_i (a_i - b_i)| < 1e-12 of sum_water m |a - b|. */
+ *     water-soil forces cancel pair by pair: |sum_i m_i (a_i - b_i)| < 1e-12 of sum_water m |a - b|;
+ *  7. soil-DEM friction (000 eq. 22-27) of soil particles sliding on a fixed plate: after one
+ *     evaluation F_t = -K_n dt u_tau (to 1e-12), the body takes -F; after enough evaluations the
+ *     spring is capped, |F_t| = mu_phi |F_n|; the spring follows its particle id through a sort that
+ *     swaps the particles; leaving the halo releases it (a new contact starts from dt u again). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "shape_build.h"
 #include "sph_fluid.h"
 
 #include "test_util.h"
@@ -230,6 +235,86 @@ static void test_seepage(void)
     sph_fluid_free(&f);
 }
 
+/* Particle id's tangential force (x) after an evaluation of the coupling alone. */
+static double friction_x(sph_fluid *f, int64_t id, double dt)
+{
+    for (int64_t i = 0; i < f->p.n; i++)
+        f->p.ax[i] = f->p.ay[i] = f->p.az[i] = 0.0;
+    sph_coupling_apply(&f->cpl, &f->p, NULL, dt);
+    for (int64_t i = 0; i < f->p.n; i++)
+        if (f->p.id[i] == id)
+            return f->p.ax[i] * f->p.m[i];
+    return NAN;
+}
+
+static void test_friction(void)
+{
+    const double dt = 1e-4, mu = 0.5, uA = 0.2, uB = -0.1;
+    lahar_body plate;
+    memset(&plate, 0, sizeof plate);
+    double half[2] = {1.0, 0.02}, t[3] = {0.0, -0.03, 0.0}; /* swept top surface at y = 0 */
+    lahar_shape_make_box2d(&plate.shape, half, 0.01);
+    lahar_shape_transform(&plate.shape, NULL, t, 1.0);
+    plate.motion = LAHAR_MOTION_FIXED;
+    plate.convex = 1;
+    plate.q[0] = 1.0;
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    prm.soil = 1;
+    prm.soil_mat = sand(30.0, 0.0);
+    prm.soil_mat.mu_phi = mu;
+    sph_fluid f;
+    char err[256];
+    if (sph_fluid_init(&f, &prm, 2, err, sizeof err) != 0) {
+        CHECK(0, "init: %s", err);
+        lahar_shape_free(&plate.shape);
+        return;
+    }
+    const double eps = 0.5 * DX, depth = 0.2 * eps, m = RHO * DX * DX;
+    double xa[3] = {0.5, eps - depth, 0.0}, va[3] = {uA, 0.0, 0.0}; /* id 0, right */
+    double xb[3] = {0.0, eps - depth, 0.0}, vb[3] = {uB, 0.0, 0.0}; /* id 1, left */
+    sph_particles_add(&f.p, xa, va, m, RHO, SPH_SOIL_PHASE);
+    sph_particles_add(&f.p, xb, vb, m, RHO, SPH_SOIL_PHASE);
+    sph_fluid_attach_bodies(&f, 1, &plate);
+    const double kn = 0.1 * m / (dt * dt), fn = kn * depth;
+    double fa = friction_x(&f, 0, dt);
+    CHECK(fabs(fa + kn * dt * uA) < 1e-12 * kn * dt * uA, "first step: F_t %.12g vs -K_n dt u = %.12g", fa,
+          -kn * dt * uA);
+    CHECK(fabs(f.cpl.force[0][0] - kn * dt * (uA + uB)) < 1e-9 * kn * dt * uA, "the plate takes -F_t: %g vs %g",
+          f.cpl.force[0][0], kn * dt * (uA + uB));
+    CHECK(fabs(f.cpl.force[0][1] + 2.0 * fn) < 1e-9 * fn, "and -F_n: %g vs %g", f.cpl.force[0][1], -2.0 * fn);
+    int64_t before = f.p.id[0];
+    sph_cells_sort(&f.cells, &f.p); /* B (left) comes first now */
+    CHECK(f.p.id[0] != before, "the sort swaps the two particles (test premise)");
+    double fb = friction_x(&f, 1, dt);
+    fa = 0.0;
+    for (int64_t i = 0; i < f.p.n; i++)
+        if (f.p.id[i] == 0)
+            fa = f.p.ax[i] * f.p.m[i];
+    CHECK(fabs(fa + 2.0 * kn * dt * uA) < 1e-9 * kn * dt * uA && fabs(fb + 2.0 * kn * dt * uB) < 1e-9 * kn * dt * fabs(uB),
+          "the springs follow their ids through the sort: %g vs %g, %g vs %g", fa, -2.0 * kn * dt * uA, fb,
+          -2.0 * kn * dt * uB);
+    for (int s = 0; s < 200; s++) /* slip: the spring is capped at mu F_n / K_n */
+        fa = friction_x(&f, 0, dt);
+    CHECK(fabs(fabs(fa) - mu * fn) < 1e-12 * mu * fn && fa < 0.0, "capped: |F_t| %.12g vs mu F_n %.12g", fabs(fa),
+          mu * fn);
+    for (int64_t i = 0; i < f.p.n; i++) /* out of the halo: released */
+        f.p.y[i] = eps + 0.5 * eps;
+    friction_x(&f, 0, dt);
+    for (int64_t i = 0; i < f.p.n; i++)
+        f.p.y[i] = eps - depth;
+    fa = friction_x(&f, 0, dt);
+    CHECK(fabs(fa + kn * dt * uA) < 1e-9 * kn * dt * uA, "released on leaving the halo: F_t %g vs %g", fa,
+          -kn * dt * uA);
+    printf("friction: first step, sort, cap at mu F_n = %.6g N/m, release: checked\n", mu * fn);
+    sph_fluid_free(&f);
+    lahar_shape_free(&plate.shape);
+}
+
 int main(void)
 {
     test_return();
@@ -237,6 +322,7 @@ int main(void)
     test_jaumann_and_uniform();
     test_water_only();
     test_seepage();
+    test_friction();
     if (failures)
         fprintf(stderr, "%d check(s) failed\n", failures);
     return failures != 0;
