@@ -45,10 +45,22 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         sph_particles_free(&f->p);
         return -1;
     }
+    f->prho2 = calloc((size_t)f->p.cap, sizeof(double));
+    f->vol = calloc((size_t)f->p.cap, sizeof(double));
+    if (!f->prho2 || !f->vol) {
+        free(f->prho2);
+        free(f->vol);
+        sph_cells_free(&f->cells);
+        sph_particles_free(&f->p);
+        snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)cap);
+        return -1;
+    }
     if (p->sps) {
         /* nu_t and the six stress components in one block, only when SPS is on */
         double *buf = calloc((size_t)f->p.cap * 7, sizeof(double));
         if (!buf) {
+            free(f->prho2);
+            free(f->vol);
             sph_cells_free(&f->cells);
             sph_particles_free(&f->p);
             snprintf(err, (size_t)errlen, "out of memory for the SPS stress of %lld particles", (long long)cap);
@@ -84,6 +96,8 @@ void sph_fluid_free(sph_fluid *f)
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
     free(f->sps_nut);
+    free(f->prho2);
+    free(f->vol);
     sph_cells_free(&f->cells);
     sph_particles_free(&f->p);
     memset(f, 0, sizeof *f);
@@ -96,25 +110,36 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
     return prm->c0 * prm->c0 * (rho - prm->rho0); /* 000 eq. 3 */
 }
 
-/* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
- * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
-static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, int64_t i,
-                                  double out[4])
+/* Sums over the neighbours of particle i (gather). `kind`, `sps` and `dim` are compile-time
+ * constants at each call site of the switch in fluid_pass, so the kernel evaluation inlines
+ * without a branch per pair and 2D reads no z components. Per pair: one square root and one
+ * division (1/(r^2 + eta^2)); p_j/rho_j^2 and V_j = m_j/rho_j come precomputed (f->prho2, f->vol,
+ * filled with the EOS), W'/r = dnorm/h f'(q)/q (kernel_dshape_over_q). The phase of j is not read
+ * yet (water only); a phase-dependent term would be a compile-time variant like `sps`. */
+static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int dim,
+                                  int64_t i, double out[4])
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
     const sph_params *prm = &f->prm;
-    const double h = f->k.h, inv_h = f->k.inv_h, dnorm = f->k.dnorm, s2 = f->k.support * f->k.support;
+    const double *const vxa = p->vx, *const vya = p->vy, *const vza = p->vz, *const rhoa = p->rho,
+                 *const ma = p->m, *const pra = f->prho2, *const vola = f->vol;
+    const double h = f->k.h, inv_h = f->k.inv_h, fnorm = f->k.dnorm * f->k.inv_h,
+                 s2 = f->k.support * f->k.support;
     const double eta2 = 0.01 * h * h;
-    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
-    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
-    const double rhoi = p->rho[i], pi_ = p->p[i], pri = pi_ / (rhoi * rhoi), mui = prm->mu;
+    const double xi = p->x[i], yi = p->y[i], zi = dim == 2 ? 0.0 : p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = dim == 2 ? 0.0 : p->vz[i];
+    const double rhoi = p->rho[i], pri = pra[i];
+    /* Morris: m_j (mu_i + mu_j)/(rho_i rho_j) = V_j (mu_i + mu_j)/rho_i */
+    const double visci = (prm->mu + prm->mu) / rhoi;
     const double c0 = prm->c0, alpha = prm->alpha, ddelta = 2.0 * prm->delta * h * c0;
+    /* Monaghan: Pi_ij = -alpha c0 h v_ij.x_ij/(r^2 + eta^2) / rho_ij, rho_ij = (rho_i + rho_j)/2 */
+    const double av = 2.0 * alpha * c0 * h;
     /* hydrostatic density difference per unit x_ij, rho0 b / c0^2, from the body force along the
      * non-periodic axes (Fourtakas et al. 2019): delta-SPH diffuses only the deviation from it */
     const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
                  hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
-                 hz = prm->periodic[2] ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
+                 hz = prm->periodic[2] || dim == 2 ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
     /* SPS stress of i over rho_i^2 (003 eq. 10); unused when sps is 0 */
     double ti[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     double *const *tau = f->sps_tau;
@@ -122,33 +147,36 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
         for (int a = 0; a < 6; a++)
             ti[a] = tau[a][i] / (rhoi * rhoi);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
-    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
-        double r = sqrt(r2);
-        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
-        double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
-        double rhoj = p->rho[j], mj = p->m[j], vj = mj / rhoj;
-        double vdotr = vx * rx + vy * ry + vz * rz;
-        double rsoft = r2 / (r2 + eta2);
+    SPH_FOR_EACH_NEIGHBOUR_D(c, p, i, xi, yi, zi, s2, dim, {
+        const double r = sqrt(r2);
+        const double fij = fnorm * kernel_dshape_over_q(kind, r * inv_h); /* W'/r */
+        const double vx = vxi - vxa[j], vy = vyi - vya[j], vz = dim == 2 ? 0.0 : vzi - vza[j];
+        const double rhoj = rhoa[j], volj = vola[j];
+        const double vdotr = vx * rx + vy * ry + vz * rz;
+        const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
+        const double vf = volj * fij;
         /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
-        double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
-        drho += rhoi * vj * vdotr * fij + ddelta * vj * drho_dev * fij * rsoft;
-        /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij */
-        double pij = pri + p->p[j] / (rhoj * rhoj);
-        if (alpha > 0.0 && vdotr < 0.0) /* Pi_ij = -alpha c0 mu_ij / rho_ij > 0 */
-            pij -= alpha * c0 * (h * vdotr / (r2 + eta2)) / (0.5 * (rhoi + rhoj));
-        double gp = -mj * pij * fij;
+        const double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
+        drho += vf * (rhoi * vdotr + ddelta * drho_dev * rsoft);
+        /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij > 0 when approaching */
+        double pij = pri + pra[j];
+        if (alpha > 0.0 && vdotr < 0.0)
+            pij -= av * vdotr * ieta / (rhoi + rhoj);
+        const double gp = -ma[j] * pij * fij;
         /* laminar viscosity, Morris 1997 */
-        double gv = mj * (mui + prm->mu) / (rhoi * rhoj) * fij * rsoft;
+        const double gv = visci * vf * rsoft;
         ax += gp * rx + gv * vx;
         ay += gp * ry + gv * vy;
-        az += gp * rz + gv * vz;
+        if (dim == 3)
+            az += gp * rz + gv * vz;
         if (sps) { /* 003 eq. 10, third term: sum_j m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
-            double irj2 = 1.0 / (rhoj * rhoj), mf = mj * fij;
+            double irj2 = 1.0 / (rhoj * rhoj), mf = ma[j] * fij;
             double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2, txz = ti[2] + tau[2][j] * irj2;
             double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2, tzz = ti[5] + tau[5][j] * irj2;
             ax += mf * (txx * rx + txy * ry + txz * rz);
             ay += mf * (txy * rx + tyy * ry + tyz * rz);
-            az += mf * (txz * rx + tyz * ry + tzz * rz);
+            if (dim == 3)
+                az += mf * (txz * rx + tyz * ry + tzz * rz);
         }
     });
     out[0] = drho;
@@ -212,19 +240,22 @@ static void fluid_pass(sph_fluid *f)
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
-    const int sps = f->prm.sps != 0;
+    const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
-        /* kind and sps constant per call site: the pair loop inlines without their branches */
+        /* kind, sps and dim constant per call site: the pair loop inlines without their branches */
+#define FLUID_PARTICLE_DIM(K, S)                                                                   \
+    (d3 ? fluid_particle(f, K, S, 3, i, out) : fluid_particle(f, K, S, 2, i, out))
         switch (kind * 2 + sps) {
-        case KERNEL_QUINTIC * 2: fluid_particle(f, KERNEL_QUINTIC, 0, i, out); break;
-        case KERNEL_QUINTIC * 2 + 1: fluid_particle(f, KERNEL_QUINTIC, 1, i, out); break;
-        case KERNEL_WENDLAND2 * 2: fluid_particle(f, KERNEL_WENDLAND2, 0, i, out); break;
-        case KERNEL_WENDLAND2 * 2 + 1: fluid_particle(f, KERNEL_WENDLAND2, 1, i, out); break;
-        case KERNEL_CUBIC * 2 + 1: fluid_particle(f, KERNEL_CUBIC, 1, i, out); break;
-        default: fluid_particle(f, KERNEL_CUBIC, 0, i, out); break;
+        case KERNEL_QUINTIC * 2: FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 0); break;
+        case KERNEL_QUINTIC * 2 + 1: FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 1); break;
+        case KERNEL_WENDLAND2 * 2: FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 0); break;
+        case KERNEL_WENDLAND2 * 2 + 1: FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 1); break;
+        case KERNEL_CUBIC * 2 + 1: FLUID_PARTICLE_DIM(KERNEL_CUBIC, 1); break;
+        default: FLUID_PARTICLE_DIM(KERNEL_CUBIC, 0); break;
         }
+#undef FLUID_PARTICLE_DIM
         p->drho[i] = out[0];
         p->ax[i] = out[1];
         p->ay[i] = out[2];
@@ -261,9 +292,14 @@ static void fluid_rates_particles(sph_fluid *f)
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const sph_params prm = f->prm;
+    double *const prho2 = f->prho2, *const vol = f->vol;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
-    for (int64_t i = 0; i < n; i++)
-        p->p[i] = sph_fluid_pressure(&prm, p->rho[i]);
+    for (int64_t i = 0; i < n; i++) {
+        const double rho = p->rho[i], pr = sph_fluid_pressure(&prm, rho);
+        p->p[i] = pr;
+        prho2[i] = pr / (rho * rho);
+        vol[i] = p->m[i] / rho;
+    }
     if (prm.sps)
         fluid_sps_pass(f);
     fluid_pass(f);

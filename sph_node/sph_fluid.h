@@ -89,6 +89,9 @@ typedef struct {
     double *sps_nut;
     double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
     double *sps_tau[6];
+    /* per particle, in the sorted order of the last evaluation, filled with the EOS so that the
+     * pair loop divides nothing per pair: p_i / rho_i^2 and the volume m_i / rho_i */
+    double *prho2, *vol;
 } sph_fluid;
 
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the
