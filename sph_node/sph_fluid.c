@@ -116,7 +116,7 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
  * division (1/(r^2 + eta^2)); p_j/rho_j^2 and V_j = m_j/rho_j come precomputed (f->prho2, f->vol,
  * filled with the EOS), W'/r = dnorm/h f'(q)/q (kernel_dshape_over_q). The phase of j is not read
  * yet (water only); a phase-dependent term would be a compile-time variant like `sps`. */
-static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int dim,
+static inline __attribute__((always_inline)) void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int dim,
                                   int64_t i, double out[4])
 {
     const sph_particles *p = &f->p;
@@ -147,36 +147,43 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
         for (int a = 0; a < 6; a++)
             ti[a] = tau[a][i] / (rhoi * rhoi);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
-    SPH_FOR_EACH_NEIGHBOUR_D(c, p, i, xi, yi, zi, s2, dim, {
-        const double r = sqrt(r2);
-        const double fij = fnorm * kernel_dshape_over_q(kind, r * inv_h); /* W'/r */
-        const double vx = vxi - vxa[j], vy = vyi - vya[j], vz = dim == 2 ? 0.0 : vzi - vza[j];
-        const double rhoj = rhoa[j], volj = vola[j];
-        const double vdotr = vx * rx + vy * ry + vz * rz;
-        const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
-        const double vf = volj * fij;
-        /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
-        const double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
-        drho += vf * (rhoi * vdotr + ddelta * drho_dev * rsoft);
-        /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij > 0 when approaching */
-        double pij = pri + pra[j];
-        if (alpha > 0.0 && vdotr < 0.0)
-            pij -= av * vdotr * ieta / (rhoi + rhoj);
-        const double gp = -ma[j] * pij * fij;
-        /* laminar viscosity, Morris 1997 */
-        const double gv = visci * vf * rsoft;
-        ax += gp * rx + gv * vx;
-        ay += gp * ry + gv * vy;
-        if (dim == 3)
-            az += gp * rz + gv * vz;
-        if (sps) { /* 003 eq. 10, third term: sum_j m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
-            double irj2 = 1.0 / (rhoj * rhoj), mf = ma[j] * fij;
-            double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2, txz = ti[2] + tau[2][j] * irj2;
-            double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2, tzz = ti[5] + tau[5][j] * irj2;
-            ax += mf * (txx * rx + txy * ry + txz * rz);
-            ay += mf * (txy * rx + tyy * ry + tyz * rz);
+    /* (an `omp simd` reduction over a chunk was measured slower with SSE2: 1.38 vs 1.19 s) */
+    SPH_NEIGHBOUR_CHUNKS_D(c, p, i, xi, yi, zi, s2, dim, {
+        for (int k = 0; k < nb_n; k++) {
+            const int64_t j = nb_j[k];
+            const double rx = nb_xi - nb_x[j], ry = nb_yi - nb_y[j], rz = dim == 2 ? 0.0 : nb_zi - nb_z[j];
+            const double r2 = rx * rx + ry * ry + rz * rz;
+            const double r = sqrt(r2);
+            const double fij = fnorm * kernel_dshape_over_q(kind, r * inv_h); /* W'/r */
+            const double vx = vxi - vxa[j], vy = vyi - vya[j], vz = dim == 2 ? 0.0 : vzi - vza[j];
+            const double rhoj = rhoa[j], volj = vola[j];
+            const double vdotr = vx * rx + vy * ry + vz * rz;
+            const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
+            const double vf = volj * fij;
+            /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
+            const double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
+            drho += vf * (rhoi * vdotr + ddelta * drho_dev * rsoft);
+            /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij > 0 when approaching
+             * (av = 0 without artificial viscosity) */
+            const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
+            const double gp = -ma[j] * (pri + pra[j] - pav) * fij;
+            /* laminar viscosity, Morris 1997 */
+            const double gv = visci * vf * rsoft;
+            ax += gp * rx + gv * vx;
+            ay += gp * ry + gv * vy;
             if (dim == 3)
-                az += mf * (txz * rx + tyz * ry + tzz * rz);
+                az += gp * rz + gv * vz;
+            if (sps) { /* 003 eq. 10, third term: sum_j m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
+                const double irj2 = 1.0 / (rhoj * rhoj), mf = ma[j] * fij;
+                const double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2,
+                             txz = ti[2] + tau[2][j] * irj2;
+                const double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2,
+                             tzz = ti[5] + tau[5][j] * irj2;
+                ax += mf * (txx * rx + txy * ry + txz * rz);
+                ay += mf * (txy * rx + tyy * ry + tyz * rz);
+                if (dim == 3)
+                    az += mf * (txz * rx + tyz * ry + tzz * rz);
+            }
         }
     });
     out[0] = drho;
