@@ -2,7 +2,7 @@
  * API; the tank walls are fixed DEM bodies seen through the coupling of sph_coupling.h), stepped
  * N times on 1 and 2 threads from the same initial state. Prints one table row per case and
  * thread count: particles, steps, wall time, CPU time (all threads), particle-steps per second, speed-up over 1 thread,
- * bytes per particle (heap held by the solver, measured with mallinfo2), and a digest of the final
+ * bytes per particle (heap held by the solver after the steps, measured with mallinfo2), and a digest of the final
  * state (equal digest = bitwise equal result). Never fails on time.
  *
  *   2d  80,000 water particles: a 0.4 x 0.8 m column at dx = 2 mm in a 1.6 m tank (the set-up of
@@ -237,10 +237,10 @@ static void run_case(bench_case *c, int steps, const int *thr, int nthr, const c
         size_t h0 = heap_bytes();
         sph_fluid f;
         setup(c, &f);
-        size_t bytes = heap_bytes() - h0;
         double t0 = now(), c0 = cpu_now();
         int rc = bench_measure(&f, steps);
         double wall_s = now() - t0, cpu_s = cpu_now() - c0;
+        size_t bytes = heap_bytes() - h0; /* after the steps: with the grown cell table and contact list */
         if (rc != 0) {
             fprintf(stderr, "bench_sph: %s: a step failed (%lld crossings)\n", c->name, (long long)f.crossings);
             sph_fluid_free(&f);
