@@ -37,8 +37,29 @@ int sph_particles_init(sph_particles *p, int64_t cap)
     return 0;
 }
 
+int sph_particles_alloc_stress(sph_particles *p)
+{
+    if (p->sig[0])
+        return 0;
+    int ok = 1;
+    for (int k = 0; k < SPH_NSTRESS; k++) {
+        ok &= (p->sig[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
+        ok &= (p->sigh[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
+    }
+    if (!ok) {
+        for (int k = 0; k < SPH_NSTRESS; k++) {
+            free(p->sig[k]), free(p->sigh[k]);
+            p->sig[k] = p->sigh[k] = NULL;
+        }
+        return -1;
+    }
+    return 0;
+}
+
 void sph_particles_free(sph_particles *p)
 {
+    for (int k = 0; k < SPH_NSTRESS; k++)
+        free(p->sig[k]), free(p->sigh[k]);
     double **a[SPH_NDOUBLE];
     particle_doubles(p, a);
     for (int k = 0; k < SPH_NDOUBLE; k++)
@@ -246,14 +267,18 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     for (int64_t i = 0; i < n; i++)
         c->perm[c->count[c->cell_of[i]]++] = i;
     /* permute the particle arrays (gathers, one parallel region) and cell_of into the new order */
-    double **a[SPH_NSORTED];
+    double **a[SPH_NSORTED + 2 * SPH_NSTRESS];
     sorted_doubles(p, a);
+    int na = SPH_NSORTED;
+    if (p->sig[0]) /* soil stress and its half-step value */
+        for (int k = 0; k < SPH_NSTRESS; k++)
+            a[na++] = &p->sig[k], a[na++] = &p->sigh[k];
     const int64_t *perm = c->perm;
     int64_t *cell_of = c->cell_of;
     /* each array is gathered into the scratch array, which then takes its place */
 #pragma omp parallel if (par)
     {
-        for (int k = 0; k < SPH_NSORTED; k++) {
+        for (int k = 0; k < na; k++) {
             const double *src = *a[k];
             double *out = p->scratch_d;
 #pragma omp for schedule(static)
