@@ -102,7 +102,8 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
  * rz, r2 = x_i - (image of x_j) and its squared length. Particle i is at (XI, YI, ZI). Periodic
  * images are taken across periodic axes (>= 3 cells each, so no pair is seen twice).
  * SPH_FOR_EACH_NEIGHBOUR_D takes the dimension DIM as a compile-time constant (2: z and rz are not
- * read, rz = 0), or 0 for the cells' own. The body must not `continue` or `break`.
+ * read, rz = 0), or 0 for the cells' own. `continue` in the body goes to the next neighbour;
+ * the body must not `break`.
  * Speed: the cells of a row along x are contiguous in the sorted arrays, so a row of the stencil is
  * one run of candidates (one run per cell only where a periodic x axis wraps); each run is scanned in chunks of
  * SPH_NB_CHUNK: the squared distances of a chunk are computed and the neighbours compacted into a
