@@ -91,6 +91,24 @@ static inline double kernel_dshape(kernel_kind kind, double q)
     }
 }
 
+/* df/dq divided by q, so that W'(r)/r = dnorm / h * kernel_dshape_over_q(q) needs no division by r
+ * in the pair loops (Wendland C2: -5 (1 - q/2)^3; cubic q < 1: -3 + 9/4 q). The limit at q = 0 for
+ * the Wendland and cubic kernels, 0 there for the quintic (where df/dq = 0 too). */
+static inline double kernel_dshape_over_q(kernel_kind kind, double q)
+{
+    switch (kind) {
+    case KERNEL_CUBIC:
+        if (q < 1.0) return -3.0 + 2.25 * q;
+        if (q < 2.0) { double a = 2.0 - q; return -0.75 * a * a / q; }
+        return 0.0;
+    case KERNEL_WENDLAND2:
+        if (q < 2.0) { double a = 1.0 - 0.5 * q; return -5.0 * a * a * a; }
+        return 0.0;
+    default:
+        return q > 0.0 ? kernel_dshape(kind, q) / q : 0.0;
+    }
+}
+
 /* W(r, h). */
 static inline double kernel_w(const kernel *k, double r) { return k->norm * kernel_shape(k->kind, r * k->inv_h); }
 /* dW/dr (<= 0); grad_i W(x_i - x_j) = dW/dr * (x_i - x_j) / r. */

@@ -92,6 +92,9 @@ typedef struct {
     double *sps_nut;
     double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
     double *sps_tau[6];
+    /* per particle, in the sorted order of the last evaluation, filled with the EOS so that the
+     * pair loop divides nothing per pair: p_i / rho_i^2 and the volume m_i / rho_i */
+    double *prho2, *vol;
     /* soil (prm.soil only; sph_soil.h): its passes run after the water pass, which then skips soil
      * particles and soil neighbours; sigma is integrated in the same leapfrog as v and rho */
     int has_soil;

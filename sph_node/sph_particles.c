@@ -118,7 +118,8 @@ int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3],
 {
     memset(c, 0, sizeof *c);
     c->dim = dim;
-    c->min_size = support;
+    c->reach = SPH_CELLS_PER_SUPPORT;
+    c->min_size = support / c->reach;
     if (!(support > 0.0)) {
         snprintf(err, (size_t)errlen, "kernel support must be > 0");
         return -1;
@@ -127,17 +128,18 @@ int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3],
         c->periodic[a] = periodic && periodic[a] && !(a == 2 && dim == 2);
         c->lo[a] = lo ? lo[a] : 0.0;
         c->hi[a] = hi ? hi[a] : 0.0;
-        c->size[a] = support;
+        c->size[a] = c->min_size;
         c->nc[a] = 1;
         if (c->periodic[a]) {
             double len = c->hi[a] - c->lo[a];
             int nc = (int)floor(len / support);
-            if (nc < 3) {
+            if (nc < 3) { /* then >= 3 reach cells: no pair is seen twice */
                 snprintf(err, (size_t)errlen,
                          "periodic axis %c: period %g m holds %d cells of the kernel support %g m; it needs >= 3",
                          "xyz"[a], len, nc, support);
                 return -1;
             }
+            nc = (int)floor(len / c->min_size);
             c->nc[a] = nc;
             c->size[a] = len / nc;
         }
@@ -165,13 +167,15 @@ void sph_cells_free(sph_cells *c)
     memset(c, 0, sizeof *c);
 }
 
-static void gather_d(double **a, double **scratch, const int64_t *perm, int64_t n)
+/* The arrays a sort permutes: the state and the half-step state. The rates (ax, ay, az, drho) and
+ * the pressure p are not: they belong to the positions before the sort and every caller evaluates
+ * them again after it (sph_fluid_rates), so moving them would be wasted memory traffic. */
+#define SPH_NSORTED 12
+static void sorted_doubles(sph_particles *p, double **a[SPH_NSORTED])
 {
-    double *src = *a, *dst = *scratch;
-    for (int64_t k = 0; k < n; k++)
-        dst[k] = src[perm[k]];
-    *a = dst;
-    *scratch = src;
+    double **list[SPH_NSORTED] = {&p->x,  &p->y,  &p->z,  &p->vx,  &p->vy,  &p->vz,
+                                  &p->rho, &p->m, &p->vhx, &p->vhy, &p->vhz, &p->rhoh};
+    memcpy(a, list, sizeof list);
 }
 
 int sph_cells_sort(sph_cells *c, sph_particles *p)
@@ -179,6 +183,7 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     int64_t n = p->n;
     if (n > c->pcap)
         return -1;
+    const int par = n >= SPH_OMP_MIN_LIGHT;
     double *pos[3] = {p->x, p->y, p->z};
     /* grid: periodic axes wrap, the others follow the particles */
     for (int a = 0; a < 3; a++) {
@@ -189,6 +194,7 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
         double *x = pos[a];
         if (c->periodic[a]) {
             double lo = c->lo[a], len = c->hi[a] - c->lo[a];
+#pragma omp parallel for schedule(static) if (par)
             for (int64_t i = 0; i < n; i++) {
                 if (x[i] < lo || x[i] >= lo + len) {
                     x[i] -= floor((x[i] - lo) / len) * len;
@@ -198,10 +204,12 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
             }
             continue;
         }
+        /* min and max are exact: the same bounds for any number of threads; NaN is skipped */
         double mn = INFINITY, mx = -INFINITY;
+#pragma omp parallel for schedule(static) reduction(min : mn) reduction(max : mx) if (par)
         for (int64_t i = 0; i < n; i++) {
-            mn = fmin(mn, x[i]);
-            mx = fmax(mx, x[i]);
+            mn = x[i] < mn ? x[i] : mn;
+            mx = x[i] > mx ? x[i] : mx;
         }
         if (!(mn <= mx)) /* no particles (or all NaN): one cell */
             mn = mx = 0.0;
@@ -240,14 +248,17 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
         c->ncell_cap = cap;
     }
     c->ncell = ncell;
-    memset(c->count, 0, (size_t)ncell * sizeof *c->count);
+    const int d3 = c->dim == 3;
+#pragma omp parallel for schedule(static) if (par)
     for (int64_t i = 0; i < n; i++) {
         int ix = sph_cells_coord(c, 0, p->x[i]), iy = sph_cells_coord(c, 1, p->y[i]);
-        int iz = c->dim == 3 ? sph_cells_coord(c, 2, p->z[i]) : 0;
-        int64_t cell = ((int64_t)iz * c->nc[1] + iy) * c->nc[0] + ix;
-        c->cell_of[i] = cell;
-        c->count[cell]++;
+        int iz = d3 ? sph_cells_coord(c, 2, p->z[i]) : 0;
+        c->cell_of[i] = ((int64_t)iz * c->nc[1] + iy) * c->nc[0] + ix;
     }
+    /* counting sort (serial: a few operations per particle) */
+    memset(c->count, 0, (size_t)ncell * sizeof *c->count);
+    for (int64_t i = 0; i < n; i++)
+        c->count[c->cell_of[i]]++;
     c->start[0] = 0;
     for (int64_t k = 0; k < ncell; k++) {
         c->start[k + 1] = c->start[k] + c->count[k];
@@ -255,27 +266,48 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     }
     for (int64_t i = 0; i < n; i++)
         c->perm[c->count[c->cell_of[i]]++] = i;
-    /* permute every particle array */
-    double **a[SPH_NDOUBLE];
-    particle_doubles(p, a);
-    for (int k = 0; k < SPH_NDOUBLE; k++)
-        gather_d(a[k], &p->scratch_d, c->perm, n);
-    if (p->sig[0]) /* soil stress, its half-step value and the soil-DEM contact memory */
+    /* permute the particle arrays (gathers, one parallel region) and cell_of into the new order */
+    double **a[SPH_NSORTED + 2 * SPH_NSTRESS];
+    sorted_doubles(p, a);
+    int na = SPH_NSORTED;
+    if (p->sig[0]) /* soil stress and its half-step value */
         for (int k = 0; k < SPH_NSTRESS; k++)
-            gather_d(&p->sig[k], &p->scratch_d, c->perm, n), gather_d(&p->sigh[k], &p->scratch_d, c->perm, n);
-    for (int64_t k = 0; k < n; k++)
-        p->scratch_i[k] = p->id[c->perm[k]];
+            a[na++] = &p->sig[k], a[na++] = &p->sigh[k];
+    const int64_t *perm = c->perm;
+    int64_t *cell_of = c->cell_of;
+    /* each array is gathered into the scratch array, which then takes its place */
+#pragma omp parallel if (par)
+    {
+        for (int k = 0; k < na; k++) {
+            const double *src = *a[k];
+            double *out = p->scratch_d;
+#pragma omp for schedule(static)
+            for (int64_t i = 0; i < n; i++)
+                out[i] = src[perm[i]];
+            /* implicit barrier: every thread has finished reading src before the swap */
+#pragma omp single
+            {
+                p->scratch_d = *a[k];
+                *a[k] = out;
+            }
+        }
+#pragma omp for schedule(static) nowait
+        for (int64_t i = 0; i < n; i++)
+            p->scratch_i[i] = p->id[perm[i]];
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < n; i++)
+            p->scratch_p[i] = p->phase[perm[i]];
+    }
     int64_t *ti = p->id;
     p->id = p->scratch_i;
     p->scratch_i = ti;
-    for (int64_t k = 0; k < n; k++)
-        p->scratch_p[k] = p->phase[c->perm[k]];
     int32_t *tp = p->phase;
     p->phase = p->scratch_p;
     p->scratch_p = tp;
     /* cell_of in the new order */
+#pragma omp parallel for schedule(static) if (par)
     for (int64_t k = 0; k < ncell; k++)
         for (int64_t i = c->start[k]; i < c->start[k + 1]; i++)
-            c->cell_of[i] = k;
+            cell_of[i] = k;
     return 0;
 }

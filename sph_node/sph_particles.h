@@ -2,7 +2,7 @@
  *
  * Particles are kept sorted by cell (counting sort of the cell index, all arrays permuted, ids kept)
  * so that the neighbours of a particle are contiguous runs of memory. Cells are cubes of side >= the
- * kernel support; periodic axes use the domain box exactly (positions wrapped into [lo, hi)), the
+ * kernel support / SPH_CELLS_PER_SUPPORT; periodic axes use the domain box exactly (positions wrapped into [lo, hi)), the
  * other axes follow the particles (bounding box recomputed at every sort). All storage is allocated
  * at setup; the cell table grows by doubling on the rare sort that needs more cells. */
 #ifndef LAHAR_SPH_PARTICLES_H
@@ -58,7 +58,8 @@ typedef struct {
     int periodic[3];
     double lo[3], hi[3];   /* domain: exact on periodic axes, particle bounds elsewhere */
     double size[3];        /* cell side per axis (>= min_size) */
-    double min_size;       /* kernel support */
+    double min_size;       /* kernel support / reach */
+    int reach;             /* cells per kernel support: neighbours lie within +-reach cells */
     int nc[3];             /* cells per axis */
     int64_t ncell, ncell_cap;
     int64_t *start;        /* ncell + 1: particles of cell c are start[c] .. start[c+1] - 1 */
@@ -68,7 +69,14 @@ typedef struct {
     int64_t pcap;
 } sph_cells;
 
-/* Cells of side >= support. Periodic axes: periodic[a] = 1 with [lo[a], hi[a]) the period, which
+/* Cells per kernel support (the side of a cell is >= support / SPH_CELLS_PER_SUPPORT, the stencil
+ * 2 SPH_CELLS_PER_SUPPORT + 1 cells wide). 2 instead of 1: the candidates of a particle cover
+ * (5/2)^D instead of 3^D supports^D, 30 % fewer distance tests in 2D and 42 % fewer in 3D. */
+#ifndef SPH_CELLS_PER_SUPPORT
+#define SPH_CELLS_PER_SUPPORT 2
+#endif
+
+/* Cells of side >= support / SPH_CELLS_PER_SUPPORT. Periodic axes: periodic[a] = 1 with [lo[a], hi[a]) the period, which
  * must hold >= 3 cells. Returns 0, or -1 (bad arguments, message in err, or out of memory). */
 int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3], const double lo[3],
                    const double hi[3], int64_t particle_cap, char *err, int errlen);
@@ -85,53 +93,121 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
     return i >= c->nc[a] ? c->nc[a] - 1 : i;
 }
 
+/* Candidates of the neighbour loop are taken in chunks of this many: distances first (no branch
+ * per candidate), then the body for those within the support. */
+#define SPH_NB_CHUNK 64
+
 /* Loop over the neighbours j != i of particle i (sorted, cell_of valid) within sqrt(S2) of it, in
- * cell order (deterministic). The body is the last (variadic) argument; inside it: j, and rx, ry, rz, r2 = x_i - (image of x_j) and its
- * squared length. Particle i is at (XI, YI, ZI). Periodic images are taken across periodic axes
- * (>= 3 cells each, so no pair is seen twice). */
+ * cell order (deterministic). The body is the last (variadic) argument; inside it: j, and rx, ry,
+ * rz, r2 = x_i - (image of x_j) and its squared length. Particle i is at (XI, YI, ZI). Periodic
+ * images are taken across periodic axes (>= 3 cells each, so no pair is seen twice).
+ * SPH_FOR_EACH_NEIGHBOUR_D takes the dimension DIM as a compile-time constant (2: z and rz are not
+ * read, rz = 0), or 0 for the cells' own. `continue` in the body goes to the next neighbour;
+ * the body must not `break`.
+ * Speed: the cells of a row along x are contiguous in the sorted arrays, so a row of the stencil is
+ * one run of candidates (one run per cell only where a periodic x axis wraps); each run is scanned in chunks of
+ * SPH_NB_CHUNK: the squared distances of a chunk are computed and the neighbours compacted into a
+ * small list without a branch per candidate (a rejected candidate, half of them in 2D and 3/4 in 3D,
+ * costs no mispredicted jump), then the body runs over the list. The order of j is the cell order
+ * either way. */
 #define SPH_FOR_EACH_NEIGHBOUR(C, P, I, XI, YI, ZI, S2, ...)                                        \
+    SPH_FOR_EACH_NEIGHBOUR_D(C, P, I, XI, YI, ZI, S2, 0, __VA_ARGS__)
+
+#define SPH_FOR_EACH_NEIGHBOUR_D(C, P, I, XI, YI, ZI, S2, DIM, ...)                                 \
+    SPH_NEIGHBOUR_CHUNKS_D(C, P, I, XI, YI, ZI, S2, DIM, {                                         \
+        for (int nc_k_ = 0; nc_k_ < nb_n; nc_k_++) {                                               \
+            const int64_t j = nb_j[nc_k_];                                                         \
+            const double rx = nb_xi - nb_x[j], ry = nb_yi - nb_y[j],                               \
+                         rz = (DIM) == 2 ? 0.0 : nb_zi - nb_z[j];                                  \
+            const double r2 = rx * rx + ry * ry + rz * rz;                                         \
+            (void)rx, (void)ry, (void)rz;                                                          \
+            __VA_ARGS__                                                                            \
+        }                                                                                          \
+    })
+
+/* The same walk a chunk at a time, for loops that want the neighbour list of a chunk as arrays
+ * (e.g. to vectorise the pair sums): the body runs once per chunk with nb_n neighbours in nb_j[]
+ * (k < nb_n) in cell order; x_i - x_j = (nb_xi - nb_x[j], nb_yi - nb_y[j], nb_zi - nb_z[j]) with
+ * the periodic image already in nb_xi, nb_yi, nb_zi (x_i minus the shift of the run); with
+ * DIM = 2 the z parts are 0 and nb_z is not to be read. */
+#define SPH_NEIGHBOUR_CHUNKS_D(C, P, I, XI, YI, ZI, S2, DIM, ...)                                   \
     do {                                                                                           \
         const sph_cells *nc_c_ = (C);                                                              \
-        const int64_t nc_cell_ = nc_c_->cell_of[I];                                                \
-        const int nc_cx_ = (int)(nc_cell_ % nc_c_->nc[0]),                                         \
-                  nc_cy_ = (int)((nc_cell_ / nc_c_->nc[0]) % nc_c_->nc[1]),                        \
-                  nc_cz_ = (int)(nc_cell_ / ((int64_t)nc_c_->nc[0] * nc_c_->nc[1]));               \
-        const int nc_zr_ = nc_c_->dim == 3 ? 1 : 0;                                                \
+        const double *const nc_px_ = (P)->x, *const nc_py_ = (P)->y, *const nc_pz_ = (P)->z;       \
+        const int64_t *const nc_start_ = nc_c_->start;                                             \
+        const int64_t nc_i_ = (I);                                                                 \
+        const double nc_xi_ = (XI), nc_yi_ = (YI), nc_zi_ = (ZI), nc_s2_ = (S2);                   \
+        const int nc_n0_ = nc_c_->nc[0], nc_n1_ = nc_c_->nc[1], nc_n2_ = nc_c_->nc[2];             \
+        const int64_t nc_cell_ = nc_c_->cell_of[nc_i_];                                            \
+        const int nc_cx_ = (int)(nc_cell_ % nc_n0_), nc_cy_ = (int)((nc_cell_ / nc_n0_) % nc_n1_), \
+                  nc_cz_ = (int)(nc_cell_ / ((int64_t)nc_n0_ * nc_n1_));                           \
+        const int nc_re_ = nc_c_->reach;                                                           \
+        const int nc_zr_ = ((DIM) ? (DIM) : nc_c_->dim) == 3 ? nc_re_ : 0;                         \
         for (int nc_dz_ = -nc_zr_; nc_dz_ <= nc_zr_; nc_dz_++) {                                   \
             int nc_jz_ = nc_cz_ + nc_dz_;                                                          \
             double nc_sz_ = 0.0;                                                                   \
-            if (nc_jz_ < 0 || nc_jz_ >= nc_c_->nc[2]) {                                            \
+            if (nc_jz_ < 0 || nc_jz_ >= nc_n2_) {                                                  \
                 if (!nc_c_->periodic[2])                                                           \
                     continue;                                                                      \
                 nc_sz_ = (nc_jz_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[2] - nc_c_->lo[2]);                \
-                nc_jz_ += nc_jz_ < 0 ? nc_c_->nc[2] : -nc_c_->nc[2];                               \
+                nc_jz_ += nc_jz_ < 0 ? nc_n2_ : -nc_n2_;                                           \
             }                                                                                      \
-            for (int nc_dy_ = -1; nc_dy_ <= 1; nc_dy_++) {                                         \
+            for (int nc_dy_ = -nc_re_; nc_dy_ <= nc_re_; nc_dy_++) {                               \
                 int nc_jy_ = nc_cy_ + nc_dy_;                                                      \
                 double nc_sy_ = 0.0;                                                               \
-                if (nc_jy_ < 0 || nc_jy_ >= nc_c_->nc[1]) {                                        \
+                if (nc_jy_ < 0 || nc_jy_ >= nc_n1_) {                                              \
                     if (!nc_c_->periodic[1])                                                       \
                         continue;                                                                  \
                     nc_sy_ = (nc_jy_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[1] - nc_c_->lo[1]);            \
-                    nc_jy_ += nc_jy_ < 0 ? nc_c_->nc[1] : -nc_c_->nc[1];                           \
+                    nc_jy_ += nc_jy_ < 0 ? nc_n1_ : -nc_n1_;                                       \
                 }                                                                                  \
-                for (int nc_dx_ = -1; nc_dx_ <= 1; nc_dx_++) {                                     \
-                    int nc_jx_ = nc_cx_ + nc_dx_;                                                  \
-                    double nc_sx_ = 0.0;                                                           \
-                    if (nc_jx_ < 0 || nc_jx_ >= nc_c_->nc[0]) {                                    \
-                        if (!nc_c_->periodic[0])                                                   \
-                            continue;                                                              \
-                        nc_sx_ = (nc_jx_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[0] - nc_c_->lo[0]);        \
-                        nc_jx_ += nc_jx_ < 0 ? nc_c_->nc[0] : -nc_c_->nc[0];                       \
+                const int64_t nc_row_ = ((int64_t)nc_jz_ * nc_n1_ + nc_jy_) * nc_n0_;              \
+                int64_t nc_sb_[2 * SPH_CELLS_PER_SUPPORT + 1], nc_se_[2 * SPH_CELLS_PER_SUPPORT + 1]; \
+                double nc_ss_[2 * SPH_CELLS_PER_SUPPORT + 1];                                      \
+                int nc_nseg_ = 0;                                                                  \
+                if (!nc_c_->periodic[0] || (nc_cx_ >= nc_re_ && nc_cx_ + nc_re_ < nc_n0_)) {       \
+                    const int nc_a_ = nc_cx_ > nc_re_ ? nc_cx_ - nc_re_ : 0,                       \
+                              nc_b_ = nc_cx_ + nc_re_ < nc_n0_ ? nc_cx_ + nc_re_ : nc_n0_ - 1;     \
+                    nc_sb_[0] = nc_start_[nc_row_ + nc_a_];                                        \
+                    nc_se_[0] = nc_start_[nc_row_ + nc_b_ + 1];                                    \
+                    nc_ss_[0] = 0.0;                                                               \
+                    nc_nseg_ = 1;                                                                  \
+                } else {                                                                           \
+                    for (int nc_dx_ = -nc_re_; nc_dx_ <= nc_re_; nc_dx_++) {                       \
+                        int nc_jx_ = nc_cx_ + nc_dx_;                                              \
+                        double nc_sx_ = 0.0;                                                       \
+                        if (nc_jx_ < 0 || nc_jx_ >= nc_n0_) {                                      \
+                            nc_sx_ = (nc_jx_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[0] - nc_c_->lo[0]);    \
+                            nc_jx_ += nc_jx_ < 0 ? nc_n0_ : -nc_n0_;                               \
+                        }                                                                          \
+                        nc_sb_[nc_nseg_] = nc_start_[nc_row_ + nc_jx_];                            \
+                        nc_se_[nc_nseg_] = nc_start_[nc_row_ + nc_jx_ + 1];                        \
+                        nc_ss_[nc_nseg_++] = nc_sx_;                                               \
                     }                                                                              \
-                    const int64_t nc_nb_ = ((int64_t)nc_jz_ * nc_c_->nc[1] + nc_jy_) * nc_c_->nc[0] + nc_jx_; \
-                    for (int64_t j = nc_c_->start[nc_nb_]; j < nc_c_->start[nc_nb_ + 1]; j++) {    \
-                        const double rx = (XI) - ((P)->x[j] + nc_sx_), ry = (YI) - ((P)->y[j] + nc_sy_), \
-                                     rz = (ZI) - ((P)->z[j] + nc_sz_);                              \
-                        const double r2 = rx * rx + ry * ry + rz * rz;                             \
-                        if (r2 >= (S2) || j == (I))                                                \
-                            continue;                                                              \
-                        __VA_ARGS__                                                                \
+                }                                                                                  \
+                for (int nc_g_ = 0; nc_g_ < nc_nseg_; nc_g_++) {                                   \
+                    /* x_i minus the image shift: rx = xs - x_j (exact when the shift is 0) */     \
+                    const double nb_xi = nc_xi_ - nc_ss_[nc_g_], nb_yi = nc_yi_ - nc_sy_,          \
+                                 nb_zi = (DIM) == 2 ? 0.0 : nc_zi_ - nc_sz_;                       \
+                    for (int64_t nc_j0_ = nc_sb_[nc_g_]; nc_j0_ < nc_se_[nc_g_]; nc_j0_ += SPH_NB_CHUNK) { \
+                        const int64_t nc_j1_ = nc_se_[nc_g_] - nc_j0_ < SPH_NB_CHUNK ? nc_se_[nc_g_]     \
+                                                                                    : nc_j0_ + SPH_NB_CHUNK; \
+                        int64_t nc_idx_[SPH_NB_CHUNK];                                             \
+                        int nc_cnt_ = 0;                                                           \
+                        for (int64_t nc_j_ = nc_j0_; nc_j_ < nc_j1_; nc_j_++) {                    \
+                            const double nc_dxr_ = nb_xi - nc_px_[nc_j_], nc_dyr_ = nb_yi - nc_py_[nc_j_], \
+                                         nc_dzr_ = (DIM) == 2 ? 0.0 : nb_zi - nc_pz_[nc_j_];       \
+                            const double nc_d2_ = nc_dxr_ * nc_dxr_ + nc_dyr_ * nc_dyr_ + nc_dzr_ * nc_dzr_; \
+                            nc_idx_[nc_cnt_] = nc_j_;                                              \
+                            nc_cnt_ += !(nc_d2_ >= nc_s2_) & (nc_j_ != nc_i_);                     \
+                        }                                                                          \
+                        {                                                                          \
+                            const int nb_n = nc_cnt_;                                              \
+                            const int64_t *const nb_j = nc_idx_;                                   \
+                            const double *const nb_x = nc_px_, *const nb_y = nc_py_, *const nb_z = nc_pz_; \
+                            (void)nb_z, (void)nb_zi;                                               \
+                            __VA_ARGS__                                                            \
+                        }                                                                          \
                     }                                                                              \
                 }                                                                                  \
             }                                                                                      \

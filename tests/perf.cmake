@@ -1,0 +1,14 @@
+# SPH speed (brief PERF, issue 4 "Speed targets").
+# The SPH benchmark (tests/bench/bench_sph.c): 80k-particle 2D and 100k-particle 3D dam breaks on
+# 1 and 2 threads, run by the `bench` target after the DEM table (never a pass/fail; it prints a table).
+add_executable(bench_sph EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_sph.c)
+target_link_libraries(bench_sph PRIVATE lahar_sph)
+add_custom_target(bench_sph_table COMMAND bench_sph DEPENDS bench_sph WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} USES_TERMINAL
+  COMMENT "bench_sph: SPH step cost, 80k 2D and 100k 3D dam breaks on 1 and 2 threads")
+add_dependencies(bench bench_sph_table)
+
+# No allocation inside the SPH step in the steady state: malloc & co. wrapped by the linker.
+add_executable(test_sph_noalloc ${LAHAR_TEST_DIR}/test_sph_noalloc.c)
+target_link_libraries(test_sph_noalloc PRIVATE lahar_sph -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
+add_test(NAME sph_noalloc COMMAND test_sph_noalloc)
+set_tests_properties(sph_noalloc PROPERTIES LABELS "fast;perf;sph" TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=2")
