@@ -74,6 +74,11 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
+    f->cpl.cells = &f->cells;
+    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, f->prm.body_force, f->prm.dx) != 0) {
+        sph_coupling_free(&f->cpl);
+        return -1;
+    }
     f->has_bodies = 1;
     f->primed = 0;
     return 0;
