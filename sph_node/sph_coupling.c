@@ -212,6 +212,8 @@ static vec3 ghost_wall_accel(const sph_coupling *c, double p, double pbar, doubl
 static double ghost_pbar(const sph_coupling *c, const sph_particles *p, int64_t i)
 {
     const kernel *k = &c->k;
+    if (!c->cells) /* coupling used without the fluid's cells: the particle's own pressure */
+        return p->p[i];
     const double s2 = k->support * k->support, bx = c->body_force[0], by = c->body_force[1], bz = c->body_force[2];
     double vw = p->m[i] / p->rho[i] * kernel_w(k, 0.0), num = vw * p->p[i], den = vw;
     SPH_FOR_EACH_NEIGHBOUR(c->cells, p, i, p->x[i], p->y[i], p->z[i], s2, {

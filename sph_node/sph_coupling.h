@@ -61,7 +61,9 @@ typedef enum {
  *   of what stays, the push along each body's normal is that body's reaction (at a 3D corner of
  *   three bodies the octant then counts zero times instead of once: a few particles). The
  *   reactions go to the bodies with the penalty force (eq. 20). Body accelerations are not
- *   known here: moving bodies are extrapolated as if at rest. Measured (tests/
+ *   known here: moving bodies are extrapolated as if at rest; b is taken along the non-periodic axes
+ *   only (sph_fluid.c), and a body force along a wall that drives a flow instead of holding a
+ *   pressure gradient is outside this model (validated: tanks at rest only). Measured (tests/
  *   test_sph_hydrostatic.c, cases/README.md): tank at rest, wall force and pressure L2 within
  *   0.7 % in 2D and 3D, against 1-6 % and 3-15 % with the penalty alone. */
 typedef enum { SPH_WALL_PRESSURE_PENALTY = 0, SPH_WALL_PRESSURE_GHOST = 1 } sph_wall_pressure;

@@ -74,8 +74,14 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
+    /* the ghosts' hydrostatic extrapolation uses the body force along the non-periodic axes only,
+     * as the delta-SPH hydrostatic part does (a periodic driving force makes a flow, not a
+     * pressure gradient) */
+    double bh[3];
+    for (int a = 0; a < 3; a++)
+        bh[a] = f->prm.periodic[a] ? 0.0 : f->prm.body_force[a];
     f->cpl.cells = &f->cells;
-    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, f->prm.body_force, f->prm.dx) != 0) {
+    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
         sph_coupling_free(&f->cpl);
         return -1;
     }
