@@ -1590,11 +1590,12 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
     static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
+    static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
     lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
@@ -1638,6 +1639,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     o->wall_viscous = (lahar_sph_wall_viscous)rmap_enum(&m, "wall_viscous", wall_names, 0, LAHAR_SPH_WALL_HALFSPACE);
     o->initial_pressure = (lahar_sph_initial_pressure)rmap_enum(&m, "initial_pressure", initial_pressure_names, 0,
                                                                 LAHAR_SPH_INITIAL_PRESSURE_NONE);
+    o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(&m, "wall_pressure", wall_pressure_names, 0,
+                                                          LAHAR_SPH_WALL_PRESSURE_PENALTY);
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);

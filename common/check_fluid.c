@@ -168,7 +168,10 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
     }
     if (p->cur_n == 0 || dx <= 0.0)
         return 0;
-    int64_t n1 = (int64_t)floor((hi1 - lo1) / dx) + 1, n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx) + 1 : 1;
+    /* columns centred on the lowest particle's coordinate: on a lattice the particles sit at the
+     * column centres, not on the column edges where rounding would put part of a lattice column
+     * into its neighbour and leave a column without its top particle */
+    int64_t n1 = (int64_t)floor((hi1 - lo1) / dx + 0.5) + 1, n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx + 0.5) + 1 : 1;
     if ((size_t)(n1 * n2) > col->cap) {
         size_t cap = col->cap ? 2 * col->cap : 1024;
         while (cap < (size_t)(n1 * n2))
@@ -186,7 +189,8 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
         double s1 = v3_dot(x, e1);
         if (s1 >= skip_lo && s1 <= skip_hi)
             continue;
-        int64_t b1 = (int64_t)floor((s1 - lo1) / dx), b2 = dim == 3 ? (int64_t)floor((v3_dot(x, e2) - lo2) / dx) : 0;
+        int64_t b1 = (int64_t)floor((s1 - lo1) / dx + 0.5),
+                b2 = dim == 3 ? (int64_t)floor((v3_dot(x, e2) - lo2) / dx + 0.5) : 0;
         b1 = b1 < 0 ? 0 : (b1 >= n1 ? n1 - 1 : b1);
         b2 = b2 < 0 ? 0 : (b2 >= n2 ? n2 - 1 : b2);
         top[b2 * n1 + b1] = fmax(top[b2 * n1 + b1], v3_dot(x, up));

@@ -95,6 +95,7 @@ typedef struct {
 typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
+typedef enum { LAHAR_SPH_WALL_PRESSURE_PENALTY = 0, LAHAR_SPH_WALL_PRESSURE_GHOST = 1 } lahar_sph_wall_pressure;
 
 typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
@@ -117,6 +118,8 @@ typedef struct {
     lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/sph_coupling.h) */
     lahar_sph_initial_pressure initial_pressure; /* block densities at t = 0: rest (none, default) or
                                                    hydrostatic per block (lahar_sph_node_fill) */
+    lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, paper 000
+                                              eq. 15) or ghost layers (sph_node/sph_coupling.h) */
 } lahar_sph_options;
 
 typedef struct {

@@ -35,6 +35,232 @@ static double ghost_layers(const kernel *k, int dim, double d, double dx)
     return g;
 }
 
+/* ---- SPH_WALL_PRESSURE_GHOST (sph_coupling.h) ----
+ * A region of ghosts (volume V_g, pressure p_g = pbar_i + rho_i b.r_g, r_g = x_g - x_i, density
+ * rho_i, moving with the wall) adds to particle i (000 eq. 2, symmetric pressure term, and eq. 1,
+ * continuity):
+ *   a = -sum_g V_g (p_i + p_g)/rho_i grad_i W_ig = (p_i + pbar_i)/rho_i A + B b,
+ *   drho = rho_i sum_g V_g u_rel.grad_i W_ig = -rho_i u_rel.A,
+ *   A = sum_g V_g F r_g,  B = sum_g V_g F r_g r_g^T,  F = W'(r)/r.
+ * The sums over the layers are tabulated at setup:
+ *  - wall table, frame (n, e, w), r_g = -(d + s_k) n + t e + w w, e up the wall (against the
+ *    body force's part along it): the ghosts with t < zeta = pbar_i / (rho_i |b_t|), where p_g
+ *    reaches 0. Values {A_n, A_e, B_nn, B_ne, B_ee} on a grid of d and zeta (cumulative in t).
+ *  - corner table, frame (n_a, n_b, e = n_a x n_b), r_g = -(d_a + s_k) n_a + t n_b + z e: wall a's
+ *    ghosts behind wall b (t < -d_b), z < zeta_e (3D: cut along the edge like the wall table).
+ *    Values {A_a, A_b, A_e, B_aa, B_ab, B_ae, B_bb, B_be, B_ee} on a grid of d_a, d_b, zeta_e. */
+#define GHOST_NT 48 /* wall table: bins of t per half support; zeta at the 2 GHOST_NT + 1 bin edges */
+#define GHOST_NZ 24 /* corner table (3D): bins of z per half support */
+
+/* One column of the wall table (distance d): out[j * 5 + v] for zeta_j = -S + j S / GHOST_NT. */
+static void ghost_wall_column(const kernel *k, int dim, double d, double dx, double *out)
+{
+    const int nw = dim == 3 ? GHOST_NT : 1;
+    const double S = k->support, dt = S / GHOST_NT, dw = S / GHOST_NT;
+    for (int v = 0; v < 5; v++)
+        out[v] = 0.0;
+    for (int j = 0; j < 2 * GHOST_NT; j++) {
+        double t = -S + (j + 0.5) * dt, bin[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+        for (int l = 0;; l++) {
+            double y = d + (l + 0.5) * dx;
+            if (y >= S)
+                break;
+            for (int c = 0; c < nw; c++) {
+                double w = dim == 3 ? (c + 0.5) * dw : 0.0, r = sqrt(y * y + t * t + w * w);
+                if (r >= S)
+                    continue;
+                double fv = kernel_dwdr(k, r) / r * dt * dx * (dim == 3 ? 2.0 * dw : 1.0); /* F V_g, w of both signs */
+                bin[0] -= fv * y;
+                bin[1] += fv * t;
+                bin[2] += fv * y * y;
+                bin[3] -= fv * y * t;
+                bin[4] += fv * t * t;
+            }
+        }
+        for (int v = 0; v < 5; v++)
+            out[(j + 1) * 5 + v] = out[j * 5 + v] + bin[v];
+    }
+}
+
+/* One column of the corner table (d_a, d_b): out[j * 9 + v] for zeta_e at the z bin edges (3D),
+ * or out[9 + v] the whole sum (2D, out[v] = 0). */
+static void ghost_corner_column(const kernel *k, int dim, double da, double db, double dx, double *out)
+{
+    const int nz = dim == 3 ? 2 * GHOST_NZ : 1, nt = GHOST_NT;
+    const double S = k->support, dz = S / GHOST_NZ;
+    for (int v = 0; v < 9; v++)
+        out[v] = 0.0;
+    for (int j = 0; j < nz; j++) {
+        double z = dim == 3 ? -S + (j + 0.5) * dz : 0.0, bin[9] = {0.0};
+        for (int l = 0; db < S; l++) {
+            double y = da + (l + 0.5) * dx, wt = (S - db) / nt;
+            if (y >= S)
+                break;
+            for (int b = 0; b < nt; b++) {
+                double t = -db - (b + 0.5) * wt, r = sqrt(y * y + t * t + z * z);
+                if (r >= S)
+                    continue;
+                double fv = kernel_dwdr(k, r) / r * wt * dx * (dim == 3 ? dz : 1.0), rg[3] = {-y, t, z};
+                bin[0] += fv * rg[0], bin[1] += fv * rg[1], bin[2] += fv * rg[2];
+                bin[3] += fv * rg[0] * rg[0], bin[4] += fv * rg[0] * rg[1], bin[5] += fv * rg[0] * rg[2];
+                bin[6] += fv * rg[1] * rg[1], bin[7] += fv * rg[1] * rg[2], bin[8] += fv * rg[2] * rg[2];
+            }
+        }
+        for (int v = 0; v < 9; v++)
+            out[(j + 1) * 9 + v] = out[j * 9 + v] + bin[v];
+    }
+}
+
+int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx)
+{
+    c->pressure = mode;
+    for (int a = 0; a < 3; a++)
+        c->body_force[a] = body_force[a];
+    if (mode != SPH_WALL_PRESSURE_GHOST || c->wtab)
+        return 0;
+    const int nd = SPH_COUPLING_WTAB + 1, nq = SPH_COUPLING_QTAB + 1, nzw = 2 * GHOST_NT + 1;
+    const int nzq = c->dim == 3 ? 2 * GHOST_NZ + 1 : 2;
+    c->wtab = calloc((size_t)nd * nzw * 5, sizeof *c->wtab);
+    c->qtab = calloc((size_t)nq * nq * nzq * 9, sizeof *c->qtab);
+    if (!c->wtab || !c->qtab) {
+        free(c->wtab), free(c->qtab);
+        c->wtab = c->qtab = NULL;
+        c->pressure = SPH_WALL_PRESSURE_PENALTY;
+        return -1;
+    }
+    c->wtab_dd = (c->k.support - c->gtab_d0) / SPH_COUPLING_WTAB;
+    c->qtab_dd = (c->k.support - c->gtab_d0) / SPH_COUPLING_QTAB;
+    for (int i = 0; i < nd; i++)
+        ghost_wall_column(&c->k, c->dim, c->gtab_d0 + i * c->wtab_dd, dx, c->wtab + (size_t)i * nzw * 5);
+    for (int i = 0; i < nq; i++)
+        for (int j = 0; j < nq; j++)
+            ghost_corner_column(&c->k, c->dim, c->gtab_d0 + i * c->qtab_dd, c->gtab_d0 + j * c->qtab_dd, dx,
+                                c->qtab + ((size_t)i * nq + j) * nzq * 9);
+    return 0;
+}
+
+/* Grid coordinate of x on [x0, x0 + n dx]: index and fraction; 0 when beyond the top (the caller
+ * treats it as outside), clamped at the bottom. */
+static int ghost_grid(double x, double x0, double dx, int n, int *i, double *f)
+{
+    double u = (x - x0) / dx;
+    if (u >= n)
+        return 0;
+    if (!(u > 0.0))
+        u = 0.0;
+    *i = (int)u < n ? (int)u : n - 1;
+    *f = u - *i;
+    return 1;
+}
+
+/* Cut coordinate zeta (height up direction e where the ghost pressure reaches 0) on the edges
+ * -S .. S in nbin bins per half: index and fraction, clamped at both ends. */
+static void ghost_cut_grid(double zeta, double S, int nbin, int *j, double *f)
+{
+    double u = (zeta + S) / (S / nbin);
+    if (!(u > 0.0)) /* below -S (or NaN): nothing */
+        u = 0.0;
+    if (u >= 2 * nbin)
+        u = 2 * nbin - 1e-9;
+    *j = (int)u;
+    *f = u - *j;
+}
+
+/* Direction e up along the plane of normal n (against the body force's part in it) and the
+ * height zeta = p / (rho |b_t|) where the extrapolated ghost pressure reaches 0; e = 0 and zeta
+ * beyond the support when the body force is along n. */
+static double ghost_cut(const sph_coupling *c, vec3 n, double p, double rho, vec3 *e)
+{
+    vec3 b = v3_load(c->body_force), bt = v3_axpy(-v3_dot(b, n), n, b);
+    double bmag = v3_norm(bt);
+    if (!(bmag > 1e-9 * v3_norm(b))) {
+        *e = v3(0, 0, 0);
+        return 2.0 * c->k.support;
+    }
+    *e = v3_scale(bt, -1.0 / bmag);
+    return p / (rho * bmag);
+}
+
+/* A particle (p, rho, relative velocity u) at distance d from a flat wall of normal n: ghost
+ * pressure acceleration, continuity rate in *drho. */
+static vec3 ghost_wall_accel(const sph_coupling *c, double p, double pbar, double rho, double d, vec3 n, vec3 u,
+                             double *drho)
+{
+    const int nzw = 2 * GHOST_NT + 1;
+    int i, j;
+    double fi, fj, K[5];
+    *drho = 0.0;
+    if (!ghost_grid(d, c->gtab_d0, c->wtab_dd, SPH_COUPLING_WTAB, &i, &fi))
+        return v3(0, 0, 0);
+    vec3 e;
+    double zeta = ghost_cut(c, n, pbar, rho, &e);
+    ghost_cut_grid(zeta, c->k.support, GHOST_NT, &j, &fj);
+    const double *t00 = c->wtab + ((size_t)i * nzw + j) * 5, *t01 = t00 + 5, *t10 = t00 + (size_t)nzw * 5,
+                 *t11 = t10 + 5;
+    for (int v = 0; v < 5; v++)
+        K[v] = (1 - fi) * ((1 - fj) * t00[v] + fj * t01[v]) + fi * ((1 - fj) * t10[v] + fj * t11[v]);
+    vec3 b = v3_load(c->body_force);
+    double bn = v3_dot(b, n), be = v3_dot(b, e), pp = (p + pbar) / rho;
+    *drho = -rho * (K[0] * v3_dot(u, n) + K[1] * v3_dot(u, e));
+    return v3_axpy(pp * K[1] + K[3] * bn + K[4] * be, e, v3_scale(n, pp * K[0] + K[2] * bn + K[3] * be));
+}
+
+/* The ghosts' reference pressure for particle i: the Shepard mean over i and its neighbours of
+ * their pressures carried to x_i hydrostatically, sum_j V_j W_ij (p_j + rho_j b.(x_i - x_j)) /
+ * sum_j V_j W_ij (Adami, Hu & Adams 2012, eq. 27). Mirroring p_i alone lets a particle's own
+ * pressure push it off the wall into the fluid, which compresses it further (unstable). */
+static double ghost_pbar(const sph_coupling *c, const sph_particles *p, int64_t i)
+{
+    const kernel *k = &c->k;
+    if (!c->cells) /* coupling used without the fluid's cells: the particle's own pressure */
+        return p->p[i];
+    const double s2 = k->support * k->support, bx = c->body_force[0], by = c->body_force[1], bz = c->body_force[2];
+    double vw = p->m[i] / p->rho[i] * kernel_w(k, 0.0), num = vw * p->p[i], den = vw;
+    SPH_FOR_EACH_NEIGHBOUR(c->cells, p, i, p->x[i], p->y[i], p->z[i], s2, {
+        double w = p->m[j] / p->rho[j] * kernel_w(k, sqrt(r2));
+        num += w * (p->p[j] + p->rho[j] * (bx * rx + by * ry + bz * rz));
+        den += w;
+    });
+    return num / den;
+}
+
+/* The corner correction: half of wall a's ghosts behind the perpendicular wall b (corner table),
+ * the acceleration and continuity rate to take off. */
+static vec3 ghost_corner_accel(const sph_coupling *c, double p, double pbar, double rho, double da, vec3 na,
+                               double db, vec3 nb, vec3 urel, double *drho)
+{
+    const int nq = SPH_COUPLING_QTAB + 1, nzq = c->dim == 3 ? 2 * GHOST_NZ + 1 : 2;
+    int i, j, k = 0;
+    double fi, fj, fk = 1.0, Q[9];
+    *drho = 0.0;
+    if (!ghost_grid(da, c->gtab_d0, c->qtab_dd, SPH_COUPLING_QTAB, &i, &fi) ||
+        !ghost_grid(db, c->gtab_d0, c->qtab_dd, SPH_COUPLING_QTAB, &j, &fj))
+        return v3(0, 0, 0);
+    vec3 b = v3_load(c->body_force), e = v3_normalize(v3_cross(na, nb));
+    if (v3_dot(b, e) > 0.0)
+        e = v3_neg(e);
+    if (c->dim == 3) {
+        double be = -v3_dot(b, e);
+        ghost_cut_grid(be > 1e-9 * v3_norm(b) ? pbar / (rho * be) : 2.0 * c->k.support, c->k.support, GHOST_NZ, &k, &fk);
+    }
+    for (int v = 0; v < 9; v++) {
+        double q = 0.0;
+        for (int a = 0; a < 2; a++)
+            for (int bb = 0; bb < 2; bb++)
+                for (int cc = 0; cc < 2; cc++) {
+                    double w = (a ? fi : 1 - fi) * (bb ? fj : 1 - fj) * (cc ? fk : 1 - fk);
+                    if (w != 0.0)
+                        q += w * c->qtab[(((size_t)(i + a) * nq + (size_t)(j + bb)) * nzq + (size_t)(k + cc)) * 9 + v];
+                }
+        Q[v] = q;
+    }
+    double bf[3] = {v3_dot(b, na), v3_dot(b, nb), v3_dot(b, e)}, pp = (p + pbar) / rho;
+    double ax = pp * Q[0] + Q[3] * bf[0] + Q[4] * bf[1] + Q[5] * bf[2];
+    double ay = pp * Q[1] + Q[4] * bf[0] + Q[6] * bf[1] + Q[7] * bf[2];
+    double az = pp * Q[2] + Q[5] * bf[0] + Q[7] * bf[1] + Q[8] * bf[2];
+    *drho = -0.5 * rho * (Q[0] * v3_dot(urel, na) + Q[1] * v3_dot(urel, nb) + Q[2] * v3_dot(urel, e));
+    return v3_scale(v3_add(v3_add(v3_scale(na, ax), v3_scale(nb, ay)), v3_scale(e, az)), 0.5);
+}
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d)
 {
     double u = (d - c->gtab_d0) / c->gtab_dd;
@@ -135,6 +361,8 @@ void sph_coupling_free(sph_coupling *c)
     free(c->contacts);
     free(c->soil_hist_body);
     free(c->soil_hist_d);
+    free(c->wtab);
+    free(c->qtab);
     memset(c, 0, sizeof *c);
 }
 
@@ -228,6 +456,9 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         const int soil = p->phase[i] != 0 && c->soil_hist_body;
         int nh = 0, hist_b[SPH_COUPLING_MAX_PER_PARTICLE];
         double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
+        vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
+        double gd[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
+        vec3 gu[SPH_COUPLING_MAX_PER_PARTICLE];
         for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
             const lahar_body *body = &c->bodies[b];
             const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
@@ -288,6 +519,17 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 hist_b[nh++] = b;
             }
             vec3 f = v3_add(fn, ft);
+            gd[ns] = -1.0;
+            if (c->pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
+                double drw;
+                if (pbar != pbar)
+                    pbar = ghost_pbar(c, p, i);
+                f = v3_axpy(p->m[i], ghost_wall_accel(c, p->p[i], pbar, p->rho[i], dv, nrm, urel, &drw), f);
+                drho_g += drw;
+                gn[ns] = nrm;
+                gd[ns] = dv;
+                gu[ns] = urel;
+            }
             ftot = v3_add(ftot, f);
             int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;
             c->slot_body[k] = cross ? -(b + 1) : b;
@@ -298,6 +540,26 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             ct->particle_id = p->id[i];
             ns++;
         }
+        /* ghost pressure at a concave corner of perpendicular bodies: the quadrant behind both
+         * once, not twice (sph_coupling.h) */
+        for (int s1 = 0; s1 < ns; s1++)
+            for (int s2 = 0; s2 < ns; s2++) {
+                if (s1 == s2 || gd[s1] < 0.0 || gd[s2] < 0.0 || fabs(v3_dot(gn[s1], gn[s2])) >= 0.1)
+                    continue;
+                double drc;
+                vec3 fc = v3_scale(ghost_corner_accel(c, p->p[i], pbar, p->rho[i], gd[s1], gn[s1], gd[s2], gn[s2], gu[s1], &drc),
+                                   -p->m[i]);
+                drho_g -= drc;
+                /* eq. 20: wall s1 takes the reaction of the correction; of the half quadrant its
+                 * layers keep, the push along n_s2 is wall s2's (a ghost behind both walls pushes
+                 * across each wall's own plane), so that part of the reaction (-fc) moves over */
+                sph_contact *ca = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s1];
+                sph_contact *cb = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s2];
+                vec3 fb = v3_scale(gn[s2], v3_dot(fc, gn[s2]));
+                v3_store(v3_sub(v3_load(ca->force), v3_add(fc, fb)), ca->force);
+                v3_store(v3_add(v3_load(cb->force), fb), cb->force);
+                ftot = v3_add(ftot, fc);
+            }
         c->slot_n[i] = ns;
         if (soil) { /* the springs of the pairs in contact now; the others are released */
             const int64_t base = p->id[i] * SPH_COUPLING_MAX_PER_PARTICLE;
@@ -308,6 +570,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             }
         }
         double inv_m = 1.0 / p->m[i];
+        p->drho[i] += drho_g;
         p->ax[i] += ftot.x * inv_m;
         p->ay[i] += ftot.y * inv_m;
         p->az[i] += ftot.z * inv_m;

@@ -102,6 +102,17 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
         sph_coupling_free(&f->cpl);
         return -1;
     }
+    /* the ghosts' hydrostatic extrapolation uses the body force along the non-periodic axes only,
+     * as the delta-SPH hydrostatic part does (a periodic driving force makes a flow, not a
+     * pressure gradient) */
+    double bh[3];
+    for (int a = 0; a < 3; a++)
+        bh[a] = f->prm.periodic[a] ? 0.0 : f->prm.body_force[a];
+    f->cpl.cells = &f->cells;
+    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
+        sph_coupling_free(&f->cpl);
+        return -1;
+    }
     f->has_bodies = 1;
     f->primed = 0;
     return 0;

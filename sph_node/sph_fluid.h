@@ -66,6 +66,7 @@ typedef struct {
     int periodic[3];        /* 1: axis periodic with period [lo, hi) */
     double lo[3], hi[3];
     sph_wall_viscous wall_viscous;
+    sph_wall_pressure wall_pressure; /* default penalty only (paper 000 eq. 15); sph_coupling.h */
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */

@@ -76,8 +76,12 @@ static void sph_node_block_density(const lahar_case *c, const double (*pts)[3], 
         rho[i] = sph_node_eos_density(c, c->sph_density * gmag * (h_free - v3_dot(v3_load(pts[i]), up)));
 }
 
-/* Append the particles of every block with mass rho0 dx^D at the density of sph.initial_pressure
- * (sph_node_block_density; the volume m / rho follows): the lattice points of
+/* Append the particles of every block at the density of sph.initial_pressure
+ * (sph_node_block_density) with volume dx^D, mass rho dx^D (rho0 dx^D at rest density): a
+ * particle's volume m / rho is its lattice cell, so a hydrostatic start is in equilibrium on the
+ * lattice (with mass rho0 dx^D the volumes of the compressed lower rows would fall short of the
+ * cells they fill, and the pressure gradient that holds them rises by up to rho g h / (rho0 c0^2)):
+ * the lattice points of
  * lahar_case_block_lattice, i.e. inside the block and outside every body (a particle that starts
  * inside a body would be a crossing at step 0). 0, or -1 when out of memory or p has no room. */
 static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
@@ -94,6 +98,7 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         free(rho);
         return -1;
     }
+    const double vol = pow(c->sph_dx, c->dim);
     int rc = 0;
     for (int b = 0; b < c->nblock && !rc; b++) {
         int64_t n = lahar_case_block_lattice(c, b, pts, most);
@@ -101,11 +106,12 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         /* soil blocks (sph_soil.h): at the rest density of their material, stress-free */
         const int soil = c->blocks[b].phase == SPH_SOIL_PHASE;
         const double rho_b = soil ? c->materials[c->blocks[b].material].density : c->sph_density;
-        const double m = rho_b * pow(c->sph_dx, c->dim);
+        const double m = rho_b * vol;
         if (n > 0 && !soil)
             sph_node_block_density(c, (const double(*)[3])pts, n, rho);
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, soil ? rho_b : rho[i], soil ? SPH_SOIL_PHASE : 0) < 0
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, soil ? m : rho[i] * vol, soil ? rho_b : rho[i],
+                                   soil ? SPH_SOIL_PHASE : 0) < 0
                      ? -1
                      : 0;
     }
@@ -163,6 +169,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->cfl_force = o->cfl_force;
     prm->cfl_visc = o->cfl_visc;
     prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
+    prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
+                                                                            : SPH_WALL_PRESSURE_PENALTY;
     prm->shepard_every = o->shepard_interval;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;

@@ -1,6 +1,7 @@
 /* sph.initial_pressure: hydrostatic (sph_node/sph_node.c lahar_sph_node_fill): every particle of a
  * block starts at the density whose EOS pressure is rho0 |g| (h - height), h the block's top (half
- * a spacing above its highest particle centre, = the box's hi along gravity), mass rho0 dx^D.
+ * a spacing above its highest particle centre, = the box's hi along gravity), volume dx^D (its lattice
+ * cell), mass rho dx^D.
  * References computed here independently of the node's code, tolerance 1e-12 relative on rho:
  *  - linear EOS (paper 000 eq. 3), 2D box 0.4 x 0.2 m, dx 10 mm, gravity -y:
  *    rho = rho0 + rho0 g (h - y) / c0^2;
@@ -59,6 +60,7 @@ static void test_linear_2d(const char *dir)
                                     "  density: 1000\n"
                                     "  c0: 20\n"
                                     "  initial_pressure: hydrostatic\n"
+                                    "  wall_pressure: ghost\n"
                                     "  blocks:\n"
                                     "    - {name: water, box: {lo: [0, 0], hi: [0.4, 0.2]}}\n";
     lahar_case c;
@@ -77,13 +79,13 @@ static void test_linear_2d(const char *dir)
         double want = rho0 + rho0 * g * (H - p.y[i]) / (c0 * c0);
         worst_rho = fmax(worst_rho, fabs(p.rho[i] / want - 1));
         worst_p = fmax(worst_p, fabs(sph_fluid_pressure(&prm, p.rho[i]) - rho0 * g * (H - p.y[i])) / (rho0 * g * H));
-        worst_m = fmax(worst_m, fabs(p.m[i] / (rho0 * dx * dx) - 1));
+        worst_m = fmax(worst_m, fabs(p.m[i] / (p.rho[i] * dx * dx) - 1));
     }
     printf("linear 2D: %lld particles, rho rel error max %.3g, p round trip %.3g of rho0 g H, mass %.3g\n",
            (long long)n, worst_rho, worst_p, worst_m);
     CHECK(worst_rho <= 1e-12, "linear: rho off the inverse EOS by %g", worst_rho);
     CHECK(worst_p <= 1e-9, "linear: EOS pressure off rho0 g (H - y) by %g of rho0 g H", worst_p);
-    CHECK(worst_m <= 1e-12, "linear: mass off rho0 dx^2 by %g", worst_m);
+    CHECK(worst_m <= 1e-12, "linear: mass off rho dx^2 (volume dx^2) by %g", worst_m);
 
     /* the scene message carries the option to the SPH node */
     lahar_scene_t msg;
@@ -92,6 +94,9 @@ static void test_linear_2d(const char *dir)
     CHECK(lahar_scene_msg_from_case(&c, "/tmp", 0, 1, 1, &msg) == 0, "scene message");
     CHECK(lahar_scene_msg_to_case(&msg, &back, err, sizeof err) == 0, "scene message back: %s", err);
     CHECK(back.sph.initial_pressure == LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC, "initial_pressure lost in the message");
+    CHECK(c.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && back.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST,
+          "wall_pressure not read or lost in the message");
+    CHECK(prm.wall_pressure == SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
     lahar_scene_msg_release(&msg);
     lahar_case_free(&back);
     sph_particles_free(&p);

@@ -45,3 +45,10 @@ lahar_validation_test(cylinder_array_2d_c0.1 cylinder_array_2d dx=0.004 c=0.1)
 lahar_validation_test(cylinder_array_2d_c0.4 cylinder_array_2d dx=0.004 c=0.4)
 lahar_validation_test(sinking_disc_2d sinking_disc_2d dx=0.005
   "sink_distance>=0.1" "rotation_deg>=10" "final_speed_rel<=0.05" "rest_gap_rel<=1")
+
+# Hydrostatic tank (issue 3; cases/README.md "Validation results"): side wall force within 1 % of
+# rho g h^2 / 2 (x width in 3D) and particle pressures within 1 % (L2) of rho g (h - y), at dx =
+# 10 mm (20 rows), 2 s in 2D and 1 s in 3D (the tanks start at rest on their lattice, so this is
+# settled: max speed < 1 % of sqrt(g h)); also the free surface level within 5 % of h.
+lahar_validation_test(hydrostatic_2d hydrostatic_2d dx=0.01 end=2 "free_surface_spread_rel<=0.05" "max_speed_rel<=0.01")
+lahar_validation_test(hydrostatic_3d hydrostatic_3d dx=0.01 end=1 "free_surface_spread_rel<=0.05" "max_speed_rel<=0.01")
