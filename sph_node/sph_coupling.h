@@ -83,6 +83,9 @@ typedef struct {
     int cross_body;            /* first crossing (lowest particle index): body, particle id, depth */
     int64_t cross_particle_id;
     double cross_depth;        /* how far inside the swept surface (m, > 0) */
+    /* periodic axes of the fluid (sph_coupling_set_periodic; none after init) */
+    int periodic[3];
+    double period[3];          /* hi - lo on the periodic axes */
 } sph_coupling;
 
 /* Shapes with more features than this get a feature grid (geom_point_body_core_near). */
@@ -101,6 +104,16 @@ void sph_coupling_free(sph_coupling *c);
  * contact list and the crossing count. Returns the number of crossings, or -1 when the contact
  * list cannot grow (out of memory). */
 int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt);
+
+/* Periodic axes of the fluid: axis a with periodic[a] repeats with period [lo[a], hi[a]). A particle
+ * then interacts with every periodic image of every body (the body shifted by whole periods) whose
+ * swept surface is within the kernel support, so a body near (or across) a periodic boundary acts
+ * on the particles on the other side of it, as the fluid's own neighbour sums do. Contacts,
+ * forces and torques stay per body: an image's contact point is mapped back onto the body itself
+ * (the particle is shifted, not the body). A body at least as long as the period along an axis
+ * (fixed: its world box; moving: its bounding sphere's diameter) spans that axis, like the walls
+ * of a periodic channel, and has no images along it. z is ignored in 2D. */
+void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const double lo[3], const double hi[3]);
 
 /* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d);

@@ -74,6 +74,7 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
+    sph_coupling_set_periodic(&f->cpl, f->prm.periodic, f->prm.lo, f->prm.hi); /* bodies act across them */
     f->has_bodies = 1;
     f->primed = 0;
     return 0;
