@@ -12,6 +12,7 @@ void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const dou
     for (int a = 0; a < 3; a++) {
         c->periodic[a] = periodic && periodic[a] && !(a == 2 && c->dim == 2) && hi[a] > lo[a];
         c->period[a] = c->periodic[a] ? hi[a] - lo[a] : 0.0;
+        c->period_lo[a] = c->periodic[a] ? lo[a] : 0.0;
     }
 }
 
@@ -247,7 +248,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
              * towards the body, for every n along each periodic axis that brings it within the
              * body's range plus the support; the contact then lies on the body itself. A body as
              * long as the period along an axis (a channel's wall) overlaps its own images: it
-             * spans that axis and has none along it, as without images. */
+             * spans that axis and has none along it, as without images; a body outside the period
+             * (plus the support) is outside the domain and has none either. */
             int nlo[3] = {0, 0, 0}, nhi[3] = {0, 0, 0};
             for (int a = 0; a < 3; a++) {
                 /* the range of the body along a: its world box when fixed (tight), else its sphere */
@@ -255,8 +257,9 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 int boxed = body->motion == LAHAR_MOTION_FIXED && isfinite(bb[a]) && isfinite(bb[3 + a]);
                 double lo = boxed ? bb[a] : bx[a] - c->bound[b], hi = boxed ? bb[3 + a] : bx[a] + c->bound[b];
                 double xa = v3_get(xp, a);
-                if (c->periodic[a] && hi - lo < c->period[a] && isfinite(xa) &&
-                    fabs(xa - 0.5 * (lo + hi)) < 1e6 * c->period[a]) {
+                const double plo = c->period_lo[a], phi = plo + c->period[a];
+                if (c->periodic[a] && hi - lo < c->period[a] && hi > plo - support && lo < phi + support &&
+                    isfinite(xa)) {
                     nlo[a] = (int)ceil((xa - hi - support) / c->period[a]);
                     nhi[a] = (int)floor((xa - lo + support) / c->period[a]);
                 }

@@ -9,7 +9,8 @@
  *     (eq. 21), and the number of contacts, to round-off (1e-9 of the largest value);
  * for
  *   1. a fixed 2D disc (world-frame core: the world-box range of images) moved onto a corner of
- *      the period (it straddles both periodic axes), onto an edge, and several periods away;
+ *      the period (it straddles both periodic axes), onto an edge and across two edges; and
+ *      outside the period (ten periods away) it touches nothing (0 contacts);
  *   2. a free, translating and rotating 2D disc (body states, sphere range of images) on an edge:
  *      u_rel of eq. 16 and the torque about its centre;
  *   3. a fixed 3D box across the x and z boundaries of a domain periodic in x and z only;
@@ -199,12 +200,21 @@ int main(void)
         disc.q[0] = 1.0;
         result ref, got;
         evaluate(2, per2, 1, &disc, NULL, mid, zero, 20, 20, 1, &ref);
-        const double shifts[3][3] = {{-0.1, -0.1, 0}, {0.1, 0.03, 0}, {0.47, -0.55, 0}};
+        const double shifts[3][3] = {{-0.1, -0.1, 0}, {0.1, 0.03, 0}, {0.12, -0.11, 0}};
         const char *names[3] = {"fixed disc on the corner (0, 0)", "fixed disc on the edge x = L",
-                                "fixed disc periods away (0.57, -0.45)"};
+                                "fixed disc across x = L and y = 0"};
         for (int s = 0; s < 3; s++) {
             evaluate(2, per2, 1, &disc, NULL, mid, shifts[s], 20, 20, 1, &got);
             compare(names[s], &ref, &got, 0.05);
+            free(got.a);
+        }
+        /* a disc outside the period (ten periods away, as a marker body parked far from the
+         * fluid) is outside the domain: no images, no contacts */
+        {
+            const double far[3] = {1.9, 2.0, 0};
+            evaluate(2, per2, 1, &disc, NULL, mid, far, 20, 20, 1, &got);
+            printf("%-40s %5lld contacts\n", "fixed disc outside the period", (long long)got.ncontacts);
+            CHECK(got.ncontacts == 0, "a disc outside the period has %lld contacts", (long long)got.ncontacts);
             free(got.a);
         }
         /* 5. the same corner disc without images: only the particles in its own quadrant of the
