@@ -7,6 +7,15 @@
 #include "geometry.h"
 #include "vec.h"
 
+void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const double lo[3], const double hi[3])
+{
+    for (int a = 0; a < 3; a++) {
+        c->periodic[a] = periodic && periodic[a] && !(a == 2 && c->dim == 2) && hi[a] > lo[a];
+        c->period[a] = c->periodic[a] ? hi[a] - lo[a] : 0.0;
+        c->period_lo[a] = c->periodic[a] ? lo[a] : 0.0;
+    }
+}
+
 /* G(d) = sum over ghost layers at depths s_k = (k + 1/2) dx behind the surface of
  * (1 + s_k/d) dx int_layer W'(r)/r r^2/(r^2 + eta^2) dA, for a particle at distance d in front of it.
  * The layers mirror the fluid lattice (first fluid row at dx/2 in front of the surface, first
@@ -450,7 +459,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         int ns = 0;
-        vec3 xi = v3(p->x[i], p->y[i], p->z[i]);
+        const vec3 xp = v3(p->x[i], p->y[i], p->z[i]);
         vec3 ftot = v3(0, 0, 0);
         /* soil-DEM springs of this evaluation (sph_coupling_enable_soil) */
         const int soil = p->phase[i] != 0 && c->soil_hist_body;
@@ -466,79 +475,105 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             const double *bv = st ? st->v : body->v, *bw = st ? st->w : body->w;
             vec3 xb = v3_load(bx);
             const double R = body->shape.radius;
-            /* bounding sphere; fixed bodies keep world-frame vertices (x = origin of that frame) */
-            if (v3_norm(v3_sub(xi, xb)) > c->bound[b] + support)
-                continue;
-            if (body->motion == LAHAR_MOTION_FIXED) {
+            /* periodic images (sph_coupling_set_periodic): the particle shifted by n whole periods
+             * towards the body, for every n along each periodic axis that brings it within the
+             * body's range plus the support; the contact then lies on the body itself. A body as
+             * long as the period along an axis (a channel's wall) overlaps its own images: it
+             * spans that axis and has none along it, as without images; a body outside the period
+             * (plus the support) is outside the domain and has none either. */
+            int nlo[3] = {0, 0, 0}, nhi[3] = {0, 0, 0};
+            for (int a = 0; a < 3; a++) {
+                /* the range of the body along a: its world box when fixed (tight), else its sphere */
                 const double *bb = c->box[b];
-                if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support ||
-                    xi.y > bb[4] + support || xi.z < bb[2] - support || xi.z > bb[5] + support)
-                    continue;
-            }
-            vec3 core = xb;
-            /* big shapes (terrain, flumes): only the features near the particle */
-            double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
-                                                                   &core, NULL)
-                                       : geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
-            int inside = inside_core(body, bx, bq, xi, c->dim); /* deep inside: far from the surface */
-            if (dc - R >= support && !inside)
-                continue;
-            if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
-                dc = 0.0;
-            int cross = inside || dc < R;
-            vec3 nrm;
-            double d;
-            if (dc > 0.0) {
-                nrm = v3_scale(v3_sub(xi, core), 1.0 / dc);
-                d = dc - R; /* eq. 13, signed */
-                if (inside) {
-                    nrm = v3_neg(nrm);
-                    d = -dc - R;
+                int boxed = body->motion == LAHAR_MOTION_FIXED && isfinite(bb[a]) && isfinite(bb[3 + a]);
+                double lo = boxed ? bb[a] : bx[a] - c->bound[b], hi = boxed ? bb[3 + a] : bx[a] + c->bound[b];
+                double xa = v3_get(xp, a);
+                const double plo = c->period_lo[a], phi = plo + c->period[a];
+                if (c->periodic[a] && hi - lo < c->period[a] && hi > plo - support && lo < phi + support &&
+                    isfinite(xa)) {
+                    nlo[a] = (int)ceil((xa - hi - support) / c->period[a]);
+                    nhi[a] = (int)floor((xa - lo + support) / c->period[a]);
                 }
-            } else {
-                nrm = v3(0, 0, 0); /* on the core: no direction to push; counted as a crossing */
-                d = -R;
             }
-            vec3 xs = v3_axpy(R, nrm, core);         /* eq. 12 */
-            double delta = c->eps - d;               /* eq. 14 */
-            vec3 fn = delta > 0.0 ? v3_scale(nrm, kn * delta) : v3(0, 0, 0); /* eq. 15 */
-            /* eq. 16: relative velocity to the body's surface at x_s */
-            vec3 urel = v3_sub(v3(p->vx[i], p->vy[i], p->vz[i]),
-                               v3_add(v3_load(bv), v3_cross(v3_load(bw), v3_sub(xs, xb))));
-            double dv = fmax(d, 0.5 * c->eps); /* the viscous term's distance, kept off zero */
-            double coef;
-            if (c->viscous == SPH_WALL_VISCOUS_HALFSPACE)
-                coef = 2.0 * c->mu / p->rho[i] * sph_coupling_halfspace_factor(c, dv);
-            else /* eq. 17 as printed */
-                coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
-                       kernel_dwdr(&c->k, dv) / w0;
-            /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
-            vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
-            if (soil && delta > 0.0) {
-                ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, kn * delta, kn, dt, hist_d[nh]);
-                hist_b[nh++] = b;
+            const int nx = nhi[0] - nlo[0] + 1, ny = nhi[1] - nlo[1] + 1, nimg = nx * ny * (nhi[2] - nlo[2] + 1);
+            for (int img = 0; img < nimg && ns < SPH_COUPLING_MAX_PER_PARTICLE; img++) {
+                const int ix = nlo[0] + img % nx, iy = nlo[1] + img / nx % ny, iz = nlo[2] + img / (nx * ny);
+                /* without images (ix = iy = iz = 0) xi is the particle's position bit for bit */
+                vec3 xi = v3(xp.x - ix * c->period[0], xp.y - iy * c->period[1], xp.z - iz * c->period[2]);
+                /* bounding sphere; fixed bodies keep world-frame vertices (x = origin of that frame) */
+                if (v3_norm(v3_sub(xi, xb)) > c->bound[b] + support)
+                    continue;
+                if (body->motion == LAHAR_MOTION_FIXED) {
+                    const double *bb = c->box[b];
+                    if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support ||
+                        xi.y > bb[4] + support || xi.z < bb[2] - support || xi.z > bb[5] + support)
+                        continue;
+                }
+                vec3 core = xb;
+                /* big shapes (terrain, flumes): only the features near the particle */
+                double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
+                                                                       &core, NULL)
+                                           : geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
+                int inside = inside_core(body, bx, bq, xi, c->dim); /* deep inside: far from the surface */
+                if (dc - R >= support && !inside)
+                    continue;
+                if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
+                    dc = 0.0;
+                int cross = inside || dc < R;
+                vec3 nrm;
+                double d;
+                if (dc > 0.0) {
+                    nrm = v3_scale(v3_sub(xi, core), 1.0 / dc);
+                    d = dc - R; /* eq. 13, signed */
+                    if (inside) {
+                        nrm = v3_neg(nrm);
+                        d = -dc - R;
+                    }
+                } else {
+                    nrm = v3(0, 0, 0); /* on the core: no direction to push; counted as a crossing */
+                    d = -R;
+                }
+                vec3 xs = v3_axpy(R, nrm, core);         /* eq. 12 */
+                double delta = c->eps - d;               /* eq. 14 */
+                vec3 fn = delta > 0.0 ? v3_scale(nrm, kn * delta) : v3(0, 0, 0); /* eq. 15 */
+                /* eq. 16: relative velocity to the body's surface at x_s */
+                vec3 urel = v3_sub(v3(p->vx[i], p->vy[i], p->vz[i]),
+                                   v3_add(v3_load(bv), v3_cross(v3_load(bw), v3_sub(xs, xb))));
+                double dv = fmax(d, 0.5 * c->eps); /* the viscous term's distance, kept off zero */
+                double coef;
+                if (c->viscous == SPH_WALL_VISCOUS_HALFSPACE)
+                    coef = 2.0 * c->mu / p->rho[i] * sph_coupling_halfspace_factor(c, dv);
+                else /* eq. 17 as printed */
+                    coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
+                           kernel_dwdr(&c->k, dv) / w0;
+                /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
+                vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
+                if (soil && delta > 0.0) {
+                    ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, kn * delta, kn, dt, hist_d[nh]);
+                    hist_b[nh++] = b;
+                }
+                vec3 f = v3_add(fn, ft);
+                gd[ns] = -1.0;
+                if (c->pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
+                    double drw;
+                    if (pbar != pbar)
+                        pbar = ghost_pbar(c, p, i);
+                    f = v3_axpy(p->m[i], ghost_wall_accel(c, p->p[i], pbar, p->rho[i], dv, nrm, urel, &drw), f);
+                    drho_g += drw;
+                    gn[ns] = nrm;
+                    gd[ns] = dv;
+                    gu[ns] = urel;
+                }
+                ftot = v3_add(ftot, f);
+                int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;
+                c->slot_body[k] = cross ? -(b + 1) : b;
+                sph_contact *ct = &c->slot[k];
+                v3_store(xs, ct->xs);
+                v3_store(v3_neg(f), ct->force); /* eq. 20 */
+                ct->delta = delta;
+                ct->particle_id = p->id[i];
+                ns++;
             }
-            vec3 f = v3_add(fn, ft);
-            gd[ns] = -1.0;
-            if (c->pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
-                double drw;
-                if (pbar != pbar)
-                    pbar = ghost_pbar(c, p, i);
-                f = v3_axpy(p->m[i], ghost_wall_accel(c, p->p[i], pbar, p->rho[i], dv, nrm, urel, &drw), f);
-                drho_g += drw;
-                gn[ns] = nrm;
-                gd[ns] = dv;
-                gu[ns] = urel;
-            }
-            ftot = v3_add(ftot, f);
-            int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;
-            c->slot_body[k] = cross ? -(b + 1) : b;
-            sph_contact *ct = &c->slot[k];
-            v3_store(xs, ct->xs);
-            v3_store(v3_neg(f), ct->force); /* eq. 20 */
-            ct->delta = delta;
-            ct->particle_id = p->id[i];
-            ns++;
         }
         /* ghost pressure at a concave corner of perpendicular bodies: the quadrant behind both
          * once, not twice (sph_coupling.h) */

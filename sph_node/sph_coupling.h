@@ -116,6 +116,10 @@ typedef struct {
     int cross_body;            /* first crossing (lowest particle index): body, particle id, depth */
     int64_t cross_particle_id;
     double cross_depth;        /* how far inside the swept surface (m, > 0) */
+    /* periodic axes of the fluid (sph_coupling_set_periodic; none after init) */
+    int periodic[3];
+    double period[3];          /* hi - lo on the periodic axes */
+    double period_lo[3];       /* lo on the periodic axes */
     /* soil-DEM friction (sph_coupling_enable_soil; NULL/0 without soil): per particle id, up to
      * SPH_COUPLING_MAX_PER_PARTICLE (body, delta_tau) pairs of the last evaluation */
     double mu_phi;
@@ -140,6 +144,17 @@ void sph_coupling_free(sph_coupling *c);
  * list cannot grow (out of memory). */
 int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt);
 
+/* Periodic axes of the fluid: axis a with periodic[a] repeats with period [lo[a], hi[a]). A particle
+ * then interacts with every periodic image of every body (the body shifted by whole periods) whose
+ * swept surface is within the kernel support, so a body near (or across) a periodic boundary acts
+ * on the particles on the other side of it, as the fluid's own neighbour sums do. Contacts,
+ * forces and torques stay per body: an image's contact point is mapped back onto the body itself
+ * (the particle is shifted, not the body). A body at least as long as the period along an axis
+ * (fixed: its world box; moving: its bounding sphere's diameter) spans that axis, like the walls
+ * of a periodic channel, and has no images along it; so has a body entirely outside the period
+ * (and the support around it) along an axis: it is outside the fluid's domain (a marker body
+ * parked far away stays inert). z is ignored in 2D. */
+void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const double lo[3], const double hi[3]);
 /* Soil-DEM friction (paper 000 section 4.2, eq. 22-27) for the soil particles (phase != 0): instead
  * of the water's viscous term, a tangential spring with a history per (particle, body) pair, kept
  * by particle id (so it survives the sort):

@@ -98,6 +98,7 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
+    sph_coupling_set_periodic(&f->cpl, f->prm.periodic, f->prm.lo, f->prm.hi); /* bodies act across them */
     if (f->has_soil && sph_coupling_enable_soil(&f->cpl, f->prm.soil_mat.mu_phi) != 0) { /* 000 section 4.2 */
         sph_coupling_free(&f->cpl);
         return -1;
