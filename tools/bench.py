@@ -114,7 +114,37 @@ def log(msg):
 
 # --------------------------------------------------------------------------------------------
 # One run: lahar run/check as a child, with its rusage (peak memory, CPU time) from wait4.
+def _vm_hwm_kb(pid):
+    """Peak resident set (VmHWM) of one process, kB; 0 when it is gone."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1])
+    except (OSError, ValueError):
+        pass
+    return 0
+
+
+def _descendants(pid):
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            for t in os.listdir(f"/proc/{p}/task"):
+                with open(f"/proc/{p}/task/{t}/children") as f:
+                    kids = [int(k) for k in f.read().split()]
+                out += kids
+                todo += kids
+        except (OSError, ValueError):
+            pass
+    return out
+
+
 def run_lahar(lahar, cmd, case_path, out, threads, in_process=True, timeout=600.0, check_plot=False):
+    """Runs lahar as a child; returns its exit status, wall and CPU time (wait4) and peak memory:
+    the sum over lahar and the nodes it starts of each process's VmHWM, sampled every 50 ms (wait4's
+    ru_maxrss cannot be used: Linux carries the forking Python's high-water mark across exec)."""
     argv = [lahar, cmd, case_path, "-o", out, "-q"]
     if threads:
         argv += ["--threads", str(threads)]
@@ -127,10 +157,13 @@ def run_lahar(lahar, cmd, case_path, out, threads, in_process=True, timeout=600.
         shutil.rmtree(out)
     load = os.getloadavg()[0]
     t0 = time.monotonic()
+    hwm = {}
     with open(out + ".log", "w") as logf:
         p = subprocess.Popen(argv, stdout=logf, stderr=subprocess.STDOUT, env=env, start_new_session=True)
         status, ru = None, None
         while True:
+            for q in [p.pid] + _descendants(p.pid):
+                hwm[q] = max(hwm.get(q, 0), _vm_hwm_kb(q))
             pid, st, r = os.wait4(p.pid, os.WNOHANG)
             if pid == p.pid:
                 status, ru = st, r
@@ -150,7 +183,7 @@ def run_lahar(lahar, cmd, case_path, out, threads, in_process=True, timeout=600.
     wall = time.monotonic() - t0
     code = "timeout" if status is None else (os.waitstatus_to_exitcode(status))
     return dict(exit_status=code, process_wall_s=wall, cpu_s=ru.ru_utime + ru.ru_stime,
-                peak_rss_mb=ru.ru_maxrss / 1024.0, load_avg=load)
+                peak_rss_mb=sum(hwm.values()) / 1024.0, load_avg=load)
 
 
 def read_json(path):
@@ -218,8 +251,13 @@ def bench_case(args, name, spec, outdir):
     os.makedirs(rundir, exist_ok=True)
     rows = []
     runs = plan_case(name, spec, args.quick)
-    log(f"== {name}: {len(runs)} runs (error: {spec['error_note']})")
+    done = read_csv_rows(os.path.join(outdir, f"{name}.csv")) if args.resume else {}
+    log(f"== {name}: {len(runs)} runs (error: {spec['error_note']})"
+        + (f", {sum(1 for r in runs if r[0] in done)} taken from the existing {name}.csv" if done else ""))
     for label, family, setting, dx, ov in runs:
+        if label in done:
+            rows.append(done[label])
+            continue
         overrides = dict(spec["overrides"])
         overrides["sph.dx"] = dx
         overrides.update(ov)
@@ -250,6 +288,26 @@ def bench_case(args, name, spec, outdir):
     write_csv(os.path.join(outdir, f"{name}.csv"), rows, CSV_COLUMNS)
     plot_pareto(os.path.join(outdir, f"{name}_pareto.png"), name, spec, rows)
     return rows
+
+
+def read_csv_rows(path):
+    """Rows of an earlier OUT/<case>.csv by label (--resume), numbers as numbers."""
+    if not os.path.exists(path):
+        return {}
+    out = {}
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            row = {}
+            for k, v in r.items():
+                try:
+                    row[k] = int(v) if re.fullmatch(r"-?\d+", v or "") else float(v)
+                except (TypeError, ValueError):
+                    row[k] = v
+            for k in ("label", "family", "setting", "error_metrics", "overrides", "case"):
+                row[k] = r[k]
+            if row.get("exit_status") in (0, 1):
+                out[r["label"]] = row
+    return out
 
 
 def write_csv(path, rows, columns):
@@ -501,6 +559,8 @@ def main(argv):
     ap.add_argument("--repeat", type=int, default=3, help="pairs of runs of the overhead section (median is used)")
     ap.add_argument("--overhead-end", type=float, default=0.02, help="simulated time of the overhead runs [s]")
     ap.add_argument("--subcycle-end", type=float, default=0.1, help="simulated time of the subcycling runs [s]")
+    ap.add_argument("--resume", action="store_true",
+                    help="pareto: take the runs already in OUT/<case>.csv (finished ones) instead of running them again")
     ap.add_argument("--keep", action="store_true", help="keep the runs' HDF5 files (deleted by default)")
     ap.add_argument("--list", action="store_true", help="print the planned runs and exit")
     args = ap.parse_args(argv)
