@@ -319,7 +319,7 @@ def write_csv(path, rows, columns):
             w.writerow({k: (fmt(v, 6) if isinstance(v, float) else v) for k, v in r.items()})
 
 
-COST_LABEL = {"wall_s": "wall time of the run [s]", "cpu_s": "CPU time of the run (user + system, all threads) [s]"}
+COST_LABEL = {"wall_s": "wall time of the run [s]", "cpu_s": "CPU time of the run (user + system) [s]"}
 
 
 def pareto_front(rows, cost="wall_s"):
@@ -364,7 +364,7 @@ def plot_pareto(path, name, spec, rows, cost="wall_s"):
     failed = [r for r in rows if not math.isfinite(r["error"])]
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel(COST_LABEL[cost] + " (numbers next to the case-settings points: particles)")
+    ax.set_xlabel(COST_LABEL[cost])
     ax.set_ylabel("error")
     title = f"{name}: error against {'wall' if cost == 'wall_s' else 'CPU'} time"
     if failed:
@@ -373,7 +373,7 @@ def plot_pareto(path, name, spec, rows, cost="wall_s"):
     ax.set_title(title, fontsize=9)
     fig.text(0.01, 0.01, "error: " + spec["error_note"], fontsize=6.5)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="best", title="numbers: particles", title_fontsize=7)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
     fig.savefig(path)
     plt.close(fig)
