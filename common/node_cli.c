@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "netns.h"
+#include "lahar_stop_t.h"
 #include "scene_msg.h"
 
 static void node_usage(FILE *f, const char *prog, const char *about, const char *exit_codes)
@@ -91,4 +92,16 @@ int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_
     if (rc != LAHAR_LINK_OK || lahar_step_t_decode(msg->data, 0, msg->size, step) < 0)
         return 1;
     return -1;
+}
+
+int lahar_node_stop_reason(const lahar_link_msg *msg, char *text, size_t n)
+{
+    lahar_stop_t st;
+    if (lahar_stop_t_decode(msg->data, 0, msg->size, &st) < 0)
+        return -1;
+    int reason = st.reason;
+    if (text && n > 0)
+        snprintf(text, n, "%s", st.message ? st.message : "");
+    lahar_stop_t_decode_cleanup(&st);
+    return reason;
 }

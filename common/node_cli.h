@@ -32,4 +32,9 @@ int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, 
  * (reported as "prog: ..."), 1 a broken message. `msg` is the caller's receive slot. */
 int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_msg *msg, lahar_step_t *step);
 
+/* After lahar_node_wait_step returned 0: the reason of the coordinator's STOP in msg (stop_t:
+ * 0 finished, 1 error, 2 interrupted, 3 node lost; -1 if undecodable) and its message into
+ * text (n bytes, may be NULL). A node writes its final snapshot for inspection when it is not 0. */
+int lahar_node_stop_reason(const lahar_link_msg *msg, char *text, size_t n);
+
 #endif

@@ -39,7 +39,9 @@ enum {
     LAHAR_PFIELD_PRESSURE = 1 << 2,
     LAHAR_PFIELD_PHASE = 1 << 3,    /* int32 */
     LAHAR_PFIELD_ID = 1 << 4,       /* int64 */
-    LAHAR_PFIELD_ALL = 0x1f
+    LAHAR_PFIELD_STRESS = 1 << 5,   /* soil effective stress, n x 6: xx, xy, xz, yy, yz, zz (Pa, tension
+                                       positive; 0 for water particles) */
+    LAHAR_PFIELD_ALL = 0x1f         /* every field of a water-only scene; soil scenes add STRESS */
 };
 
 /* One snapshot of particles as structure-of-arrays. Arrays for fields not selected at open may
@@ -51,6 +53,7 @@ typedef struct {
     const double *density, *pressure;
     const int32_t *phase;
     const int64_t *id;
+    const double *stress[6]; /* SoA xx, xy, xz, yy, yz, zz; NULL without soil (then not written) */
 } lahar_particles_view;
 
 typedef struct lahar_particle_output lahar_particle_output;
@@ -82,6 +85,14 @@ void lahar_contact_output_close(lahar_contact_output *o);
  * missing). Safe to call when no writer has the files open, e.g. by the coordinator at the end
  * of a run; the writers also call it from their close. Returns 0, or -1 with a message. */
 int lahar_output_xdmf_combine(const char *outdir, char *err, size_t n);
+
+/* A run stopped by an instability or an error: mark the last snapshot of OUT/<file> (bodies.h5,
+ * particles.h5) with a string attribute `name` holding `text` (the report), so that whoever opens
+ * the final snapshot sees why the run ended there. 0, or -1 (message on stderr). */
+int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const char *name, const char *text);
+/* The last snapshot of OUT/<file>: its group ("/snapshots/NNNNNN"), step and time. 0, or -1 when
+ * the file is missing or has none. */
+int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t);
 
 /* Display mesh of a sphero-polyhedron for viewers (not used by the physics): a closed surface of
  * triangles in 3D (spheres: icospheres; polyhedra: core faces offset by the sweep radius plus

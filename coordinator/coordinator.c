@@ -19,6 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "dem_node.h"
+#include "instability.h"
 #include "lahar_hello_t.h"
 #include "lahar_status_t.h"
 #include "lahar_step_t.h"
@@ -59,6 +60,7 @@ typedef struct {
     double dt_proposed, dt_stable, kinetic_energy;
     int ncontacts;
     double starved_s;            /* silence forgiven so far (COORD_NODE_STARVED_MAX) */
+    lahar_status_t work;         /* the work_* fields of the last STATUS (cumulative) */
 } coord_node;
 
 typedef struct {
@@ -76,6 +78,9 @@ typedef struct {
     double wall0;
     const char *status;
     char message[1024];
+    lahar_instability inst;  /* status "unstable": what, where, when (summary.json "instability") */
+    int has_inst;
+    const char *inst_node;   /* who caught it: "dem", "sph" or "coordinator" */
     int exit_status;
     int progress;           /* progress line on stderr */
     double last_progress;
@@ -348,6 +353,49 @@ static int coord_hello(coord *co)
     return LAHAR_EXIT_OK;
 }
 
+/* The work counters of a STATUS: cumulative, so the last STATUS holds the run's totals. */
+static void coord_take_work(coord_node *n, const lahar_status_t *s)
+{
+    n->work.work_passes = s->work_passes;
+    n->work.work_pairs_fluid = s->work_pairs_fluid;
+    n->work.work_pairs_soil = s->work_pairs_soil;
+    n->work.work_pairs_fluid_soil = s->work_pairs_fluid_soil;
+    n->work.work_particle_body = s->work_particle_body;
+    n->work.work_body_body = s->work_body_body;
+    n->work.work_output_derived = s->work_output_derived;
+}
+
+/* summary.json "work": what the run computed and sent, per kind (coordinator/README.md). Nodes
+ * that did not take part count 0. */
+static void coord_summary_work(const coord *co, cJSON *root)
+{
+    const lahar_status_t *sph = &co->node[LAHAR_ROLE_SPH].work, *dem = &co->node[LAHAR_ROLE_DEM].work;
+    cJSON *w = cJSON_AddObjectToObject(root, "work");
+    cJSON_AddBoolToObject(w, "dem_node", co->node[LAHAR_ROLE_DEM].needed);
+    cJSON_AddBoolToObject(w, "sph_node", co->node[LAHAR_ROLE_SPH].needed);
+    cJSON_AddNumberToObject(w, "sph_passes", (double)sph->work_passes);
+    cJSON_AddNumberToObject(w, "pairs_fluid_fluid", (double)sph->work_pairs_fluid);
+    cJSON_AddNumberToObject(w, "pairs_soil_soil", (double)sph->work_pairs_soil);
+    cJSON_AddNumberToObject(w, "pairs_fluid_soil", (double)sph->work_pairs_fluid_soil);
+    cJSON_AddNumberToObject(w, "particle_body", (double)sph->work_particle_body);
+    cJSON_AddNumberToObject(w, "body_body", (double)dem->work_body_body);
+    cJSON_AddNumberToObject(w, "dem_substeps", (double)co->node[LAHAR_ROLE_DEM].substeps);
+    cJSON_AddNumberToObject(w, "output_derived", (double)(sph->work_output_derived + dem->work_output_derived));
+    /* per channel: messages and bytes of the run's first publications (re-sends excluded; they
+     * are in "channels") */
+    cJSON *ch = cJSON_AddObjectToObject(w, "channels");
+    if (co->link) {
+        lahar_link_stats st[LAHAR_NMSG];
+        lahar_link_get_stats(co->link, st);
+        for (int ty = 1; ty < LAHAR_NMSG; ty++) {
+            const lahar_link_stats *s = &st[ty];
+            cJSON *j = cJSON_AddObjectToObject(ch, lahar_link_channel(ty));
+            cJSON_AddNumberToObject(j, "messages", (double)(s->msgs_sent + s->msgs_heard));
+            cJSON_AddNumberToObject(j, "bytes", (double)(s->bytes_sent + s->bytes_heard - s->bytes_resent_heard));
+        }
+    }
+}
+
 /* Wait for STATUS(k) of every node; fills the node records. */
 static int coord_collect_status(coord *co, int64_t k)
 {
@@ -401,6 +449,11 @@ static int coord_collect_status(coord *co, int64_t k)
         int err = s.error;
         s.message[sizeof s.message - 1] = 0;
         const char *text = (const char *)s.message;
+        if (err && lahar_instability_decode(text, &co->inst)) {
+            co->has_inst = 1;
+            co->inst_node = r == LAHAR_ROLE_DEM ? "dem" : "sph";
+            text = co->inst.text;
+        }
         if (err)
             snprintf(co->message, sizeof co->message, "the %s reports at step %lld: %s", lahar_link_role_name(r),
                      (long long)k, text[0] ? text : "(no message)");
@@ -413,11 +466,12 @@ static int coord_collect_status(coord *co, int64_t k)
         n->dt_stable = s.dt_stable;
         n->kinetic_energy = s.kinetic_energy;
         n->ncontacts = s.ncontacts;
+        coord_take_work(n, &s);
         if (!err)
             n->last_step = k;
         lahar_status_t_decode_cleanup(&s);
         if (err) {
-            co->status = "error";
+            co->status = co->has_inst ? "unstable" : "error";
             return LAHAR_EXIT_RUN_ERROR;
         }
     }
@@ -443,12 +497,54 @@ static void coord_progress(coord *co, int final)
     fflush(stderr);
 }
 
+/* Time step collapse before step k (the nodes at t = co->sim_time): the step the nodes allow is
+ * below time.dt_min, or below stability.dt_collapse x the first step (the state has gone
+ * unstable: a blow-up drives the CFL and force limits of the SPH step down by orders of
+ * magnitude first). Names the node whose proposal sets the step. 1 when the run must stop. */
+static int coord_dt_collapse(coord *co, int64_t k, double dt_allowed, double dt_first)
+{
+    const lahar_case *c = co->c;
+    const double rel = c->stability.dt_collapse * dt_first;
+    if (!(dt_allowed < c->dt_min || dt_allowed < rel))
+        return 0;
+    int by = 0;
+    for (int r = 1; r < LAHAR_NROLES; r++)
+        if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed <= dt_allowed)
+            by = r;
+    lahar_instability *u = &co->inst;
+    memset(u, 0, sizeof *u);
+    snprintf(u->what, sizeof u->what, "dt collapse");
+    snprintf(u->name, sizeof u->name, "%s", by ? lahar_link_role_name(by) : "");
+    u->id = -1;
+    u->x[0] = u->x[1] = u->x[2] = NAN;
+    u->step = k;
+    u->t = co->sim_time;
+    u->value = dt_allowed;
+    const int absolute = dt_allowed < c->dt_min;
+    u->limit = absolute ? c->dt_min : rel;
+    if (absolute)
+        snprintf(u->text, sizeof u->text,
+                 "time step collapse before step %lld (t = %.9g s): the %s allows %.3g s < time.dt_min = %.3g s",
+                 (long long)k, co->sim_time, by ? lahar_link_role_name(by) : "nodes", dt_allowed, c->dt_min);
+    else
+        snprintf(u->text, sizeof u->text,
+                 "time step collapse before step %lld (t = %.9g s): the %s allows %.3g s < stability.dt_collapse "
+                 "%g x the first step %.3g s",
+                 (long long)k, co->sim_time, by ? lahar_link_role_name(by) : "nodes", dt_allowed,
+                 c->stability.dt_collapse, dt_first);
+    co->has_inst = 1;
+    co->inst_node = "coordinator";
+    co->status = "unstable";
+    snprintf(co->message, sizeof co->message, "%s", u->text);
+    return 1;
+}
+
 static int coord_lockstep(coord *co)
 {
     const lahar_case *c = co->c;
     lahar_clock clk;
     lahar_clock_init(&clk, c->t_end, c->output_interval);
-    double dt_allowed = c->dt_max;
+    double dt_allowed = c->dt_max, dt_first = c->dt_max;
     for (int r = 1; r < LAHAR_NROLES; r++)
         if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed < dt_allowed)
             dt_allowed = co->node[r].dt_proposed;
@@ -458,13 +554,10 @@ static int coord_lockstep(coord *co)
             snprintf(co->message, sizeof co->message, "interrupted at step %lld (t = %.9g s)", (long long)k, co->sim_time);
             return LAHAR_EXIT_RUN_ERROR;
         }
-        if (dt_allowed < c->dt_min) {
-            co->status = "error";
-            snprintf(co->message, sizeof co->message,
-                     "time step collapse at step %lld (t = %.9g s): the nodes allow %.3g s < dt_min = %.3g s", (long long)k,
-                     co->sim_time, dt_allowed, c->dt_min);
+        if (k == 0)
+            dt_first = dt_allowed;
+        if (coord_dt_collapse(co, k, dt_allowed, dt_first))
             return LAHAR_EXIT_RUN_ERROR;
-        }
         double t, t_next;
         int is_output;
         if (lahar_clock_next(&clk, dt_allowed, &t, &t_next, &is_output))
@@ -499,6 +592,56 @@ static int coord_lockstep(coord *co)
 }
 
 /* ---- summary ------------------------------------------------------------------------------- */
+
+/* summary.json of a run that did not finish: "instability" (what, where, when, as the node or
+ * the coordinator caught it) and "final_snapshot" (the last snapshot of each file: the state to
+ * inspect, marked in the HDF5 with an "instability" or "stopped" attribute). */
+static void coord_summary_instability(coord *co, cJSON *root)
+{
+    if (co->has_inst) {
+        const lahar_instability *u = &co->inst;
+        cJSON *j = cJSON_AddObjectToObject(root, "instability");
+        cJSON_AddStringToObject(j, "what", u->what);
+        cJSON_AddStringToObject(j, "caught_by", co->inst_node ? co->inst_node : "");
+        cJSON *w = cJSON_AddObjectToObject(j, "where");
+        cJSON_AddStringToObject(w, "kind", u->kind);
+        cJSON_AddNumberToObject(w, "id", (double)u->id);
+        cJSON_AddStringToObject(w, "name", u->name);
+        if (isfinite(u->x[0]) && isfinite(u->x[1]) && isfinite(u->x[2]))
+            cJSON_AddItemToObject(w, "position", cJSON_CreateDoubleArray(u->x, 3));
+        else
+            cJSON_AddNullToObject(w, "position");
+        cJSON *when = cJSON_AddObjectToObject(j, "when");
+        cJSON_AddNumberToObject(when, "step", (double)u->step);
+        cJSON_AddNumberToObject(when, "time", u->t);
+        if (isfinite(u->value))
+            cJSON_AddNumberToObject(j, "value", u->value);
+        else
+            cJSON_AddNullToObject(j, "value");
+        if (isfinite(u->limit))
+            cJSON_AddNumberToObject(j, "limit", u->limit);
+        else
+            cJSON_AddNullToObject(j, "limit");
+        cJSON_AddStringToObject(j, "message", u->text);
+    }
+    if (strcmp(co->status, "finished") == 0)
+        return;
+    cJSON *fs = NULL;
+    static const char *const files[] = {"particles.h5", "bodies.h5"};
+    for (int i = 0; i < 2; i++) {
+        char group[64];
+        int64_t step;
+        double t;
+        if (lahar_output_last_snapshot(co->outdir, files[i], group, sizeof group, &step, &t) != 0)
+            continue;
+        if (!fs)
+            fs = cJSON_AddObjectToObject(root, "final_snapshot");
+        cJSON *j = cJSON_AddObjectToObject(fs, files[i]);
+        cJSON_AddStringToObject(j, "group", group);
+        cJSON_AddNumberToObject(j, "step", (double)step);
+        cJSON_AddNumberToObject(j, "time", t);
+    }
+}
 
 static void coord_write_summary(coord *co)
 {
@@ -572,6 +715,8 @@ static void coord_write_summary(coord *co)
         }
     }
     cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
+    coord_summary_work(co, root);
+    coord_summary_instability(co, root);
     char *text = cJSON_Print(root);
     char path[PATH_MAX + 32];
     snprintf(path, sizeof path, "%s/summary.json", co->outdir);
@@ -616,6 +761,22 @@ static int64_t coord_random_run_id(void)
     return r ? (int64_t)r : 1;
 }
 
+/* The DEM node integrates bodies. With particles in the scene it is needed only when a body
+ * moves (free or prescribed): the SPH node knows fixed bodies from the scene, couples with them
+ * and writes their files, so a scene of water and fixed walls runs without it (no DEM STEP,
+ * STATUS, LOADS or BODY_STATE). Without particles it runs whenever there are bodies. */
+static int coord_dem_needed(const lahar_case *c)
+{
+    if (c->nbody == 0)
+        return 0;
+    if (c->nblock == 0)
+        return 1;
+    for (int i = 0; i < c->nbody; i++)
+        if (c->bodies[i].motion != LAHAR_MOTION_FIXED)
+            return 1;
+    return 0;
+}
+
 int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
 {
     coord co;
@@ -624,7 +785,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     co.o = o;
     co.status = "error";
     co.wall0 = lahar_now();
-    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = c->nbody > 0, .last_step = -1};
+    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
     co.node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
     if (!co.node[LAHAR_ROLE_DEM].needed && !co.node[LAHAR_ROLE_SPH].needed) {
         fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
@@ -758,7 +919,7 @@ out:
             if (access(path, R_OK) == 0)
                 printf("              h5dump -H %s\n", path);
         }
-        if (co.node[LAHAR_ROLE_DEM].needed)
+        if (c->nbody > 0 && c->output_forces)
             printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
                    LAHAR_TOOLS_DIR, co.outdir);
         printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co.outdir);

@@ -15,6 +15,8 @@
 #include <string.h>
 #include "case.h"
 #include "dem_engine.h"
+#include "instability.h"
+#include "node_cli.h"
 #include "lahar_body_state_t.h"
 #include "lahar_loads_t.h"
 #include "lahar_step_t.h"
@@ -176,6 +178,55 @@ static int dem_node_wait_stop(dem_node *d)
     }
 }
 
+/* After advance() failed in step k (ending at time t): when the engine reports an instability of
+ * the bodies (ops->fault), the report of common/instability.h with the body's name, the place
+ * (its centre or the contact point) and the step, else 0 (the engine's message stays). */
+static int dem_node_fault_report(const dem_node *d, int64_t k, double t, lahar_instability *u)
+{
+    lahar_dem_fault f;
+    if (!d->ops->fault || !d->ops->fault(d->engine, &f))
+        return 0;
+    const lahar_case *c = &d->ns.scene;
+    const char *name = f.body >= 0 && f.body < c->nbody ? c->bodies[f.body].name : "?";
+    memset(u, 0, sizeof *u);
+    snprintf(u->what, sizeof u->what, "%s", f.what);
+    snprintf(u->kind, sizeof u->kind, "body");
+    u->id = f.body;
+    snprintf(u->name, sizeof u->name, "%s", name);
+    memcpy(u->x, f.x, sizeof u->x);
+    u->step = k;
+    u->t = t;
+    u->value = f.value;
+    u->limit = f.limit;
+    if (strcmp(f.what, "overlap") == 0)
+        snprintf(u->text, sizeof u->text,
+                 "body %d '%s' overlaps body %d '%s' by %.3g m at (%.4g, %.4g, %.4g) m, more than "
+                 "stability.max_overlap allows (%.3g m), in step %lld (t = %.9g s, substep %ld)",
+                 f.body, name, f.other, f.other >= 0 && f.other < c->nbody ? c->bodies[f.other].name : "?", f.value,
+                 f.x[0], f.x[1], f.x[2], f.limit, (long long)k, t, f.substep);
+    else
+        snprintf(u->text, sizeof u->text, "body %d '%s' has a %s state at (%.4g, %.4g, %.4g) m in step %lld "
+                 "(t = %.9g s, substep %ld)", f.body, name, f.what, f.x[0], f.x[1], f.x[2], (long long)k, t, f.substep);
+    return 1;
+}
+
+/* The coordinator stopped the run before step k (the bodies are at the end of step k - 1, time
+ * t): on a stop for an error (an instability in the SPH node, a time step collapse) the state
+ * reached is written as the final snapshot, marked with the coordinator's reason, unless a
+ * snapshot of it exists. */
+static void dem_node_final_snapshot(dem_node *d, const lahar_link_msg *stop, int64_t k, double t, int64_t last)
+{
+    char why[512];
+    if (lahar_node_stop_reason(stop, why, sizeof why) <= 0)
+        return;
+    if (last != k) {
+        dem_node_get_states(d);
+        if (lahar_body_output_snapshot(d->out, k, t, d->states) != 0)
+            return;
+    }
+    lahar_output_mark_last_snapshot(d->ns.output_dir, "bodies.h5", "stopped", why);
+}
+
 static int dem_node_loop(dem_node *d)
 {
     char err[2048];
@@ -185,18 +236,24 @@ static int dem_node_loop(dem_node *d)
     for (int i = 0; i < d->ns.scene.nbody; i++)
         moving += d->ns.scene.bodies[i].motion != LAHAR_MOTION_FIXED;
     int at_output_time = 1; /* t_0 */
+    int64_t last_snapshot = 0;
+    double t_now = 0.0; /* time of the state: the end of the last step taken */
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(d->link);
         lahar_step_t step;
         int rc = lahar_node_wait_step(d->link, "lahar-dem", k, &msg, &step);
+        if (rc == 0)
+            dem_node_final_snapshot(d, &msg, k, t_now, last_snapshot);
         if (rc >= 0)
             return rc;
         lahar_status_t st = {0};
         err[0] = '\0';
         if (has_sph) {
             rc = lahar_link_wait(d->link, LAHAR_ROLE_SPH, LAHAR_FRAME_T_MSG_LOADS, k, -1, &msg);
-            if (rc == LAHAR_LINK_STOP)
+            if (rc == LAHAR_LINK_STOP) {
+                dem_node_final_snapshot(d, &msg, k, t_now, last_snapshot);
                 return 0;
+            }
             if (rc == LAHAR_LINK_LOST)
                 return 3;
             if (rc != LAHAR_LINK_OK || dem_node_read_loads(d, &msg, err, sizeof err) != 0)
@@ -214,6 +271,12 @@ static int dem_node_loop(dem_node *d)
         double c0 = lahar_now();
         int nsub = st.error ? -1 : d->ops->advance(d->engine, step.dt, has_sph ? d->loads : NULL, err, sizeof err);
         double compute = lahar_now() - c0;
+        lahar_instability u;
+        int unstable = 0;
+        if (nsub < 0 && !st.error && dem_node_fault_report(d, k, step.t_next, &u)) {
+            unstable = 1;
+            lahar_instability_encode(&u, err, sizeof err);
+        }
         if (nsub < 0)
             st.error = 1;
         dem_node_get_states(d);
@@ -226,10 +289,15 @@ static int dem_node_loop(dem_node *d)
             snprintf(err, sizeof err, "cannot append to forces.h5 in %s", d->ns.output_dir);
         }
         /* On an engine error the last state is kept as a snapshot to look at. */
-        if ((step.write_output || st.error) && lahar_body_output_snapshot(d->out, k + 1, step.t_next, d->states) != 0 &&
-            !st.error) {
-            st.error = 1;
-            snprintf(err, sizeof err, "cannot write a snapshot to bodies.h5 in %s", d->ns.output_dir);
+        if (step.write_output || st.error) {
+            if (lahar_body_output_snapshot(d->out, k + 1, step.t_next, d->states) == 0) {
+                last_snapshot = k + 1;
+                if (unstable)
+                    lahar_output_mark_last_snapshot(d->ns.output_dir, "bodies.h5", "instability", u.text);
+            } else if (!st.error) {
+                st.error = 1;
+                snprintf(err, sizeof err, "cannot write a snapshot to bodies.h5 in %s", d->ns.output_dir);
+            }
         }
         st.dt_proposed = 0.0; /* the engine subcycles: no limit on the coordinator step */
         st.dt_stable = d->ops->stable_dt(d->engine);
@@ -238,13 +306,16 @@ static int dem_node_loop(dem_node *d)
         st.ncontacts = d->ops->ncontacts(d->engine);
         st.nsubsteps = nsub > 0 ? nsub : 0;
         st.kinetic_energy = d->ops->kinetic_energy(d->engine);
+        st.work_body_body = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
         lahar_node_send_status(d->link, ROLE, k, &st, err);
         if (st.error) {
-            fprintf(stderr, "lahar-dem: step %lld: %s\n", (long long)k, err);
+            fprintf(stderr, "lahar-dem: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
+                    unstable ? u.text : err);
             dem_node_wait_stop(d);
             return 1;
         }
         lahar_link_set_step(d->link, k);
+        t_now = step.t_next;
     }
 }
 
@@ -268,6 +339,12 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     if (rc != LAHAR_LINK_OK) {
         fprintf(stderr, "lahar-dem: %s\n", err);
         status = rc == LAHAR_LINK_LOST ? 3 : 2;
+        goto done;
+    }
+    /* A run whose bodies are all fixed has no DEM node (the SPH node writes the body files): a
+     * node started by hand for it has nothing to do. */
+    if (!d.ns.has_dem) {
+        fprintf(stderr, "lahar-dem: this run has no DEM node (its bodies are all fixed); exiting\n");
         goto done;
     }
     /* Ready = STATUS(-1); an error here (unknown engine, unwritable output) stops the run. */

@@ -117,6 +117,11 @@ struct lahar_dem_engine {
     vec3 *rep_f, *rep_t;
     int rep_n;
     int *ncontact_body;
+    long long contacts_evaluated; /* work counter: contacts summed over every force evaluation */
+    /* instability report of the last failed advance (lahar_dem_fault) */
+    double max_overlap;       /* overlap limit, fraction of the smaller sweep radius (stability.max_overlap) */
+    lahar_dem_fault fault;
+    int has_fault;
 };
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -753,6 +758,7 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
     e->prev = e->cur;
     e->cur = tmp;
     e->nprev = n;
+    e->contacts_evaluated += n;
     if (history_rebuild(e)) {
         snprintf(err, errlen, "spheropoly: out of memory for the contact history");
         return -1;
@@ -772,12 +778,21 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
         sb->tc = v3_add(sb->tc, v3_cross(v3_sub(c->cp, sb->x), c->f));
         e->ncontact_body[c->a]++;
         e->ncontact_body[c->b]++;
+        /* the sweep radii are the contact halo of a sphero-polyhedron: an overlap of the smaller
+         * one lets a core reach into the other body, where the contact normal is lost */
         double rmin = fmin(e->geo[c->a].radius, e->geo[c->b].radius);
-        if (c->delta > 0.5 * rmin) {
+        if (c->delta > e->max_overlap * rmin) {
             snprintf(err, errlen,
-                     "spheropoly: overlap %.3g m between bodies %d '%s' and %d '%s' exceeds half the smaller "
+                     "spheropoly: overlap %.3g m between bodies %d '%s' and %d '%s' exceeds %g x the smaller "
                      "sweep radius %.3g m at substep %ld (time step too large or bodies interpenetrating)",
-                     c->delta, c->a, e->names[c->a], c->b, e->names[c->b], rmin, e->step);
+                     c->delta, c->a, e->names[c->a], c->b, e->names[c->b], e->max_overlap, rmin, e->step);
+            /* the free body of the pair is the one to name (a wall does not move) */
+            int a = e->geo[c->a].motion == LAHAR_MOTION_FREE ? c->a : c->b, b = a == c->a ? c->b : c->a;
+            e->fault = (lahar_dem_fault){.body = a, .other = b, .value = c->delta, .limit = e->max_overlap * rmin,
+                                         .substep = e->step};
+            snprintf(e->fault.what, sizeof e->fault.what, "overlap");
+            v3_store(c->cp, e->fault.x);
+            e->has_fault = 1;
             return -1;
         }
     }
@@ -865,7 +880,7 @@ static void drift(lahar_dem_engine *e, double h)
 
 /* Non-finite or runaway states stop the run before they reach the grid (cell indices of a NaN or
  * of 1e300 would overflow). */
-static int check_finite(const lahar_dem_engine *e, char *err, size_t errlen)
+static int check_finite(lahar_dem_engine *e, char *err, size_t errlen)
 {
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
@@ -875,6 +890,12 @@ static int check_finite(const lahar_dem_engine *e, char *err, size_t errlen)
         if (!isfinite(sum) || far > 1e12) {
             snprintf(err, errlen, "spheropoly: body %d '%s' has a %s state at substep %ld", i, e->names[i],
                      isfinite(sum) ? "runaway (|x| > 1e12 m)" : "non-finite", e->step);
+            lahar_dem_fault *f = &e->fault;
+            *f = (lahar_dem_fault){.body = i, .other = -1, .value = isfinite(sum) ? far : NAN,
+                                   .limit = isfinite(sum) ? 1e12 : NAN, .substep = e->step};
+            snprintf(f->what, sizeof f->what, "%s", isfinite(sum) ? "runaway" : "non-finite state");
+            v3_store(s->x, f->x);
+            e->has_fault = 1;
             return -1;
         }
     }
@@ -883,6 +904,7 @@ static int check_finite(const lahar_dem_engine *e, char *err, size_t errlen)
 
 static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loads, char *err, size_t errlen)
 {
+    e->has_fault = 0;
     if (!(dt > 0.0)) {
         snprintf(err, errlen, "spheropoly: step %g must be positive", dt);
         return -1;
@@ -918,6 +940,13 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Setup                                                                                           */
+
+static int sp_fault(const lahar_dem_engine *e, lahar_dem_fault *out)
+{
+    if (e->has_fault)
+        *out = e->fault;
+    return e->has_fault;
+}
 
 static void sp_destroy(lahar_dem_engine *e)
 {
@@ -1070,6 +1099,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     }
     e->dim = c->dim == 2 ? 2 : 3;
     e->nbody = c->nbody;
+    e->max_overlap = c->stability.max_overlap > 0.0 ? c->stability.max_overlap : 0.5; /* 0: a case built in code */
     e->nmat = c->nmaterial;
     e->g = v3_load(c->gravity);
     if (e->dim == 2) e->g.z = 0.0;
@@ -1321,6 +1351,7 @@ fail:
 static double sp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
 static int sp_nbody(const lahar_dem_engine *e) { return e->nbody; }
 static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev; }
+static long long sp_contacts_evaluated(const lahar_dem_engine *e) { return e->contacts_evaluated; }
 
 static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
 {
@@ -1402,7 +1433,9 @@ const lahar_dem_engine_ops lahar_dem_spheropoly_ops = {
     .get_report = sp_get_report,
     .ncontacts = sp_ncontacts,
     .kinetic_energy = sp_kinetic_energy,
+    .contacts_evaluated = sp_contacts_evaluated,
     .write_restart = sp_write_restart,
     .read_restart = sp_read_restart,
     .destroy = sp_destroy,
+    .fault = sp_fault,
 };

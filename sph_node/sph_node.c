@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "instability.h"
 #include "lahar_body_state_t.h"
 #include "lahar_loads_t.h"
 #include "lahar_step_t.h"
@@ -93,15 +94,20 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         free(rho);
         return -1;
     }
-    const double m = c->sph_density * pow(c->sph_dx, c->dim);
     int rc = 0;
     for (int b = 0; b < c->nblock && !rc; b++) {
         int64_t n = lahar_case_block_lattice(c, b, pts, most);
         rc = n < 0 ? -1 : 0;
-        if (n > 0)
+        /* soil blocks (sph_soil.h): at the rest density of their material, stress-free */
+        const int soil = c->blocks[b].phase == SPH_SOIL_PHASE;
+        const double rho_b = soil ? c->materials[c->blocks[b].material].density : c->sph_density;
+        const double m = rho_b * pow(c->sph_dx, c->dim);
+        if (n > 0 && !soil)
             sph_node_block_density(c, (const double(*)[3])pts, n, rho);
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, rho[i], 0) < 0 ? -1 : 0;
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, soil ? rho_b : rho[i], soil ? SPH_SOIL_PHASE : 0) < 0
+                     ? -1
+                     : 0;
     }
     free(pts);
     free(rho);
@@ -160,6 +166,19 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->shepard_every = o->shepard_interval;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
+    for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */
+        if (c->blocks[b].phase == SPH_SOIL_PHASE && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial) {
+            const lahar_material *mt = &c->materials[c->blocks[b].material];
+            prm->soil = 1;
+            prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
+                                                .phi = mt->friction_angle, .cohesion = mt->cohesion,
+                                                .psi = mt->dilatancy, .kh = mt->permeability, .mu_phi = mt->friction,
+                                                .damping = mt->damping, .rho_water = c->sph_density,
+                                                .gravity = {c->gravity[0], c->gravity[1], c->gravity[2]},
+                                                .g_ref = v3_norm(v3_load(c->gravity)) > 0.0
+                                                             ? v3_norm(v3_load(c->gravity))
+                                                             : 9.81};
+        }
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {
         snprintf(err, errlen, "sph.halo: the coupling uses eps = dx/2 = %g m; another halo (%g m) is not implemented yet",
@@ -193,15 +212,54 @@ typedef struct {
     double **l_px, **l_pf;
     int64_t l_pcap;
     int64_t last_snapshot;       /* step of the last snapshot written */
+    /* work counters the solver does not keep itself (sph_fluid.work_* are its own) */
+    int64_t work_particle_body;  /* coupling contacts summed over the coupling's evaluations */
+    int64_t work_output_derived; /* values computed only to be written (snapshot pressures) */
+    double *out_pressure;        /* per particle: snapshot pressure; allocated only when written */
+    /* A scene whose bodies are all fixed runs without a DEM node (nothing for it to integrate):
+     * this node then writes what the DEM node would have, from the same numbers (sph_node_fixed_*). */
+    int fixed_only;
+    lahar_body_output *bout;     /* bodies.h5, forces.h5 */
+    lahar_contact_output *cout;  /* contacts.h5 (NULL unless a body is marked record_contacts) */
+    lahar_body_report *reports;
+    double (*c_x)[3], (*c_f)[3]; /* contact points and forces, contiguous, for contacts.h5 */
+    int64_t c_cap;
+    int at_output_time;          /* step k starts at an output time (contacts.h5 is written then) */
+    double kinetic_energy;       /* of the last snapshot (J, J/m in 2D) */
 } sph_node;
 
+/* A particle snapshot of the fields the case writes (output.fields), nothing else: unselected
+ * fields are neither gathered nor computed. The pressure written is the EOS of the density
+ * written (000 eq. 3 / 003 eq. 19), computed here only when the case writes pressure: the
+ * solver's own pressure array belongs to its last evaluation (the predicted density at the end
+ * of the step, before the second kick and any Shepard filter), so a snapshot's density and
+ * pressure agree exactly, whatever the solver stores. */
 static int sph_node_snapshot(sph_node *s, int64_t step, double t)
 {
     const sph_particles *p = &s->f.p;
+    const unsigned fields = s->ns.scene.output_fields;
+    const int vel = (fields & LAHAR_PFIELD_VELOCITY) != 0;
     lahar_particles_view v = {
-        .n = p->n, .x = p->x, .y = p->y, .z = p->z, .vx = p->vx, .vy = p->vy, .vz = p->vz,
-        .density = p->rho, .pressure = p->p, .phase = p->phase, .id = p->id,
+        .n = p->n, .x = p->x, .y = p->y, .z = p->z,
+        .vx = vel ? p->vx : NULL, .vy = vel ? p->vy : NULL, .vz = vel ? p->vz : NULL,
+        .density = fields & LAHAR_PFIELD_DENSITY ? p->rho : NULL,
+        .pressure = NULL,
+        .phase = fields & LAHAR_PFIELD_PHASE ? p->phase : NULL,
+        .id = fields & LAHAR_PFIELD_ID ? p->id : NULL,
+        .stress = {NULL, NULL, NULL, NULL, NULL, NULL}, /* soil only, below */
     };
+    if ((fields & LAHAR_PFIELD_PRESSURE) && s->out_pressure) {
+        const sph_params *prm = &s->f.prm;
+        for (int64_t i = 0; i < p->n; i++) /* soil (sph_soil.h): the mean stress -tr(sigma)/3 */
+            s->out_pressure[i] = p->sig[0] && p->phase[i] == SPH_SOIL_PHASE
+                                     ? -(p->sig[0][i] + p->sig[3][i] + p->sig[5][i]) / 3.0
+                                     : sph_fluid_pressure(prm, p->rho[i]);
+        s->work_output_derived += p->n;
+        v.pressure = s->out_pressure;
+    }
+    if ((fields & LAHAR_PFIELD_STRESS) && p->sig[0])
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            v.stress[a] = p->sig[a];
     s->last_snapshot = step;
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }
@@ -265,6 +323,12 @@ static void sph_node_free(sph_node *s)
     free(s->l_ptorque);
     free(s->l_px);
     free(s->l_pf);
+    free(s->out_pressure);
+    lahar_body_output_close(s->bout);
+    lahar_contact_output_close(s->cout);
+    free(s->reports);
+    free(s->c_x);
+    free(s->c_f);
     lahar_case_free(&s->ns.scene);
 }
 
@@ -295,10 +359,12 @@ static void sph_node_reach(const sph_node *s, double lo[3], double hi[3])
     }
 }
 
-/* LOADS(k) from the coupling's last evaluation (the bodies and particles at t_k): every body with
- * at least one particle within reach; contact points for moving bodies and for bodies marked
- * record_contacts (fixed ones: the resultant only otherwise, for forces.h5). */
-static int sph_node_send_loads(sph_node *s, int64_t k)
+/* The rows of LOADS from the coupling's last evaluation (the bodies and particles at t_k): every
+ * body with at least one particle within reach; contact points for moving bodies and for bodies
+ * marked record_contacts (fixed ones: the resultant only otherwise, for forces.h5). Returns the
+ * number of bodies listed (rows in s->l_*; *npoints the points in s->l_px/l_pf), or -1 when
+ * out of memory. */
+static int sph_node_build_loads(sph_node *s, int64_t *npoints)
 {
     const sph_coupling *cp = &s->f.cpl;
     const lahar_case *c = &s->ns.scene;
@@ -339,6 +405,17 @@ static int sph_node_send_loads(sph_node *s, int64_t k)
     }
     if (np > INT32_MAX)
         return -1;
+    *npoints = np;
+    return nb;
+}
+
+/* LOADS(k) for the DEM node (sph_node_build_loads). */
+static int sph_node_send_loads(sph_node *s, int64_t k)
+{
+    int64_t np;
+    int nb = sph_node_build_loads(s, &np);
+    if (nb < 0)
+        return -1;
     lahar_loads_t m = {
         .run_id = lahar_link_run_id(s->link), .step = k, .nbody = nb, .body_id = s->l_id, .force = s->l_pforce,
         .torque = s->l_ptorque, .npoints = s->l_np, .ntotal = (int32_t)np, .point_x = s->l_px, .point_f = s->l_pf,
@@ -347,6 +424,102 @@ static int sph_node_send_loads(sph_node *s, int64_t k)
     int rc;
     LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &m);
     return rc;
+}
+
+/* ---- fixed bodies only: no DEM node ----------------------------------------------------------
+ * Bodies that never move need no integration: the coordinator then starts no DEM node (no STEP,
+ * STATUS, LOADS or BODY_STATE for it), the coupling uses the scene's poses (it always does for
+ * fixed bodies) and this node writes the body files the DEM node would have written, from the
+ * same numbers: bodies.h5 (the scene's poses, quaternions normalised as the engine stores them,
+ * zero velocities), forces.h5 (per step k the row of t_{k+1} holding the fluid's force at t_k:
+ * the resultants LOADS(k) would carry; fixed bodies have no body-body contacts) and contacts.h5
+ * (the points of the marked bodies, at the steps that start at an output time). */
+
+static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t)
+{
+    const lahar_case *c = &s->ns.scene;
+    for (int b = 0; b < s->nbody; b++) {
+        lahar_body_state *st = &s->states[b];
+        memcpy(st->x, c->bodies[b].x, sizeof st->x);
+        q_store(q_normalize(q_load(c->bodies[b].q)), st->q);
+        memset(st->v, 0, sizeof st->v);
+        memset(st->w, 0, sizeof st->w);
+    }
+    return lahar_body_output_snapshot(s->bout, step, t, s->states);
+}
+
+/* Open the body files and write the snapshot at t = 0. 0, or -1 with a message in err. */
+static int sph_node_fixed_open(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    s->reports = calloc((size_t)s->nbody, sizeof *s->reports);
+    if (!s->reports) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    if (!(s->bout = lahar_body_output_open(s->ns.output_dir, c, err, errlen)))
+        return -1;
+    err[0] = '\0';
+    if (!(s->cout = lahar_contact_output_open(s->ns.output_dir, c, err, errlen)) && err[0])
+        return -1;
+    s->at_output_time = 1; /* t_0 */
+    if (sph_node_fixed_snapshot(s, 0, 0.0) != 0) {
+        snprintf(err, errlen, "cannot write the first body snapshot in %s", s->ns.output_dir);
+        return -1;
+    }
+    return 0;
+}
+
+/* Step k of the body files, before the particles move: the force row of t_{k+1} and, when step
+ * k starts at an output time, contacts.h5 at t_k, both from the coupling at t_k (the numbers of
+ * LOADS(k)). 0, or -1 with a message in err. */
+static int sph_node_fixed_forces(sph_node *s, int64_t k, const lahar_step_t *step, char *err, size_t errlen)
+{
+    int64_t np;
+    int nb = sph_node_build_loads(s, &np);
+    if (nb < 0) {
+        snprintf(err, errlen, "out of memory for the body loads");
+        return -1;
+    }
+    memset(s->reports, 0, (size_t)s->nbody * sizeof *s->reports);
+    for (int i = 0; i < nb; i++) {
+        memcpy(s->reports[s->l_id[i]].force, s->l_force[i], sizeof s->reports[0].force);
+        memcpy(s->reports[s->l_id[i]].torque, s->l_torque[i], sizeof s->reports[0].torque);
+    }
+    if (lahar_body_output_forces(s->bout, k + 1, step->t_next, s->reports) != 0) {
+        snprintf(err, errlen, "cannot append to forces.h5 in %s", s->ns.output_dir);
+        return -1;
+    }
+    int at_output = s->at_output_time;
+    s->at_output_time = step->write_output;
+    if (!s->cout || !at_output)
+        return 0;
+    if (np > s->c_cap) { /* at output times only, and only when more points than ever before */
+        int64_t cap = s->c_cap > 0 ? s->c_cap : 1024;
+        while (cap < np)
+            cap *= 2;
+        double(*x)[3] = realloc(s->c_x, (size_t)cap * sizeof *x);
+        if (x)
+            s->c_x = x;
+        double(*f)[3] = x ? realloc(s->c_f, (size_t)cap * sizeof *f) : NULL;
+        if (!x || !f) {
+            snprintf(err, errlen, "out of memory for %lld contact points", (long long)np);
+            return -1;
+        }
+        s->c_f = f;
+        s->c_cap = cap;
+    }
+    for (int64_t i = 0; i < np; i++) {
+        memcpy(s->c_x[i], s->l_px[i], sizeof s->c_x[i]);
+        memcpy(s->c_f[i], s->l_pf[i], sizeof s->c_f[i]);
+    }
+    if (lahar_contact_output_write(s->cout, k, step->t, nb, s->l_id, s->l_np, (const double(*)[3])s->c_x,
+                                   (const double(*)[3])s->c_f, (const double(*)[3])s->l_force,
+                                   (const double(*)[3])s->l_torque) != 0) {
+        snprintf(err, errlen, "cannot write to contacts.h5 in %s", s->ns.output_dir);
+        return -1;
+    }
+    return 0;
 }
 
 /* Bodies at t_{k+1} from BODY_STATE(k). A moving body the DEM node did not list is out of reach
@@ -381,6 +554,27 @@ static double sph_node_kinetic_energy(const sph_particles *p)
     return e;
 }
 
+/* The work counters of STATUS (cumulative since set-up; lcm_types/status_t.lcm). Pairs are the
+ * solver's neighbour counts halved: the water pass visits each pair from both ends. No soil
+ * phase yet: its pair counts stay 0 until a soil pass counts them. */
+static void sph_node_work(const sph_node *s, lahar_status_t *st)
+{
+    st->work_passes = s->f.work_passes;
+    st->work_pairs_fluid = s->f.work_neighbours_fluid / 2;
+    st->work_pairs_soil = 0;
+    st->work_pairs_fluid_soil = 0;
+    st->work_particle_body = s->work_particle_body;
+    st->work_body_body = 0;
+    st->work_output_derived = s->work_output_derived;
+}
+
+/* After every evaluation of the coupling: its contacts join the particle-body work. */
+static void sph_node_count_coupling(sph_node *s)
+{
+    if (s->f.has_bodies)
+        s->work_particle_body += s->f.cpl.ncontacts;
+}
+
 static void sph_node_crossing_message(const sph_node *s, int64_t k, double t, char *err, size_t n)
 {
     const sph_coupling *cp = &s->f.cpl;
@@ -399,24 +593,148 @@ static void sph_node_crossing_message(const sph_node *s, int64_t k, double t, ch
              (long long)k, t, cp->cross_depth, (long long)cp->crossings, cp->crossings == 1 ? "" : "s");
 }
 
+/* Position of the particle with this id (a search: only after a failure), 0 if found. */
+static int sph_node_find_particle(const sph_particles *p, int64_t id, double x[3])
+{
+    for (int64_t i = 0; i < p->n; i++)
+        if (p->id[i] == id) {
+            x[0] = p->x[i], x[1] = p->y[i], x[2] = p->z[i];
+            return 0;
+        }
+    x[0] = x[1] = x[2] = NAN;
+    return -1;
+}
+
+/* The crossing of step k (sph_node_crossing_message) as an instability report. */
+static void sph_node_crossing_report(const sph_node *s, int64_t k, double t, lahar_instability *u)
+{
+    const sph_coupling *cp = &s->f.cpl;
+    int b = cp->cross_body;
+    memset(u, 0, sizeof *u);
+    snprintf(u->what, sizeof u->what, "crossing");
+    snprintf(u->kind, sizeof u->kind, "particle");
+    u->id = cp->cross_particle_id;
+    snprintf(u->name, sizeof u->name, "%s", b >= 0 && b < s->nbody ? s->ns.scene.bodies[b].name : "?");
+    sph_node_find_particle(&s->f.p, u->id, u->x);
+    u->step = k;
+    u->t = t;
+    u->value = cp->cross_depth;
+    u->limit = 0.0;
+    sph_node_crossing_message(s, k, t, u->text, sizeof u->text);
+}
+
+/* The particle checks of common/instability.h on the state after step k (time t): every
+ * position, velocity and density finite, and rho / rho0 within stability.density_band. One
+ * streaming pass counts the failures (a sum: the same for any thread count); only when there are
+ * some, a serial pass names the worst: the non-finite particle of lowest id, else the one
+ * farthest outside the band (largest |ln(rho / rho0)|, lowest id on a tie). Returns the count. */
+static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, lahar_instability *u)
+{
+    const sph_particles *p = &s->f.p;
+    const int64_t n = p->n;
+    const double rho_water = s->ns.scene.sph_density;
+    /* rho0 of particle I: the water's; soil particles (sph_soil.h) have no EOS, so their density
+     * (from continuity, thinning where the soil spreads) cannot blow up a pressure: they are held
+     * to finite values only (an infinite band) */
+#define SPH_NODE_RHO0(I) (s->f.has_soil && p->phase[I] == SPH_SOIL_PHASE ? NAN : rho_water)
+    const double *band = s->ns.scene.stability.density_band;
+    int64_t bad = 0;
+#pragma omp parallel for schedule(static) reduction(+ : bad) if (n >= SPH_OMP_MIN_LIGHT)
+    for (int64_t i = 0; i < n; i++) {
+        /* a NaN or an infinity in any component makes the sum non-finite; a NaN density fails
+         * the band test too */
+        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i], rho0 = SPH_NODE_RHO0(i);
+        bad += !(isfinite(sum) && isfinite(p->rho[i]) &&
+                 (isnan(rho0) || (p->rho[i] >= band[0] * rho0 && p->rho[i] <= band[1] * rho0)));
+    }
+    if (bad == 0)
+        return 0;
+    int64_t worst = -1, worst_nf = -1;
+    double dev_max = -1.0;
+    for (int64_t i = 0; i < n; i++) {
+        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i];
+        if (!isfinite(sum) || !isfinite(p->rho[i])) {
+            if (worst_nf < 0 || p->id[i] < p->id[worst_nf])
+                worst_nf = i;
+        } else if (!isnan(SPH_NODE_RHO0(i)) &&
+                   !(p->rho[i] >= band[0] * SPH_NODE_RHO0(i) && p->rho[i] <= band[1] * SPH_NODE_RHO0(i))) {
+            double dev = fabs(log(p->rho[i] / SPH_NODE_RHO0(i)));
+            if (dev > dev_max || (dev == dev_max && p->id[i] < p->id[worst])) {
+                dev_max = dev;
+                worst = i;
+            }
+        }
+    }
+    int64_t i = worst_nf >= 0 ? worst_nf : worst;
+    memset(u, 0, sizeof *u);
+    snprintf(u->kind, sizeof u->kind, "particle");
+    u->id = p->id[i];
+    u->x[0] = p->x[i], u->x[1] = p->y[i], u->x[2] = p->z[i];
+    u->step = k;
+    u->t = t;
+    const double r = p->rho[i] / SPH_NODE_RHO0(i);
+#undef SPH_NODE_RHO0
+    if (worst_nf >= 0) {
+        snprintf(u->what, sizeof u->what, "non-finite state");
+        u->value = NAN;
+        u->limit = NAN;
+        snprintf(u->text, sizeof u->text,
+                 "particle %lld has a non-finite state after step %lld (t = %.9g s): x = (%.4g, %.4g, %.4g) m, "
+                 "v = (%.3g, %.3g, %.3g) m/s, rho/rho0 = %.4g; %lld particle%s failed the checks; the last snapshot is "
+                 "that state",
+                 (long long)u->id, (long long)k, t, p->x[i], p->y[i], p->z[i], p->vx[i], p->vy[i], p->vz[i], r,
+                 (long long)bad, bad == 1 ? "" : "s");
+    } else {
+        snprintf(u->what, sizeof u->what, "density out of band");
+        u->value = r;
+        u->limit = r < band[0] ? band[0] : band[1];
+        snprintf(u->text, sizeof u->text,
+                 "particle %lld at (%.4g, %.4g, %.4g) m has rho/rho0 = %.4g outside stability.density_band [%g, %g] "
+                 "after step %lld (t = %.9g s); %lld particle%s outside; the last snapshot is that state",
+                 (long long)u->id, u->x[0], u->x[1], u->x[2], r, band[0], band[1], (long long)k, t, (long long)bad,
+                 bad == 1 ? "" : "s");
+    }
+    return bad;
+}
+
+/* The coordinator stopped the run before step k (the particles are at the end of step k - 1,
+ * time t): on a stop for an error (another node's instability, a time step collapse) the state
+ * reached is written as the final snapshot, marked with the coordinator's reason, unless a
+ * snapshot of it exists. */
+static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int64_t k, double t)
+{
+    char why[512];
+    int reason = lahar_node_stop_reason(stop, why, sizeof why);
+    if (reason <= 0 || s->f.begun)
+        return;
+    if (s->last_snapshot != k && sph_node_snapshot(s, k, t) != 0)
+        return;
+    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "stopped", why);
+}
+
 static int sph_node_loop(sph_node *s)
 {
     char err[2048];
     lahar_link_msg msg;
     const int has_dem = s->ns.has_dem && s->nbody > 0;
+    double t_now = 0.0; /* time of the state: the end of the last step taken */
     for (int64_t k = 0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
         lahar_step_t step;
         int rc = lahar_node_wait_step(s->link, "lahar-sph", k, &msg, &step);
+        if (rc == 0)
+            sph_node_final_snapshot(s, &msg, k, t_now);
         if (rc >= 0)
             return rc;
         lahar_status_t st = {0};
         err[0] = '\0';
         double compute = 0.0, c0 = lahar_now();
         int64_t cross = 0;
-        if (k == 0) {
-            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt) */
+        if (k == 0 && s->f.has_bodies) {
+            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt); without bodies
+             * the rates of the set-up do not depend on dt and stand */
             cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step.dt);
+            sph_node_count_coupling(s);
             if (cross < 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH rates");
@@ -428,6 +746,8 @@ static int sph_node_loop(sph_node *s)
         if (has_dem && sph_node_send_loads(s, k) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
+        } else if (s->fixed_only && !st.error && sph_node_fixed_forces(s, k, &step, err, sizeof err) != 0) {
+            st.error = 1;
         }
         /* the particle work of step k needs no body states: do it before waiting for them, so
          * the DEM node's advance and the BODY_STATE latency hide behind it */
@@ -459,15 +779,23 @@ static int sph_node_loop(sph_node *s)
         c0 = lahar_now();
         /* a failed BODY_STATE after step_begin leaves the particles drifted but not kicked: that
          * state is neither t_k nor t_{k+1}, so no snapshot is written for it (see below) */
-        int stepped = begun && !st.error;
+        int stepped = begun && !st.error, unstable = 0;
+        lahar_instability u;
         if (stepped) {
             cross = sph_fluid_step_end(&s->f, step.dt, has_dem ? s->states : NULL);
+            sph_node_count_coupling(s);
             if (cross < 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH step");
             } else if (cross > 0) {
+                sph_node_crossing_report(s, k, step.t_next, &u);
+                unstable = 1;
+            } else {
+                unstable = sph_node_check_particles(s, k, step.t_next, &u) > 0;
+            }
+            if (unstable) {
                 st.error = 1;
-                sph_node_crossing_message(s, k, step.t_next, err, sizeof err);
+                lahar_instability_encode(&u, err, sizeof err);
             }
         }
         /* on an error the state reached is kept as the last snapshot to look at: after the step,
@@ -478,20 +806,35 @@ static int sph_node_loop(sph_node *s)
         } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
+        /* fixed bodies only: their snapshots, as the DEM node writes them (after each step) */
+        if (s->fixed_only && (step.write_output || st.error) && sph_node_fixed_snapshot(s, k + 1, step.t_next) != 0 &&
+            !st.error) {
+            st.error = 1;
+            snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
+        }
+        if (unstable && s->last_snapshot == k + 1)
+            lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
-        st.kinetic_energy = sph_node_kinetic_energy(&s->f.p);
+        /* the kinetic energy is a summary figure (the coordinator keeps the last one): computed
+         * at the output times (the last step is one) and on an error, not every step */
+        if (step.write_output || st.error)
+            s->kinetic_energy = sph_node_kinetic_energy(&s->f.p);
+        st.kinetic_energy = s->kinetic_energy;
+        sph_node_work(s, &st);
         compute += lahar_now() - c0;
         st.compute_s = compute;
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
         lahar_node_send_status(s->link, ROLE, k, &st, err);
         if (st.error) {
-            fprintf(stderr, "lahar-sph: step %lld: %s\n", (long long)k, err);
+            fprintf(stderr, "lahar-sph: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
+                    unstable ? u.text : err);
             sph_node_wait_stop(s);
             return 1;
         }
         lahar_link_set_step(s->link, k);
+        t_now = step.t_next;
     }
 }
 
@@ -533,7 +876,29 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory in the SPH rates");
         return -1;
     }
+    sph_node_count_coupling(s);
+    /* the snapshot pressure (sph_node_snapshot) has a buffer only when the case writes it */
+    if ((c->output_fields & LAHAR_PFIELD_PRESSURE) && !(s->out_pressure = malloc((size_t)s->f.p.cap * sizeof(double)))) {
+        snprintf(err, errlen, "out of memory for %lld particles", (long long)s->f.p.cap);
+        return -1;
+    }
     return 0;
+}
+
+/* Without a DEM node in the run (the coordinator starts none when every body is fixed), this
+ * node writes the body files itself; a moving body without a DEM node cannot be integrated. */
+static int sph_node_setup_bodies(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    if (s->ns.has_dem || s->nbody == 0)
+        return 0;
+    for (int b = 0; b < s->nbody; b++)
+        if (c->bodies[b].motion != LAHAR_MOTION_FIXED) {
+            snprintf(err, errlen, "body %d '%s' moves, but the run has no DEM node to integrate it", b, c->bodies[b].name);
+            return -1;
+        }
+    s->fixed_only = 1;
+    return sph_node_fixed_open(s, err, errlen);
 }
 
 int lahar_sph_node_run(const lahar_sph_node_options *o)
@@ -570,15 +935,21 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         ;
     else if (sph_node_snapshot(&s, 0, 0.0) != 0)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
+    else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
+        /* the message is in err */
+    }
     char desc[256];
     if (s.fluid_ready)
-        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s",
+        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s%s",
                  (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody,
-                 s.f.prm.sps ? ", SPS turbulence" : "");
+                 s.f.prm.sps ? ", SPS turbulence" : "", s.f.has_soil ? ", Drucker-Prager soil" : "");
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;
-    st.kinetic_energy = st.error ? 0.0 : sph_node_kinetic_energy(&s.f.p);
+    s.kinetic_energy = st.error ? 0.0 : sph_node_kinetic_energy(&s.f.p);
+    st.kinetic_energy = s.kinetic_energy;
+    if (s.fluid_ready)
+        sph_node_work(&s, &st);
     lahar_node_send_status(s.link, ROLE, -1, &st, st.error ? err : desc);
     if (st.error) {
         fprintf(stderr, "lahar-sph: %s\n", err);

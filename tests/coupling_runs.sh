@@ -265,21 +265,25 @@ cross_host)
     [ "$(summary xhost "s['mode']")" = no-spawn ] || fail "mode is not no-spawn"
     ;;
 engine_error)
-    # An engine failure (here: a DEM step far too large for a 6 m/s impact) stops the run with the
-    # engine's message (which bodies, which step), exit 1, and a last snapshot at the failed step.
+    # An engine failure (here: a 6 m/s impact overlapping two balls by more than a tight
+    # stability.max_overlap, 5 % of the smaller sweep radius; a DEM step beyond the contact's
+    # stability limit is refused by the case loader) stops the run with the engine's message
+    # (which bodies, which step), exit 1, and a last snapshot at the failed step.
     write_case bad.yaml 0.3
-    sed -i 's/^time:.*/time: {end: 0.3, dt_max: 1e-2, output_interval: 0.05}\ndem: {engine: spheropoly, dt_safety: 1}/;
+    sed -i 's/^time:.*/time: {end: 0.3, dt_max: 1e-2, output_interval: 0.05}\ndem: {engine: spheropoly, dt_safety: 0.2}\nstability: {max_overlap: 0.05}/;
             s/velocity: \[0, 0, -1\]/velocity: [0, 0, -6]/' bad.yaml
     "$bin/lahar" run bad.yaml -o bad -q --in-process 2> stderr.txt
     rc=$?
     cat stderr.txt
     [ "$rc" -eq 1 ] || fail "exit status $rc, expected 1"
-    grep -q "the DEM node reports at step [0-9]*: spheropoly" stderr.txt || fail "no engine message"
+    grep -q "the DEM node reports at step [0-9]*: body [0-9] '[a-z0-9]*' overlaps body [0-9] '[a-z0-9]*' by" stderr.txt ||
+        fail "no engine message"
     "$python" - bad <<'PY' || fail "summary or last snapshot wrong"
 import json, sys
 import h5py
 s = json.load(open(sys.argv[1] + "/summary.json"))
-assert s["status"] == "error" and s["exit_status"] == 1, s["status"]
+assert s["status"] == "unstable" and s["exit_status"] == 1, s["status"]
+assert s["instability"]["what"] == "overlap" and s["instability"]["where"]["kind"] == "body", s["instability"]
 failed_step = s["steps"]  # steps completed before the failing one
 with h5py.File(sys.argv[1] + "/bodies.h5", "r") as f:
     last = sorted(f["snapshots"])[-1]

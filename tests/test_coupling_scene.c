@@ -30,7 +30,8 @@ static void compare(const char *path, const lahar_case *a, const lahar_case *b)
               SAME(a->dt_min, b->dt_min) && SAME(a->output_interval, b->output_interval) &&
               SAME(a->forces_interval, b->forces_interval) && SAME(a->dem_dt_safety, b->dem_dt_safety) &&
               !strcmp(a->dem_engine, b->dem_engine) && !strcmp(a->path, b->path) &&
-              a->output_fields == b->output_fields && a->output_forces == b->output_forces,
+              a->output_fields == b->output_fields && a->output_forces == b->output_forces &&
+              SAME(a->stability, b->stability),
           "%s: case settings differ", path);
     CHECK(a->nmaterial == b->nmaterial, "%s: material count", path);
     for (int i = 0; i < a->nmaterial && i < b->nmaterial; i++) {
