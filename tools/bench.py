@@ -2,7 +2,7 @@
 """lahar bench: run time against error, co-simulation overhead and DEM subcycling.
 
 usage: lahar bench -o OUT [--quick] [--sections pareto,overhead,subcycle] [--cases A,B]
-                   [--threads N] [--timeout S] [--keep] [--list]
+                   [--threads N] [--cost wall|cpu] [--resume] [--timeout S] [--keep] [--list]
        (or tools/bench.py --lahar build/bin/lahar -o OUT ...)
 
 Sections (default: all three):
@@ -19,7 +19,8 @@ Sections (default: all three):
             inside the SPH step against the whole run forced down to the DEM's stable step
             (time.dt_max = dt_stable): OUT/subcycle.csv, .md.
 --quick: 2 resolutions and few settings per case, overhead and subcycle at small sizes (a smoke
-test of the tool, about 1-3 min; the numbers are not the benchmark's).
+test of the tool, about 1-3 min; the numbers are not the benchmark's). The default run needs
+about 780 s of CPU (7-15 min on 2 idle cores).
 Speed figures are wall times on whatever machine runs this: on a shared or loaded machine they
 are noisy (each row records the load average at its start and the CPU time used).
 Exit status: 0 done (runs that fail are recorded in the CSV with their exit status), 2 bad
