@@ -509,6 +509,24 @@ def ci(args):
         u = r.summary["instability"]
         if u["where"]["name"] != "disc" or not u["value"] > u["limit"]:
             fail("overlap report %r" % u)
+    elif name == "runaway":
+        # a body thrown at 1e16 m/s leaves any sane domain within one step: caught with its name
+        case = {
+            "dimensions": 3, "time": {"end": 0.01, "dt_max": 1e-3, "output_interval": 0.005},
+            "materials": {"rock": {"density": 2650, "young": 1e8, "restitution": 0.5, "friction": 0.5}},
+            "bodies": [
+                {"name": "ball", "shape": "sphere", "radius": 0.05, "material": "rock", "position": [0, 0, 1]},
+                {"name": "bullet", "shape": "sphere", "radius": 0.05, "material": "rock", "position": [1, 0, 1],
+                 "velocity": [1e16, 0, 0]},
+                {"name": "floor", "shape": "plane", "motion": "fixed", "normal": [0, 0, 1], "size": [2, 2],
+                 "radius": 0.02, "material": "rock", "position": [0, 0, 0]},
+            ],
+        }
+        r = Run(args, case, os.path.join(args.out, name), name)
+        check_caught(r, "runaway", "body")
+        u = r.summary["instability"]
+        if u["where"]["name"] != "bullet" or u["where"]["id"] != 1 or not u["where"]["position"][0] > 1e12 * 0.999:
+            fail("runaway report %r" % u)
     elif name == "stable":
         # the same scenes at safe settings finish
         for label, case in (("dam_break", dam_break(args, 0.005, 0.3)), ("dem", dem_drop_case(1e9, 0.02, 5.0))):
