@@ -60,6 +60,7 @@ typedef struct {
     double dt_proposed, dt_stable, kinetic_energy;
     int ncontacts;
     double starved_s;            /* silence forgiven so far (COORD_NODE_STARVED_MAX) */
+    lahar_status_t work;         /* the work_* fields of the last STATUS (cumulative) */
 } coord_node;
 
 typedef struct {
@@ -352,6 +353,49 @@ static int coord_hello(coord *co)
     return LAHAR_EXIT_OK;
 }
 
+/* The work counters of a STATUS: cumulative, so the last STATUS holds the run's totals. */
+static void coord_take_work(coord_node *n, const lahar_status_t *s)
+{
+    n->work.work_passes = s->work_passes;
+    n->work.work_pairs_fluid = s->work_pairs_fluid;
+    n->work.work_pairs_soil = s->work_pairs_soil;
+    n->work.work_pairs_fluid_soil = s->work_pairs_fluid_soil;
+    n->work.work_particle_body = s->work_particle_body;
+    n->work.work_body_body = s->work_body_body;
+    n->work.work_output_derived = s->work_output_derived;
+}
+
+/* summary.json "work": what the run computed and sent, per kind (coordinator/README.md). Nodes
+ * that did not take part count 0. */
+static void coord_summary_work(const coord *co, cJSON *root)
+{
+    const lahar_status_t *sph = &co->node[LAHAR_ROLE_SPH].work, *dem = &co->node[LAHAR_ROLE_DEM].work;
+    cJSON *w = cJSON_AddObjectToObject(root, "work");
+    cJSON_AddBoolToObject(w, "dem_node", co->node[LAHAR_ROLE_DEM].needed);
+    cJSON_AddBoolToObject(w, "sph_node", co->node[LAHAR_ROLE_SPH].needed);
+    cJSON_AddNumberToObject(w, "sph_passes", (double)sph->work_passes);
+    cJSON_AddNumberToObject(w, "pairs_fluid_fluid", (double)sph->work_pairs_fluid);
+    cJSON_AddNumberToObject(w, "pairs_soil_soil", (double)sph->work_pairs_soil);
+    cJSON_AddNumberToObject(w, "pairs_fluid_soil", (double)sph->work_pairs_fluid_soil);
+    cJSON_AddNumberToObject(w, "particle_body", (double)sph->work_particle_body);
+    cJSON_AddNumberToObject(w, "body_body", (double)dem->work_body_body);
+    cJSON_AddNumberToObject(w, "dem_substeps", (double)co->node[LAHAR_ROLE_DEM].substeps);
+    cJSON_AddNumberToObject(w, "output_derived", (double)(sph->work_output_derived + dem->work_output_derived));
+    /* per channel: messages and bytes of the run's first publications (re-sends excluded; they
+     * are in "channels") */
+    cJSON *ch = cJSON_AddObjectToObject(w, "channels");
+    if (co->link) {
+        lahar_link_stats st[LAHAR_NMSG];
+        lahar_link_get_stats(co->link, st);
+        for (int ty = 1; ty < LAHAR_NMSG; ty++) {
+            const lahar_link_stats *s = &st[ty];
+            cJSON *j = cJSON_AddObjectToObject(ch, lahar_link_channel(ty));
+            cJSON_AddNumberToObject(j, "messages", (double)(s->msgs_sent + s->msgs_heard));
+            cJSON_AddNumberToObject(j, "bytes", (double)(s->bytes_sent + s->bytes_heard - s->bytes_resent_heard));
+        }
+    }
+}
+
 /* Wait for STATUS(k) of every node; fills the node records. */
 static int coord_collect_status(coord *co, int64_t k)
 {
@@ -422,6 +466,7 @@ static int coord_collect_status(coord *co, int64_t k)
         n->dt_stable = s.dt_stable;
         n->kinetic_energy = s.kinetic_energy;
         n->ncontacts = s.ncontacts;
+        coord_take_work(n, &s);
         if (!err)
             n->last_step = k;
         lahar_status_t_decode_cleanup(&s);
@@ -670,6 +715,7 @@ static void coord_write_summary(coord *co)
         }
     }
     cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
+    coord_summary_work(co, root);
     coord_summary_instability(co, root);
     char *text = cJSON_Print(root);
     char path[PATH_MAX + 32];
@@ -715,6 +761,22 @@ static int64_t coord_random_run_id(void)
     return r ? (int64_t)r : 1;
 }
 
+/* The DEM node integrates bodies. With particles in the scene it is needed only when a body
+ * moves (free or prescribed): the SPH node knows fixed bodies from the scene, couples with them
+ * and writes their files, so a scene of water and fixed walls runs without it (no DEM STEP,
+ * STATUS, LOADS or BODY_STATE). Without particles it runs whenever there are bodies. */
+static int coord_dem_needed(const lahar_case *c)
+{
+    if (c->nbody == 0)
+        return 0;
+    if (c->nblock == 0)
+        return 1;
+    for (int i = 0; i < c->nbody; i++)
+        if (c->bodies[i].motion != LAHAR_MOTION_FIXED)
+            return 1;
+    return 0;
+}
+
 int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
 {
     coord co;
@@ -723,7 +785,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     co.o = o;
     co.status = "error";
     co.wall0 = lahar_now();
-    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = c->nbody > 0, .last_step = -1};
+    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
     co.node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
     if (!co.node[LAHAR_ROLE_DEM].needed && !co.node[LAHAR_ROLE_SPH].needed) {
         fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
@@ -857,7 +919,7 @@ out:
             if (access(path, R_OK) == 0)
                 printf("              h5dump -H %s\n", path);
         }
-        if (co.node[LAHAR_ROLE_DEM].needed)
+        if (c->nbody > 0 && c->output_forces)
             printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
                    LAHAR_TOOLS_DIR, co.outdir);
         printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co.outdir);

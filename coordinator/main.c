@@ -1,10 +1,13 @@
 /* lahar: the user's entry point. `lahar run` loads a case, starts the nodes it needs and
  * coordinates the run; `lahar check` runs and evaluates the case's check; `lahar validate` only
- * loads the case. */
+ * loads the case; `lahar bench` runs the benchmark driver tools/bench.py. */
+#include <errno.h>
 #include <getopt.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "case.h"
 #include "check.h"
 #include "coordinator.h"
@@ -16,6 +19,9 @@ static void usage(FILE *f)
             "usage: lahar run CASE.yaml -o OUT [options]     simulate the case, output in OUT\n"
             "       lahar check CASE.yaml -o OUT [options]   simulate, then evaluate the case's check: section\n"
             "       lahar validate CASE.yaml                 load and validate the case only\n"
+            "       lahar bench -o OUT [--quick] [options]   run time against error of the validation cases,\n"
+            "                                                co-simulation overhead, DEM subcycling: CSV, PNG\n"
+            "                                                and OUT/summary.md (`lahar bench --help`)\n"
             "       lahar --help | --version\n\n"
             "Options of run and check:\n"
             "  -o, --output OUT   output directory (created): bodies.h5, forces.h5, particles.h5, *.xmf,\n"
@@ -39,6 +45,39 @@ static void usage(FILE *f)
             LAHAR_NETNS_URL);
 }
 
+/* `lahar bench ARGS`: exec python3 tools/bench.py --lahar THIS_EXECUTABLE ARGS (the driver starts
+ * `lahar check` runs of case variants; Python for its CSV and plots). */
+static int bench_exec(int argc, char **argv)
+{
+    const char *py = getenv("LAHAR_PYTHON");
+    if (!py || !*py)
+        py = "python3";
+    static char self[PATH_MAX], script[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0)
+        snprintf(self, sizeof self, "%s", argv[0]);
+    else
+        self[n] = '\0';
+    snprintf(script, sizeof script, "%s/bench.py", LAHAR_TOOLS_DIR);
+    char **av = calloc((size_t)argc + 4, sizeof *av);
+    if (!av)
+        return 2;
+    int k = 0;
+    av[k++] = (char *)py;
+    av[k++] = script;
+    av[k++] = "--lahar";
+    av[k++] = self;
+    for (int i = 2; i < argc; i++)
+        av[k++] = argv[i];
+    av[k] = NULL;
+    execvp(py, av);
+    fprintf(stderr, "lahar bench: cannot run %s %s: %s (install python3, python3-numpy, python3-matplotlib, "
+                    "python3-yaml, or set LAHAR_PYTHON)\n",
+            py, script, strerror(errno));
+    free(av);
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -54,9 +93,11 @@ int main(int argc, char **argv)
         printf("lahar %s\n", LAHAR_VERSION);
         return 0;
     }
+    if (!strcmp(cmd, "bench"))
+        return bench_exec(argc, argv);
     int is_run = !strcmp(cmd, "run"), is_check = !strcmp(cmd, "check"), is_validate = !strcmp(cmd, "validate");
     if (!is_run && !is_check && !is_validate) {
-        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate)\n", cmd);
+        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, bench)\n", cmd);
         usage(stderr);
         return 2;
     }

@@ -36,6 +36,9 @@ typedef struct {
     void (*get_report)(const lahar_dem_engine *e, int body, lahar_body_report *out);
     int (*ncontacts)(const lahar_dem_engine *e);
     double (*kinetic_energy)(const lahar_dem_engine *e);
+    /* Work counter: body-body contacts summed over every force evaluation since create (one per
+     * substep; not part of a restart). Optional (NULL: the node reports 0). */
+    long long (*contacts_evaluated)(const lahar_dem_engine *e);
     /* Restart: everything needed to continue bit for bit (states, contact history). */
     int (*write_restart)(const lahar_dem_engine *e, FILE *f);
     int (*read_restart)(lahar_dem_engine *e, FILE *f);

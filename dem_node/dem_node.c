@@ -306,6 +306,7 @@ static int dem_node_loop(dem_node *d)
         st.ncontacts = d->ops->ncontacts(d->engine);
         st.nsubsteps = nsub > 0 ? nsub : 0;
         st.kinetic_energy = d->ops->kinetic_energy(d->engine);
+        st.work_body_body = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
         lahar_node_send_status(d->link, ROLE, k, &st, err);
         if (st.error) {
             fprintf(stderr, "lahar-dem: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
@@ -338,6 +339,12 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     if (rc != LAHAR_LINK_OK) {
         fprintf(stderr, "lahar-dem: %s\n", err);
         status = rc == LAHAR_LINK_LOST ? 3 : 2;
+        goto done;
+    }
+    /* A run whose bodies are all fixed has no DEM node (the SPH node writes the body files): a
+     * node started by hand for it has nothing to do. */
+    if (!d.ns.has_dem) {
+        fprintf(stderr, "lahar-dem: this run has no DEM node (its bodies are all fixed); exiting\n");
         goto done;
     }
     /* Ready = STATUS(-1); an error here (unknown engine, unwritable output) stops the run. */

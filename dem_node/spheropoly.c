@@ -117,6 +117,7 @@ struct lahar_dem_engine {
     vec3 *rep_f, *rep_t;
     int rep_n;
     int *ncontact_body;
+    long long contacts_evaluated; /* work counter: contacts summed over every force evaluation */
     /* instability report of the last failed advance (lahar_dem_fault) */
     double max_overlap;       /* overlap limit, fraction of the smaller sweep radius (stability.max_overlap) */
     lahar_dem_fault fault;
@@ -757,6 +758,7 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
     e->prev = e->cur;
     e->cur = tmp;
     e->nprev = n;
+    e->contacts_evaluated += n;
     if (history_rebuild(e)) {
         snprintf(err, errlen, "spheropoly: out of memory for the contact history");
         return -1;
@@ -1349,6 +1351,7 @@ fail:
 static double sp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
 static int sp_nbody(const lahar_dem_engine *e) { return e->nbody; }
 static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev; }
+static long long sp_contacts_evaluated(const lahar_dem_engine *e) { return e->contacts_evaluated; }
 
 static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
 {
@@ -1430,6 +1433,7 @@ const lahar_dem_engine_ops lahar_dem_spheropoly_ops = {
     .get_report = sp_get_report,
     .ncontacts = sp_ncontacts,
     .kinetic_energy = sp_kinetic_energy,
+    .contacts_evaluated = sp_contacts_evaluated,
     .write_restart = sp_write_restart,
     .read_restart = sp_read_restart,
     .destroy = sp_destroy,

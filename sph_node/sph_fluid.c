@@ -98,8 +98,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
 
 /* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
  * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
-static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, int64_t i,
-                                  double out[4])
+static inline int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, int64_t i,
+                                     double out[4])
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
@@ -122,7 +122,9 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
         for (int a = 0; a < 6; a++)
             ti[a] = tau[a][i] / (rhoi * rhoi);
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    int64_t nnb = 0; /* neighbours summed over (work counter) */
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        nnb++;
         double r = sqrt(r2);
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
         double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
@@ -155,6 +157,7 @@ static inline void fluid_particle(const sph_fluid *f, const kernel_kind kind, co
     out[1] = ax + prm->body_force[0];
     out[2] = ay + prm->body_force[1];
     out[3] = az + prm->body_force[2];
+    return nnb;
 }
 
 /* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, 003 eq. 11). */
@@ -213,23 +216,26 @@ static void fluid_pass(sph_fluid *f)
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
     const int sps = f->prm.sps != 0;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    int64_t neighbours = 0;
+#pragma omp parallel for schedule(static) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
         /* kind and sps constant per call site: the pair loop inlines without their branches */
         switch (kind * 2 + sps) {
-        case KERNEL_QUINTIC * 2: fluid_particle(f, KERNEL_QUINTIC, 0, i, out); break;
-        case KERNEL_QUINTIC * 2 + 1: fluid_particle(f, KERNEL_QUINTIC, 1, i, out); break;
-        case KERNEL_WENDLAND2 * 2: fluid_particle(f, KERNEL_WENDLAND2, 0, i, out); break;
-        case KERNEL_WENDLAND2 * 2 + 1: fluid_particle(f, KERNEL_WENDLAND2, 1, i, out); break;
-        case KERNEL_CUBIC * 2 + 1: fluid_particle(f, KERNEL_CUBIC, 1, i, out); break;
-        default: fluid_particle(f, KERNEL_CUBIC, 0, i, out); break;
+        case KERNEL_QUINTIC * 2: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, i, out); break;
+        case KERNEL_QUINTIC * 2 + 1: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 2: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 2 + 1: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, i, out); break;
+        case KERNEL_CUBIC * 2 + 1: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, i, out); break;
+        default: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, i, out); break;
         }
         p->drho[i] = out[0];
         p->ax[i] = out[1];
         p->ay[i] = out[2];
         p->az[i] = out[3];
     }
+    f->work_passes++;
+    f->work_neighbours_fluid += neighbours; /* integer sum: exact in any order */
 }
 
 void sph_fluid_shepard(sph_fluid *f)

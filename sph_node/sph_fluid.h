@@ -89,6 +89,13 @@ typedef struct {
     double *sps_nut;
     double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
     double *sps_tau[6];
+    /* Work counters (cumulative since init; read by the SPH node for its STATUS work fields):
+     * particle-particle passes, and the neighbours (i, j), j != i, within the kernel support that
+     * the water pass summed over, counted once per particle i (each pair twice in gather form).
+     * The count is a register increment in the pair loop summed by the pass's reduction: integer,
+     * so the same for any thread count. A soil pass adds its own counts next to these. */
+    int64_t work_passes;
+    int64_t work_neighbours_fluid;
 } sph_fluid;
 
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the

@@ -194,15 +194,48 @@ typedef struct {
     double **l_px, **l_pf;
     int64_t l_pcap;
     int64_t last_snapshot;       /* step of the last snapshot written */
+    /* work counters the solver does not keep itself (sph_fluid.work_* are its own) */
+    int64_t work_particle_body;  /* coupling contacts summed over the coupling's evaluations */
+    int64_t work_output_derived; /* values computed only to be written (snapshot pressures) */
+    double *out_pressure;        /* per particle: snapshot pressure; allocated only when written */
+    /* A scene whose bodies are all fixed runs without a DEM node (nothing for it to integrate):
+     * this node then writes what the DEM node would have, from the same numbers (sph_node_fixed_*). */
+    int fixed_only;
+    lahar_body_output *bout;     /* bodies.h5, forces.h5 */
+    lahar_contact_output *cout;  /* contacts.h5 (NULL unless a body is marked record_contacts) */
+    lahar_body_report *reports;
+    double (*c_x)[3], (*c_f)[3]; /* contact points and forces, contiguous, for contacts.h5 */
+    int64_t c_cap;
+    int at_output_time;          /* step k starts at an output time (contacts.h5 is written then) */
+    double kinetic_energy;       /* of the last snapshot (J, J/m in 2D) */
 } sph_node;
 
+/* A particle snapshot of the fields the case writes (output.fields), nothing else: unselected
+ * fields are neither gathered nor computed. The pressure written is the EOS of the density
+ * written (000 eq. 3 / 003 eq. 19), computed here only when the case writes pressure: the
+ * solver's own pressure array belongs to its last evaluation (the predicted density at the end
+ * of the step, before the second kick and any Shepard filter), so a snapshot's density and
+ * pressure agree exactly, whatever the solver stores. */
 static int sph_node_snapshot(sph_node *s, int64_t step, double t)
 {
     const sph_particles *p = &s->f.p;
+    const unsigned fields = s->ns.scene.output_fields;
+    const int vel = (fields & LAHAR_PFIELD_VELOCITY) != 0;
     lahar_particles_view v = {
-        .n = p->n, .x = p->x, .y = p->y, .z = p->z, .vx = p->vx, .vy = p->vy, .vz = p->vz,
-        .density = p->rho, .pressure = p->p, .phase = p->phase, .id = p->id,
+        .n = p->n, .x = p->x, .y = p->y, .z = p->z,
+        .vx = vel ? p->vx : NULL, .vy = vel ? p->vy : NULL, .vz = vel ? p->vz : NULL,
+        .density = fields & LAHAR_PFIELD_DENSITY ? p->rho : NULL,
+        .pressure = NULL,
+        .phase = fields & LAHAR_PFIELD_PHASE ? p->phase : NULL,
+        .id = fields & LAHAR_PFIELD_ID ? p->id : NULL,
     };
+    if ((fields & LAHAR_PFIELD_PRESSURE) && s->out_pressure) {
+        const sph_params *prm = &s->f.prm;
+        for (int64_t i = 0; i < p->n; i++)
+            s->out_pressure[i] = sph_fluid_pressure(prm, p->rho[i]);
+        s->work_output_derived += p->n;
+        v.pressure = s->out_pressure;
+    }
     s->last_snapshot = step;
     return lahar_particle_output_snapshot(s->out, step, t, &v);
 }
@@ -266,6 +299,12 @@ static void sph_node_free(sph_node *s)
     free(s->l_ptorque);
     free(s->l_px);
     free(s->l_pf);
+    free(s->out_pressure);
+    lahar_body_output_close(s->bout);
+    lahar_contact_output_close(s->cout);
+    free(s->reports);
+    free(s->c_x);
+    free(s->c_f);
     lahar_case_free(&s->ns.scene);
 }
 
@@ -296,10 +335,12 @@ static void sph_node_reach(const sph_node *s, double lo[3], double hi[3])
     }
 }
 
-/* LOADS(k) from the coupling's last evaluation (the bodies and particles at t_k): every body with
- * at least one particle within reach; contact points for moving bodies and for bodies marked
- * record_contacts (fixed ones: the resultant only otherwise, for forces.h5). */
-static int sph_node_send_loads(sph_node *s, int64_t k)
+/* The rows of LOADS from the coupling's last evaluation (the bodies and particles at t_k): every
+ * body with at least one particle within reach; contact points for moving bodies and for bodies
+ * marked record_contacts (fixed ones: the resultant only otherwise, for forces.h5). Returns the
+ * number of bodies listed (rows in s->l_*; *npoints the points in s->l_px/l_pf), or -1 when
+ * out of memory. */
+static int sph_node_build_loads(sph_node *s, int64_t *npoints)
 {
     const sph_coupling *cp = &s->f.cpl;
     const lahar_case *c = &s->ns.scene;
@@ -340,6 +381,17 @@ static int sph_node_send_loads(sph_node *s, int64_t k)
     }
     if (np > INT32_MAX)
         return -1;
+    *npoints = np;
+    return nb;
+}
+
+/* LOADS(k) for the DEM node (sph_node_build_loads). */
+static int sph_node_send_loads(sph_node *s, int64_t k)
+{
+    int64_t np;
+    int nb = sph_node_build_loads(s, &np);
+    if (nb < 0)
+        return -1;
     lahar_loads_t m = {
         .run_id = lahar_link_run_id(s->link), .step = k, .nbody = nb, .body_id = s->l_id, .force = s->l_pforce,
         .torque = s->l_ptorque, .npoints = s->l_np, .ntotal = (int32_t)np, .point_x = s->l_px, .point_f = s->l_pf,
@@ -348,6 +400,102 @@ static int sph_node_send_loads(sph_node *s, int64_t k)
     int rc;
     LAHAR_LINK_SEND(rc, s->link, LAHAR_FRAME_T_MSG_LOADS, lahar_loads_t, k, &m);
     return rc;
+}
+
+/* ---- fixed bodies only: no DEM node ----------------------------------------------------------
+ * Bodies that never move need no integration: the coordinator then starts no DEM node (no STEP,
+ * STATUS, LOADS or BODY_STATE for it), the coupling uses the scene's poses (it always does for
+ * fixed bodies) and this node writes the body files the DEM node would have written, from the
+ * same numbers: bodies.h5 (the scene's poses, quaternions normalised as the engine stores them,
+ * zero velocities), forces.h5 (per step k the row of t_{k+1} holding the fluid's force at t_k:
+ * the resultants LOADS(k) would carry; fixed bodies have no body-body contacts) and contacts.h5
+ * (the points of the marked bodies, at the steps that start at an output time). */
+
+static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t)
+{
+    const lahar_case *c = &s->ns.scene;
+    for (int b = 0; b < s->nbody; b++) {
+        lahar_body_state *st = &s->states[b];
+        memcpy(st->x, c->bodies[b].x, sizeof st->x);
+        q_store(q_normalize(q_load(c->bodies[b].q)), st->q);
+        memset(st->v, 0, sizeof st->v);
+        memset(st->w, 0, sizeof st->w);
+    }
+    return lahar_body_output_snapshot(s->bout, step, t, s->states);
+}
+
+/* Open the body files and write the snapshot at t = 0. 0, or -1 with a message in err. */
+static int sph_node_fixed_open(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    s->reports = calloc((size_t)s->nbody, sizeof *s->reports);
+    if (!s->reports) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    if (!(s->bout = lahar_body_output_open(s->ns.output_dir, c, err, errlen)))
+        return -1;
+    err[0] = '\0';
+    if (!(s->cout = lahar_contact_output_open(s->ns.output_dir, c, err, errlen)) && err[0])
+        return -1;
+    s->at_output_time = 1; /* t_0 */
+    if (sph_node_fixed_snapshot(s, 0, 0.0) != 0) {
+        snprintf(err, errlen, "cannot write the first body snapshot in %s", s->ns.output_dir);
+        return -1;
+    }
+    return 0;
+}
+
+/* Step k of the body files, before the particles move: the force row of t_{k+1} and, when step
+ * k starts at an output time, contacts.h5 at t_k, both from the coupling at t_k (the numbers of
+ * LOADS(k)). 0, or -1 with a message in err. */
+static int sph_node_fixed_forces(sph_node *s, int64_t k, const lahar_step_t *step, char *err, size_t errlen)
+{
+    int64_t np;
+    int nb = sph_node_build_loads(s, &np);
+    if (nb < 0) {
+        snprintf(err, errlen, "out of memory for the body loads");
+        return -1;
+    }
+    memset(s->reports, 0, (size_t)s->nbody * sizeof *s->reports);
+    for (int i = 0; i < nb; i++) {
+        memcpy(s->reports[s->l_id[i]].force, s->l_force[i], sizeof s->reports[0].force);
+        memcpy(s->reports[s->l_id[i]].torque, s->l_torque[i], sizeof s->reports[0].torque);
+    }
+    if (lahar_body_output_forces(s->bout, k + 1, step->t_next, s->reports) != 0) {
+        snprintf(err, errlen, "cannot append to forces.h5 in %s", s->ns.output_dir);
+        return -1;
+    }
+    int at_output = s->at_output_time;
+    s->at_output_time = step->write_output;
+    if (!s->cout || !at_output)
+        return 0;
+    if (np > s->c_cap) { /* at output times only, and only when more points than ever before */
+        int64_t cap = s->c_cap > 0 ? s->c_cap : 1024;
+        while (cap < np)
+            cap *= 2;
+        double(*x)[3] = realloc(s->c_x, (size_t)cap * sizeof *x);
+        if (x)
+            s->c_x = x;
+        double(*f)[3] = x ? realloc(s->c_f, (size_t)cap * sizeof *f) : NULL;
+        if (!x || !f) {
+            snprintf(err, errlen, "out of memory for %lld contact points", (long long)np);
+            return -1;
+        }
+        s->c_f = f;
+        s->c_cap = cap;
+    }
+    for (int64_t i = 0; i < np; i++) {
+        memcpy(s->c_x[i], s->l_px[i], sizeof s->c_x[i]);
+        memcpy(s->c_f[i], s->l_pf[i], sizeof s->c_f[i]);
+    }
+    if (lahar_contact_output_write(s->cout, k, step->t, nb, s->l_id, s->l_np, (const double(*)[3])s->c_x,
+                                   (const double(*)[3])s->c_f, (const double(*)[3])s->l_force,
+                                   (const double(*)[3])s->l_torque) != 0) {
+        snprintf(err, errlen, "cannot write to contacts.h5 in %s", s->ns.output_dir);
+        return -1;
+    }
+    return 0;
 }
 
 /* Bodies at t_{k+1} from BODY_STATE(k). A moving body the DEM node did not list is out of reach
@@ -380,6 +528,27 @@ static double sph_node_kinetic_energy(const sph_particles *p)
     for (int64_t i = 0; i < p->n; i++)
         e += 0.5 * p->m[i] * (p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i] + p->vz[i] * p->vz[i]);
     return e;
+}
+
+/* The work counters of STATUS (cumulative since set-up; lcm_types/status_t.lcm). Pairs are the
+ * solver's neighbour counts halved: the water pass visits each pair from both ends. No soil
+ * phase yet: its pair counts stay 0 until a soil pass counts them. */
+static void sph_node_work(const sph_node *s, lahar_status_t *st)
+{
+    st->work_passes = s->f.work_passes;
+    st->work_pairs_fluid = s->f.work_neighbours_fluid / 2;
+    st->work_pairs_soil = 0;
+    st->work_pairs_fluid_soil = 0;
+    st->work_particle_body = s->work_particle_body;
+    st->work_body_body = 0;
+    st->work_output_derived = s->work_output_derived;
+}
+
+/* After every evaluation of the coupling: its contacts join the particle-body work. */
+static void sph_node_count_coupling(sph_node *s)
+{
+    if (s->f.has_bodies)
+        s->work_particle_body += s->f.cpl.ncontacts;
 }
 
 static void sph_node_crossing_message(const sph_node *s, int64_t k, double t, char *err, size_t n)
@@ -531,9 +700,11 @@ static int sph_node_loop(sph_node *s)
         err[0] = '\0';
         double compute = 0.0, c0 = lahar_now();
         int64_t cross = 0;
-        if (k == 0) {
-            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt) */
+        if (k == 0 && s->f.has_bodies) {
+            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt); without bodies
+             * the rates of the set-up do not depend on dt and stand */
             cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step.dt);
+            sph_node_count_coupling(s);
             if (cross < 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH rates");
@@ -545,6 +716,8 @@ static int sph_node_loop(sph_node *s)
         if (has_dem && sph_node_send_loads(s, k) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
+        } else if (s->fixed_only && !st.error && sph_node_fixed_forces(s, k, &step, err, sizeof err) != 0) {
+            st.error = 1;
         }
         /* the particle work of step k needs no body states: do it before waiting for them, so
          * the DEM node's advance and the BODY_STATE latency hide behind it */
@@ -580,6 +753,7 @@ static int sph_node_loop(sph_node *s)
         lahar_instability u;
         if (stepped) {
             cross = sph_fluid_step_end(&s->f, step.dt, has_dem ? s->states : NULL);
+            sph_node_count_coupling(s);
             if (cross < 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "out of memory in the SPH step");
@@ -602,12 +776,23 @@ static int sph_node_loop(sph_node *s)
         } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
+        /* fixed bodies only: their snapshots, as the DEM node writes them (after each step) */
+        if (s->fixed_only && (step.write_output || st.error) && sph_node_fixed_snapshot(s, k + 1, step.t_next) != 0 &&
+            !st.error) {
+            st.error = 1;
+            snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
+        }
         if (unstable && s->last_snapshot == k + 1)
             lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
-        st.kinetic_energy = sph_node_kinetic_energy(&s->f.p);
+        /* the kinetic energy is a summary figure (the coordinator keeps the last one): computed
+         * at the output times (the last step is one) and on an error, not every step */
+        if (step.write_output || st.error)
+            s->kinetic_energy = sph_node_kinetic_energy(&s->f.p);
+        st.kinetic_energy = s->kinetic_energy;
+        sph_node_work(s, &st);
         compute += lahar_now() - c0;
         st.compute_s = compute;
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
@@ -661,7 +846,29 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
         snprintf(err, errlen, "out of memory in the SPH rates");
         return -1;
     }
+    sph_node_count_coupling(s);
+    /* the snapshot pressure (sph_node_snapshot) has a buffer only when the case writes it */
+    if ((c->output_fields & LAHAR_PFIELD_PRESSURE) && !(s->out_pressure = malloc((size_t)s->f.p.cap * sizeof(double)))) {
+        snprintf(err, errlen, "out of memory for %lld particles", (long long)s->f.p.cap);
+        return -1;
+    }
     return 0;
+}
+
+/* Without a DEM node in the run (the coordinator starts none when every body is fixed), this
+ * node writes the body files itself; a moving body without a DEM node cannot be integrated. */
+static int sph_node_setup_bodies(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    if (s->ns.has_dem || s->nbody == 0)
+        return 0;
+    for (int b = 0; b < s->nbody; b++)
+        if (c->bodies[b].motion != LAHAR_MOTION_FIXED) {
+            snprintf(err, errlen, "body %d '%s' moves, but the run has no DEM node to integrate it", b, c->bodies[b].name);
+            return -1;
+        }
+    s->fixed_only = 1;
+    return sph_node_fixed_open(s, err, errlen);
 }
 
 int lahar_sph_node_run(const lahar_sph_node_options *o)
@@ -698,6 +905,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         ;
     else if (sph_node_snapshot(&s, 0, 0.0) != 0)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
+    else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
+        /* the message is in err */
+    }
     char desc[256];
     if (s.fluid_ready)
         snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s",
@@ -706,7 +916,10 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;
-    st.kinetic_energy = st.error ? 0.0 : sph_node_kinetic_energy(&s.f.p);
+    s.kinetic_energy = st.error ? 0.0 : sph_node_kinetic_energy(&s.f.p);
+    st.kinetic_energy = s.kinetic_energy;
+    if (s.fluid_ready)
+        sph_node_work(&s, &st);
     lahar_node_send_status(s.link, ROLE, -1, &st, st.error ? err : desc);
     if (st.error) {
         fprintf(stderr, "lahar-sph: %s\n", err);

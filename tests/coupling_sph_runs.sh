@@ -10,8 +10,9 @@
 #              same particles.h5, bodies.h5, forces.h5 and contacts.h5, and so does a run on 2
 #              OpenMP threads; the water slows the box.
 # far_body     the same scene with one more free box 5 m away from the water: LOADS and BODY_STATE
-#              carry exactly the bytes of the run without it (the far body is never sent), and the
-#              water and the near box move bitwise as without it.
+#              carry exactly the bytes of the run without it (the far body is never sent), the
+#              work counters of summary.json (pairs, particle-body and body-body contacts) are the
+#              same, and the water and the near box move bitwise as without it.
 # hydrostatic  water at rest in a tank of three fixed DEM walls: the time-averaged force on a side
 #              wall in forces.h5 equals rho g h^2 / 2 (per unit width) within 5 % at this CI
 #              resolution (20 particles over h), the floor carries the weight within 2 %, and the
@@ -116,6 +117,10 @@ for ch in ("LAHAR_LOADS", "LAHAR_BODY_STATE"):
     # first publications only: re-sends on a NACK depend on timing (a slow sanitizer build)
     a, b = near["channels"][ch]["first_bytes"], far["channels"][ch]["first_bytes"]
     assert a == b, "%s: %d bytes without the far body, %d with it" % (ch, a, b)
+# nor any work: the same pairs, particle-body and body-body contacts (summary.json "work")
+for k in ("sph_passes", "pairs_fluid_fluid", "particle_body", "body_body"):
+    assert near["work"][k] == far["work"][k], "%s: %d without the far body, %d with it" % (k, near["work"][k], far["work"][k])
+assert far["work"]["particle_body"] > 0, "the near box and the walls must touch the water"
 with h5py.File(sys.argv[1] + "/bodies.h5") as a, h5py.File(sys.argv[2] + "/bodies.h5") as b:
     for name in a["snapshots"]:
         pa, pb = np.asarray(a["snapshots"][name]["position"]), np.asarray(b["snapshots"][name]["position"])

@@ -1,0 +1,17 @@
+# `lahar bench` (tools/bench.py, brief BENCH): the --quick preset on two validation cases plus the
+# overhead (processes over LCM in a private namespace: label netns) and subcycling scenes, then
+# tests/test_bench_output.py checks the CSVs, PNGs and summary.md it wrote: columns, particles x
+# steps / wall, the error column against each run's check.json, n ~ dx^-D, one DEM substep per
+# step when dt_max is forced to the DEM's stable dt. Speed is never asserted.
+find_program(LAHAR_BENCH_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT LAHAR_BENCH_PYTHON)
+  find_program(LAHAR_BENCH_PYTHON python3)
+endif()
+set(LAHAR_BENCH_OUT ${CMAKE_CURRENT_BINARY_DIR}/bench_quick)
+set(LAHAR_BENCH_QUICK_CASES poiseuille_2d,dam_break_2d)
+add_test(NAME bench_quick
+  COMMAND sh -c "rm -rf \"$1\" && \"$0\" bench --quick --cases $3 -o \"$1\" && \"$2\" \"$4\" \"$1\" pareto,overhead,subcycle $3"
+          $<TARGET_FILE:lahar> ${LAHAR_BENCH_OUT} ${LAHAR_BENCH_PYTHON} ${LAHAR_BENCH_QUICK_CASES}
+          ${LAHAR_TEST_DIR}/test_bench_output.py)
+set_tests_properties(bench_quick PROPERTIES LABELS "slow;netns;bench" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_BENCH_PYTHON}")

@@ -1,0 +1,556 @@
+#!/usr/bin/env python3
+"""lahar bench: run time against error, co-simulation overhead and DEM subcycling.
+
+usage: lahar bench -o OUT [--quick] [--sections pareto,overhead,subcycle] [--cases A,B]
+                   [--threads N] [--timeout S] [--keep] [--list]
+       (or tools/bench.py --lahar build/bin/lahar -o OUT ...)
+
+Sections (default: all three):
+  pareto    every validation case at >= 4 resolutions (the case's settings) plus one-at-a-time
+            changes of the settings that trade speed for accuracy (kernel, CFL number, delta-SPH,
+            artificial sound speed c0) at two resolutions; each run is `lahar check --in-process`
+            on a copy of the case (tools/case_override.py) with a shorter time.end. Writes
+            OUT/<case>.csv, OUT/<case>_pareto.png (error against wall time, Pareto front drawn) and
+            OUT/summary.md (the cheapest setting within a stated error per case).
+  overhead  the boulder pool (docs/bench/cases/boulder_pool_2d.yaml, free boulders sinking in
+            water, >= 20,000 particles) run as separate processes over LCM and --in-process:
+            wall-time ratio, per-node compute and wait time per step (OUT/overhead.csv, .md).
+  subcycle  the same pool with stiff boulders (kn 1e8) at a coarser dx: the DEM node subcycling
+            inside the SPH step against the whole run forced down to the DEM's stable step
+            (time.dt_max = dt_stable): OUT/subcycle.csv, .md.
+--quick: 2 resolutions and few settings per case, overhead and subcycle at small sizes (a smoke
+test of the tool, about 1-3 min; the numbers are not the benchmark's).
+Speed figures are wall times on whatever machine runs this: on a shared or loaded machine they
+are noisy (each row records the load average at its start and the CPU time used).
+Exit status: 0 done (runs that fail are recorded in the CSV with their exit status), 2 bad
+usage or the lahar executable missing."""
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+TOOLS = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(TOOLS)
+sys.path.insert(0, TOOLS)
+import lahar_py  # noqa: E402
+
+lahar_py.require("yaml", "numpy", "matplotlib")
+import case_override  # noqa: E402
+
+CASES_DIR = os.path.join(ROOT, "cases")
+BENCH_CASES_DIR = os.path.join(ROOT, "docs", "bench", "cases")
+
+# --------------------------------------------------------------------------------------------
+# What is swept. `dx`: the resolutions of the base setting (coarse to fine; dx divides the
+# periodic lengths); `vary_at`: indices into dx where the settings are varied; `error`: the
+# check.json values whose maximum is the run's error; `target`: the error the summary picks the
+# cheapest setting within; `overrides`: applied to every run (shorter end times).
+# Settings: (family, value, {path: value}); c0 values are factors of the case's c0.
+SETTINGS = [
+    ("kernel", "quintic", {"sph.kernel": "quintic"}),
+    ("kernel", "wendland2", {"sph.kernel": "wendland2"}),
+    ("cfl", "0.4", {"sph.cfl": 0.4}),
+    ("cfl", "0.1", {"sph.cfl": 0.1}),
+    ("delta", "0", {"sph.delta": 0.0}),
+    ("c0", "x0.5", {"sph.c0": 0.5}),
+    ("c0", "x2", {"sph.c0": 2.0}),
+]
+QUICK_SETTINGS = ["kernel=wendland2", "cfl=0.4"]
+
+BENCH = {
+    "poiseuille_2d": dict(
+        file="poiseuille_2d.yaml", overrides={"time.end": 30.0},
+        dx=[0.1 / 10, 0.1 / 16, 0.1 / 20, 0.1 / 25, 0.1 / 40], vary_at=[1, 2],
+        error=["steady_l2_rel_error", "plate_force_rel_error"], target=0.01,
+        error_note="max(steady L2 of u against the transient series at t = 30 s, plate force) (000 eq. 28-32)"),
+    "cylinder_array_2d": dict(
+        file="cylinder_array_2d.yaml", overrides={},
+        dx=[0.2 / 20, 0.2 / 25, 0.2 / 32, 0.2 / 40], vary_at=[0, 1],
+        error=["K_rel_error"], target=0.05,
+        error_note="K against Sangani & Acrivos at c = 0.1 after the case's 100 s"),
+    "hydrostatic_2d": dict(
+        file="hydrostatic_2d.yaml", overrides={"time.end": 1.0},
+        dx=[0.02, 0.0125, 0.01, 0.0075, 0.005], vary_at=[1, 2],
+        error=["wall_force_rel_error", "pressure_l2_rel_error"], target=0.03,
+        error_note="max(wall force, pressure L2) against rho g h^2/2, rho g (h - y), late window of 1 s"),
+    "dam_break_2d": dict(
+        file="dam_break_2d.yaml", overrides={"time.end": 0.35},
+        dx=[0.1 / 10, 0.1 / 14, 0.1 / 20, 0.1 / 28, 0.1 / 40], vary_at=[1, 2],
+        error=["front_rel_error"], target=0.15,
+        error_note="surge front against Martin & Moyce 1952 (n^2 = 2), largest relative deviation, t <= 0.35 s"),
+    "dam_break_3d": dict(
+        # the column made 0.1 wide (height 2 x width, the tank's full 0.25 m across) so that the
+        # Martin & Moyce front applies; the case's 0.3 m column has no published front to compare
+        file="dam_break_3d.yaml", overrides={"time.end": 0.35, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]},
+        dx=[0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 12], vary_at=[0, 1],
+        error=["front_rel_error"], target=0.15,
+        error_note="surge front against Martin & Moyce 1952 (n^2 = 2; column 0.1 x 0.25 x 0.2 m instead of the "
+                   "case's 0.3 m wide one), t <= 0.35 s"),
+}
+QUICK = {
+    "poiseuille_2d": dict(dx=[0.1 / 10, 0.1 / 16], vary_at=[0], overrides={"time.end": 10.0}),
+    "cylinder_array_2d": dict(dx=[0.2 / 20, 0.2 / 25], vary_at=[0], overrides={"time.end": 20.0}),
+    "hydrostatic_2d": dict(dx=[0.02, 0.0125], vary_at=[0], overrides={"time.end": 0.3}),
+    "dam_break_2d": dict(dx=[0.1 / 10, 0.1 / 14], vary_at=[0], overrides={"time.end": 0.25}),
+    "dam_break_3d": dict(dx=[0.1 / 4, 0.1 / 5], vary_at=[0],
+                         overrides={"time.end": 0.2, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]}),
+}
+
+CSV_COLUMNS = ["case", "label", "family", "setting", "dx", "particles", "steps", "sim_time", "wall_s",
+               "particle_steps_per_s", "cpu_s", "process_wall_s", "peak_rss_mb", "rss_per_particle_kb",
+               "error", "error_metrics", "dem_substeps", "exit_status", "load_avg", "threads", "overrides"]
+
+
+def log(msg):
+    print(msg, flush=True)
+
+
+# --------------------------------------------------------------------------------------------
+# One run: lahar run/check as a child, with its rusage (peak memory, CPU time) from wait4.
+def run_lahar(lahar, cmd, case_path, out, threads, in_process=True, timeout=600.0, check_plot=False):
+    argv = [lahar, cmd, case_path, "-o", out, "-q"]
+    if threads:
+        argv += ["--threads", str(threads)]
+    if in_process:
+        argv.append("--in-process")
+    env = dict(os.environ)
+    if not check_plot:
+        env["LAHAR_CHECK_NO_PLOT"] = "1"
+    if os.path.isdir(out):
+        shutil.rmtree(out)
+    load = os.getloadavg()[0]
+    t0 = time.monotonic()
+    with open(out + ".log", "w") as logf:
+        p = subprocess.Popen(argv, stdout=logf, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        status, ru = None, None
+        while True:
+            pid, st, r = os.wait4(p.pid, os.WNOHANG)
+            if pid == p.pid:
+                status, ru = st, r
+                break
+            if time.monotonic() - t0 > timeout:
+                os.killpg(p.pid, signal.SIGTERM)
+                time.sleep(2.0)
+                try:
+                    os.killpg(p.pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+                _, st, r = os.wait4(p.pid, 0)
+                status, ru = None, r
+                break
+            time.sleep(0.05)
+        p.returncode = 0  # reaped by wait4 above; keep Popen from waiting again
+    wall = time.monotonic() - t0
+    code = "timeout" if status is None else (os.waitstatus_to_exitcode(status))
+    return dict(exit_status=code, process_wall_s=wall, cpu_s=ru.ru_utime + ru.ru_stime,
+                peak_rss_mb=ru.ru_maxrss / 1024.0, load_avg=load)
+
+
+def read_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def summary_numbers(out):
+    """Particles, steps, wall time of the stepping loop and DEM substeps from OUT/summary.json."""
+    s = read_json(os.path.join(out, "summary.json")) or {}
+    sph = s.get("nodes", {}).get("sph", {})
+    m = re.search(r"(\d+) particles", sph.get("engine_detail", ""))
+    return dict(particles=int(m.group(1)) if m else 0, steps=int(s.get("steps", 0)),
+                sim_time=float(s.get("sim_time", 0.0)), wall_s=float(s.get("wall_time_s", float("nan"))),
+                dem_substeps=int(s.get("dem_substeps", 0)), summary=s)
+
+
+def check_error(out, names):
+    """max of the named check.json values (metrics or information); NaN when one is missing."""
+    c = read_json(os.path.join(out, "check.json"))
+    if not c:
+        return float("nan"), ""
+    vals = {k: v.get("value") for k, v in c.get("metrics", {}).items()}
+    vals.update({k: v for k, v in c.get("info", {}).items() if isinstance(v, (int, float))})
+    got = [(n, vals.get(n)) for n in names]
+    text = ";".join(f"{n}={v:.4g}" if isinstance(v, (int, float)) else f"{n}=nan" for n, v in got)
+    nums = [v for _, v in got if isinstance(v, (int, float)) and math.isfinite(v)]
+    return (max(nums) if len(nums) == len(names) else float("nan")), text
+
+
+def fmt(v, nd=4):
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.{nd}g}"
+    return str(v)
+
+
+# --------------------------------------------------------------------------------------------
+# Section 1: run time against error
+def plan_case(name, spec, quick):
+    """The runs of one case: (label, family, setting, dx, overrides)."""
+    runs = []
+    doc = case_override.load_case(os.path.join(CASES_DIR, spec["file"]))
+    c0 = case_override.get_path(doc, "sph.c0")
+    for i, dx in enumerate(spec["dx"]):
+        runs.append((f"base_dx{dx:.5g}", "base", "case", dx, {}))
+    for i in spec["vary_at"]:
+        dx = spec["dx"][i]
+        for family, value, ov in SETTINGS:
+            if quick and f"{family}={value}" not in QUICK_SETTINGS:
+                continue
+            ov = dict(ov)
+            if family == "c0":
+                if not isinstance(c0, (int, float)):
+                    continue
+                ov["sph.c0"] = c0 * ov["sph.c0"]
+            runs.append((f"{family}_{value}_dx{dx:.5g}", family, value, dx, ov))
+    return runs
+
+
+def bench_case(args, name, spec, outdir):
+    rundir = os.path.join(outdir, "runs", name)
+    os.makedirs(rundir, exist_ok=True)
+    rows = []
+    runs = plan_case(name, spec, args.quick)
+    log(f"== {name}: {len(runs)} runs (error: {spec['error_note']})")
+    for label, family, setting, dx, ov in runs:
+        overrides = dict(spec["overrides"])
+        overrides["sph.dx"] = dx
+        overrides.update(ov)
+        case_path = os.path.join(rundir, label + ".yaml")
+        out = os.path.join(rundir, label)
+        case_override.override_case(os.path.join(CASES_DIR, spec["file"]), case_path, overrides)
+        r = run_lahar(args.lahar, "check", case_path, out, args.threads, timeout=args.timeout)
+        s = summary_numbers(out)
+        # exit 1 = a check metric out of its bound: the run itself is fine, its error is recorded
+        ok = r["exit_status"] in (0, 1) and s["steps"] > 0 and s["sim_time"] > 0
+        err, err_text = check_error(out, spec["error"]) if ok else (float("nan"), "")
+        n, steps, wall = s["particles"], s["steps"], s["wall_s"]
+        row = dict(case=name, label=label, family=family, setting=setting, dx=dx, particles=n, steps=steps,
+                   sim_time=s["sim_time"], wall_s=wall,
+                   particle_steps_per_s=(n * steps / wall) if wall and wall > 0 else float("nan"),
+                   cpu_s=r["cpu_s"], process_wall_s=r["process_wall_s"], peak_rss_mb=r["peak_rss_mb"],
+                   rss_per_particle_kb=(r["peak_rss_mb"] * 1024.0 / n) if n else float("nan"),
+                   error=err, error_metrics=err_text, dem_substeps=s["dem_substeps"],
+                   exit_status=r["exit_status"], load_avg=r["load_avg"], threads=args.threads,
+                   overrides=" ".join(f"{k}={v}" for k, v in overrides.items()))
+        rows.append(row)
+        log(f"  {label:28s} n={n:6d} steps={steps:6d} wall={fmt(wall, 3):>7s} s  "
+            f"pps={fmt(row['particle_steps_per_s'], 3):>8s}  err={fmt(err, 3):>8s}  exit={r['exit_status']}")
+        if not args.keep:
+            for f in os.listdir(out) if os.path.isdir(out) else []:
+                if f.endswith(".h5"):
+                    os.remove(os.path.join(out, f))
+    write_csv(os.path.join(outdir, f"{name}.csv"), rows, CSV_COLUMNS)
+    plot_pareto(os.path.join(outdir, f"{name}_pareto.png"), name, spec, rows)
+    return rows
+
+
+def write_csv(path, rows, columns):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=columns, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (fmt(v, 6) if isinstance(v, float) else v) for k, v in r.items()})
+
+
+def pareto_front(rows):
+    """Rows not dominated in (wall time, error), by increasing wall time."""
+    good = sorted((r for r in rows if math.isfinite(r["error"]) and math.isfinite(r["wall_s"])),
+                  key=lambda r: (r["wall_s"], r["error"]))
+    front, best = [], float("inf")
+    for r in good:
+        if r["error"] < best:
+            front.append(r)
+            best = r["error"]
+    return front
+
+
+def plot_pareto(path, name, spec, rows):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=90)
+    markers = {"base": "o", "kernel": "s", "cfl": "^", "delta": "D", "c0": "v"}
+    fam_order = ["base", "kernel", "cfl", "delta", "c0"]
+    for fam in fam_order:
+        for setting in sorted({r["setting"] for r in rows if r["family"] == fam}):
+            pts = [r for r in rows if r["family"] == fam and r["setting"] == setting
+                   and math.isfinite(r["error"]) and r["error"] > 0]
+            if pts:
+                lab = "case settings (dx sweep)" if fam == "base" else f"{fam} = {setting}"
+                ax.scatter([r["wall_s"] for r in pts], [r["error"] for r in pts], marker=markers.get(fam, "x"),
+                           s=42 if fam == "base" else 30, label=lab, alpha=0.85)
+                if fam == "base":
+                    ax.plot([r["wall_s"] for r in pts], [r["error"] for r in pts], lw=0.6, color="grey")
+                    for r in pts:
+                        ax.annotate(f"{r['particles']}", (r["wall_s"], r["error"]), fontsize=7,
+                                    xytext=(4, 3), textcoords="offset points")
+    front = [r for r in pareto_front(rows) if r["error"] > 0]
+    if front:
+        ax.step([r["wall_s"] for r in front], [r["error"] for r in front], where="post", color="k", lw=1.6,
+                label="Pareto front")
+        ax.scatter([r["wall_s"] for r in front], [r["error"] for r in front], s=110, facecolors="none",
+                   edgecolors="k", lw=1.3)
+    ax.axhline(spec["target"], color="r", ls=":", lw=1, label=f"target {spec['target']:g}")
+    failed = [r for r in rows if not math.isfinite(r["error"])]
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time of the run [s] (shared machine: noisy)")
+    ax.set_ylabel("error")
+    title = f"{name}: error against wall time"
+    if failed:
+        title += f" ({len(failed)} runs failed: " + ", ".join(r["label"] for r in failed[:3]) + \
+                 (" ..." if len(failed) > 3 else "") + ")"
+    ax.set_title(title, fontsize=9)
+    fig.text(0.01, 0.01, "error: " + spec["error_note"], fontsize=6.5)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def summary_markdown(results):
+    lines = ["| case | error (what) | target | cheapest within target | particles | wall [s] | error | "
+             "most accurate | its wall [s] | its error |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for name, (spec, rows) in results.items():
+        ok = [r for r in rows if math.isfinite(r["error"]) and math.isfinite(r["wall_s"])]
+        within = sorted((r for r in ok if r["error"] <= spec["target"]), key=lambda r: r["wall_s"])
+        best = min(ok, key=lambda r: r["error"]) if ok else None
+        cheap = within[0] if within else None
+
+        def desc(r):
+            return f"{r['family']} {r['setting']}, dx {r['dx']:.4g}" if r["family"] != "base" else \
+                f"case settings, dx {r['dx']:.4g}"
+        lines.append("| %s | %s | %g | %s | %s | %s | %s | %s | %s | %s |" % (
+            name, spec["error_note"], spec["target"],
+            desc(cheap) if cheap else "none", cheap["particles"] if cheap else "",
+            fmt(cheap["wall_s"], 3) if cheap else "", fmt(cheap["error"], 3) if cheap else "",
+            desc(best) if best else "none", fmt(best["wall_s"], 3) if best else "", fmt(best["error"], 3) if best else ""))
+    return "\n".join(lines) + "\n"
+
+
+# --------------------------------------------------------------------------------------------
+# Section 2: co-simulation overhead (processes over LCM against in-process)
+def per_step(s, node, key):
+    v = s.get("nodes", {}).get(node, {}).get(key)
+    return 1e3 * v / s["steps"] if isinstance(v, (int, float)) and s.get("steps") else float("nan")
+
+
+def overhead_row(args, case_path, out, mode, rep, size):
+    r = run_lahar(args.lahar, "run", case_path, out, args.threads, in_process=(mode == "in-process"),
+                  timeout=args.timeout)
+    s = summary_numbers(out)
+    sj = s["summary"]
+    row = dict(size=size, mode=mode, repeat=rep, particles=s["particles"], steps=s["steps"], wall_s=s["wall_s"],
+               wall_ms_per_step=(1e3 * s["wall_s"] / s["steps"]) if s["steps"] else float("nan"),
+               cpu_s=r["cpu_s"], peak_rss_mb=r["peak_rss_mb"],
+               sph_compute_ms_per_step=per_step(sj, "sph", "compute_s"),
+               sph_wait_ms_per_step=per_step(sj, "sph", "wait_s"),
+               dem_compute_ms_per_step=per_step(sj, "dem", "compute_s"),
+               dem_wait_ms_per_step=per_step(sj, "dem", "wait_s"),
+               coordinator_wait_ms_per_step=(1e3 * sj.get("coordinator_wait_s", float("nan")) / s["steps"]
+                                             if s["steps"] else float("nan")),
+               body_state_messages=sj.get("channels", {}).get("LAHAR_BODY_STATE", {}).get("messages", 0),
+               exit_status=r["exit_status"], load_avg=r["load_avg"])
+    log(f"  {size:5s} {mode:10s} n={row['particles']} steps={row['steps']} wall={fmt(row['wall_s'], 4)} s "
+        f"({fmt(row['wall_ms_per_step'], 3)} ms/step) cpu={fmt(row['cpu_s'], 4)} s "
+        f"sph wait {fmt(row['sph_wait_ms_per_step'], 3)} ms/step exit={r['exit_status']}")
+    if not args.keep:
+        for f in os.listdir(out) if os.path.isdir(out) else []:
+            if f.endswith(".h5"):
+                os.remove(os.path.join(out, f))
+    return row
+
+
+def median(xs):
+    xs = sorted(xs)
+    return float("nan") if not xs else (xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2]))
+
+
+def bench_overhead(args, outdir):
+    """Pairs of runs (processes, in-process; the order alternates) of the boulder pool: `large` at
+    >= 20,000 particles, and `floor` at dx 20 mm (about 400 particles), whose wall time per step is
+    almost all protocol: the difference of the two modes there is the per-step cost of LCM over
+    UDP multicast against the in-process queue."""
+    src = os.path.join(BENCH_CASES_DIR, "boulder_pool_2d.yaml")
+    dx, end = (0.004, 0.02) if args.quick else (0.0025, args.overhead_end)
+    d = os.path.join(outdir, "runs", "overhead")
+    sizes = {"large": (dx, end), "floor": (0.02, 0.1 if args.quick else 0.5)}
+    rows = []
+    log(f"== overhead: {src} at dx {dx} (and {sizes['floor'][0]}), end {end} s, {args.repeat} pair(s) of runs")
+    for size, (sdx, send) in sizes.items():
+        case_path = os.path.join(d, f"pool_{size}.yaml")
+        case_override.override_case(src, case_path, {"sph.dx": sdx, "time.end": send})
+        for rep in range(args.repeat):
+            modes = ("processes", "in-process") if rep % 2 == 0 else ("in-process", "processes")
+            for mode in modes:
+                rows.append(overhead_row(args, case_path, os.path.join(d, f"{size}_{mode}_{rep}"), mode, rep, size))
+    write_csv(os.path.join(outdir, "overhead.csv"), rows, list(rows[0].keys()))
+
+    def ratios(size, key):
+        out = []
+        for rep in range(args.repeat):
+            pair = {r["mode"]: r for r in rows if r["size"] == size and r["repeat"] == rep and r["exit_status"] == 0}
+            if len(pair) == 2 and pair["in-process"][key] > 0:
+                out.append(pair["processes"][key] / pair["in-process"][key])
+        return out
+    wall_r, cpu_r = ratios("large", "wall_s"), ratios("large", "cpu_s")
+    fl = {m: median([r["wall_ms_per_step"] for r in rows if r["size"] == "floor" and r["mode"] == m
+                     and r["exit_status"] == 0]) for m in ("processes", "in-process")}
+    lg = median([r["wall_ms_per_step"] for r in rows if r["size"] == "large" and r["mode"] == "in-process"
+                 and r["exit_status"] == 0])
+    md = ["| scene | mode | pair | particles | steps | wall [s] | wall/step [ms] | CPU [s] | "
+          "SPH compute / wait [ms/step] | DEM compute / wait [ms/step] | coordinator wait [ms/step] | "
+          "BODY_STATE msgs | exit | load |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        md.append(f"| {r['size']} | {r['mode']} | {r['repeat']} | {r['particles']} | {r['steps']} | {fmt(r['wall_s'], 4)} | "
+                  f"{fmt(r['wall_ms_per_step'], 3)} | {fmt(r['cpu_s'], 4)} | "
+                  f"{fmt(r['sph_compute_ms_per_step'], 3)} / {fmt(r['sph_wait_ms_per_step'], 3)} | "
+                  f"{fmt(r['dem_compute_ms_per_step'], 3)} / {fmt(r['dem_wait_ms_per_step'], 3)} | "
+                  f"{fmt(r['coordinator_wait_ms_per_step'], 3)} | {r['body_state_messages']} | {r['exit_status']} | "
+                  f"{fmt(r['load_avg'], 2)} |")
+    ratio = median(wall_r)
+    protocol = fl["processes"] - fl["in-process"]
+    md += ["", f"Wall-time ratio processes / in-process at {rows[0]['particles']} particles, median of "
+           f"{len(wall_r)} pair(s): **{fmt(ratio, 3)}** (pairs: {', '.join(fmt(x, 3) for x in wall_r)}; target <= 1.05); "
+           f"CPU-time ratio {fmt(median(cpu_r), 3)}.",
+           f"Protocol floor (dx {sizes['floor'][0]}): {fmt(fl['processes'], 3)} ms/step as processes, "
+           f"{fmt(fl['in-process'], 3)} ms/step in-process: LCM over UDP costs {fmt(protocol, 3)} ms/step more, "
+           f"{fmt(100.0 * protocol / lg, 2) if lg > 0 else 'nan'} % of the large scene's "
+           f"{fmt(lg, 3)} ms/step in-process."]
+    with open(os.path.join(outdir, "overhead.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    log(f"  ratio processes / in-process: {fmt(ratio, 3)} (CPU {fmt(median(cpu_r), 3)}); "
+        f"protocol {fmt(protocol, 3)} ms/step")
+    return ratio
+
+
+# --------------------------------------------------------------------------------------------
+# Section 3: DEM subcycling against the global step forced down to the DEM step
+def bench_subcycle(args, outdir):
+    src = os.path.join(BENCH_CASES_DIR, "boulder_pool_2d.yaml")
+    dx, end = (0.01, 0.01) if args.quick else (0.005, args.subcycle_end)
+    d = os.path.join(outdir, "runs", "subcycle")
+    base = {"sph.dx": dx, "time.end": end, "materials.rock.kn": 1.0e8}
+    rows = []
+    log(f"== subcycle: {src} with kn = 1e8 at dx {dx}, end {end} s")
+    dt_dem = None
+    for variant in ("subcycling", "global dt = DEM dt"):
+        ov = dict(base)
+        if variant != "subcycling":
+            ov["time.dt_max"] = dt_dem
+        tag = "sub" if variant == "subcycling" else "forced"
+        case_path = os.path.join(d, f"{tag}.yaml")
+        case_override.override_case(src, case_path, ov)
+        out = os.path.join(d, tag)
+        r = run_lahar(args.lahar, "run", case_path, out, args.threads, timeout=args.timeout)
+        s = summary_numbers(out)
+        sj = s["summary"]
+        dem = sj.get("nodes", {}).get("dem", {})
+        sph = sj.get("nodes", {}).get("sph", {})
+        if dt_dem is None:
+            dt_dem = float(dem.get("dt_stable", 0.0)) or 1e-6
+        rows.append(dict(variant=variant, particles=s["particles"], steps=s["steps"], dem_substeps=s["dem_substeps"],
+                         dem_dt_stable=dem.get("dt_stable", float("nan")),
+                         sph_dt_stable=sph.get("dt_stable", float("nan")), wall_s=s["wall_s"], cpu_s=r["cpu_s"],
+                         sph_compute_s=sph.get("compute_s", float("nan")),
+                         dem_compute_s=dem.get("compute_s", float("nan")),
+                         exit_status=r["exit_status"], load_avg=r["load_avg"]))
+        log(f"  {variant:20s} steps={s['steps']} substeps={s['dem_substeps']} wall={fmt(s['wall_s'], 4)} s "
+            f"exit={r['exit_status']}")
+        if not args.keep:
+            for f in os.listdir(out) if os.path.isdir(out) else []:
+                if f.endswith(".h5"):
+                    os.remove(os.path.join(out, f))
+    write_csv(os.path.join(outdir, "subcycle.csv"), rows, list(rows[0].keys()))
+    gain = rows[1]["wall_s"] / rows[0]["wall_s"] if rows[0]["wall_s"] > 0 else float("nan")
+    md = ["| variant | particles | coordinator steps | DEM substeps | DEM dt_stable [s] | SPH dt [s] | wall [s] | "
+          "SPH compute [s] | DEM compute [s] | load |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        md.append(f"| {r['variant']} | {r['particles']} | {r['steps']} | {r['dem_substeps']} | "
+                  f"{fmt(r['dem_dt_stable'], 3)} | {fmt(r['sph_dt_stable'], 3)} | {fmt(r['wall_s'], 4)} | "
+                  f"{fmt(r['sph_compute_s'], 4)} | {fmt(r['dem_compute_s'], 4)} | {fmt(r['load_avg'], 2)} |")
+    md.append("")
+    md.append(f"Gain of subcycling (wall time forced / subcycling): **{fmt(gain, 3)}**")
+    with open(os.path.join(outdir, "subcycle.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    log(f"  gain: {fmt(gain, 3)}")
+    return gain
+
+
+# --------------------------------------------------------------------------------------------
+def main(argv):
+    ap = argparse.ArgumentParser(prog="lahar bench", description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog="\n\n".join(__doc__.split("\n\n")[2:]))
+    ap.add_argument("-o", "--output", required=True, help="output directory (created)")
+    ap.add_argument("--lahar", default=os.path.join(ROOT, "build", "bin", "lahar"), help="the lahar executable")
+    ap.add_argument("--quick", action="store_true", help="2 resolutions and 2 settings per case, small scenes")
+    ap.add_argument("--sections", default="pareto,overhead,subcycle", help="comma list of pareto, overhead, subcycle")
+    ap.add_argument("--cases", default=",".join(BENCH), help="comma list of the cases of the pareto section")
+    ap.add_argument("--threads", type=int, default=2, help="OpenMP threads per node (default 2)")
+    ap.add_argument("--timeout", type=float, default=900.0, help="seconds after which one run is stopped")
+    ap.add_argument("--repeat", type=int, default=3, help="pairs of runs of the overhead section (median is used)")
+    ap.add_argument("--overhead-end", type=float, default=0.02, help="simulated time of the overhead runs [s]")
+    ap.add_argument("--subcycle-end", type=float, default=0.1, help="simulated time of the subcycling runs [s]")
+    ap.add_argument("--keep", action="store_true", help="keep the runs' HDF5 files (deleted by default)")
+    ap.add_argument("--list", action="store_true", help="print the planned runs and exit")
+    args = ap.parse_args(argv)
+    sections = [s.strip() for s in args.sections.split(",") if s.strip()]
+    bad = [s for s in sections if s not in ("pareto", "overhead", "subcycle")]
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    badc = [c for c in cases if c not in BENCH]
+    if bad or badc:
+        sys.stderr.write(f"lahar bench: unknown {'section' if bad else 'case'} {', '.join(bad or badc)} "
+                         f"(sections: pareto, overhead, subcycle; cases: {', '.join(BENCH)})\n")
+        return 2
+    if args.quick:
+        args.repeat = 1
+    specs = {}
+    for c in cases:
+        spec = dict(BENCH[c])
+        if args.quick:
+            spec.update(QUICK[c])
+        specs[c] = spec
+    if args.list:
+        for c, spec in specs.items():
+            for label, family, setting, dx, ov in plan_case(c, spec, args.quick):
+                print(c, label, json.dumps({**spec["overrides"], "sph.dx": dx, **ov}))
+        return 0
+    if not os.access(args.lahar, os.X_OK):
+        sys.stderr.write(f"lahar bench: {args.lahar} is not an executable (build first, or --lahar PATH)\n")
+        return 2
+    os.makedirs(args.output, exist_ok=True)
+    t0 = time.monotonic()
+    md = [f"# lahar bench{' --quick' if args.quick else ''}", "",
+          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {args.threads} OpenMP threads per node, "
+          f"{os.cpu_count()} CPUs, load average at start {os.getloadavg()[0]:.2f}. Wall times are noisy on a "
+          "shared machine; cpu_s in the CSVs is the CPU time the run used.", ""]
+    if "pareto" in sections:
+        results = {}
+        for c, spec in specs.items():
+            results[c] = (spec, bench_case(args, c, spec, args.output))
+        md += ["## Run time against error (cheapest setting within the target error)", "", summary_markdown(results)]
+    if "overhead" in sections:
+        bench_overhead(args, args.output)
+        md += ["## Co-simulation overhead", "", open(os.path.join(args.output, "overhead.md")).read()]
+    if "subcycle" in sections:
+        bench_subcycle(args, args.output)
+        md += ["## DEM subcycling", "", open(os.path.join(args.output, "subcycle.md")).read()]
+    md.append(f"Total bench time {time.monotonic() - t0:.0f} s.")
+    with open(os.path.join(args.output, "summary.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    log(f"lahar bench: wrote {os.path.join(args.output, 'summary.md')} ({time.monotonic() - t0:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
