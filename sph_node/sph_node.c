@@ -677,9 +677,14 @@ static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int
     int reason = lahar_node_stop_reason(stop, why, sizeof why);
     if (reason <= 0 || s->f.begun)
         return;
-    if (s->last_snapshot != k && sph_node_snapshot(s, k, t) != 0)
-        return;
+    if (s->last_snapshot != k) {
+        /* fixed bodies only: their snapshots go with the particles' (this node writes both) */
+        if (sph_node_snapshot(s, k, t) != 0 || (s->fixed_only && sph_node_fixed_snapshot(s, k, t) != 0))
+            return;
+    }
     lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "stopped", why);
+    if (s->fixed_only)
+        lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", "stopped", why);
 }
 
 static int sph_node_loop(sph_node *s)
@@ -782,8 +787,11 @@ static int sph_node_loop(sph_node *s)
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
         }
-        if (unstable && s->last_snapshot == k + 1)
+        if (unstable && s->last_snapshot == k + 1) {
             lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
+            if (s->fixed_only)
+                lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", "stopped", u.text);
+        }
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
