@@ -394,11 +394,66 @@ static void read_time(reader *r, yaml_node_t *root, yaml_node_t *n, lahar_case *
         rmap_fail(&m, "forces_interval", "must be >= 0 s (got %g); 0 records every step", c->forces_interval);
 }
 
+/* A model: soil material (an SPH soil, sph_node/sph_soil.h): elastic constants, Mohr-Coulomb
+ * strength (angles in degrees in the case, radians in lahar_material), k_h for seepage and mu_phi
+ * against DEM surfaces (friction, default tan(friction_angle)). */
+static void read_soil_material(rmap *m, lahar_material *mat, const char *const *dem_only)
+{
+    const double deg = acos(-1.0) / 180.0;
+    for (int k = 0; dem_only[k] && !m->r->failed; k++)
+        if (rmap_get(m, dem_only[k]))
+            rmap_fail(m, dem_only[k], "is a DEM contact key, but this material is an SPH soil (model: soil); remove "
+                      "it (the soil-DEM contact uses the SPH coupling's K_n, paper 000 eq. 15)");
+    mat->young = rmap_num(m, "young", 1, 0.0, "8.4e5");
+    mat->poisson = rmap_num(m, "poisson", 0, 0.3, "0.3");
+    double phi = rmap_num(m, "friction_angle", 1, 0.0, "30");
+    double coh = rmap_num(m, "cohesion", 0, 0.0, "0");
+    double psi = rmap_num(m, "dilatancy", 0, 0.0, "0");
+    double kh = rmap_num(m, "permeability", 0, 0.0, "1e-3");
+    double cd = rmap_num(m, "damping", 0, 0.0, "100");
+    if (m->r->failed)
+        return;
+    mat->friction = rmap_num(m, "friction", 0, tan(phi * deg), "0.5");
+    if (m->r->failed)
+        return;
+    mat->friction_angle = phi * deg;
+    mat->cohesion = coh;
+    mat->dilatancy = psi * deg;
+    mat->permeability = kh;
+    mat->damping = cd;
+    mat->restitution = 1.0;
+    mat->kt_ratio = 2.0 / 7.0;
+    if (!(mat->density > 0))
+        rmap_fail(m, "density", "must be > 0 kg/m^3 (got %g); the soil's bulk density, e.g. 2000", mat->density);
+    else if (!(mat->young > 0))
+        rmap_fail(m, "young", "must be > 0 Pa (got %g); the soil's Young's modulus, e.g. 8.4e5", mat->young);
+    else if (!(mat->poisson >= 0 && mat->poisson < 0.5))
+        rmap_fail(m, "poisson", "must be in [0, 0.5) (got %g)", mat->poisson);
+    else if (!(phi >= 0 && phi < 90))
+        rmap_fail(m, "friction_angle", "must be in [0, 90) degrees (got %g); sands are about 30", phi);
+    else if (!(coh >= 0))
+        rmap_fail(m, "cohesion", "must be >= 0 Pa (got %g); 0 for a dry sand", coh);
+    else if (!(phi > 0 || coh > 0))
+        rmap_fail(m, "cohesion", "a soil with friction_angle 0 needs cohesion > 0 (it would have no strength)");
+    else if (!(psi >= 0 && psi <= phi))
+        rmap_fail(m, "dilatancy", "must be in [0, friction_angle = %g] degrees (got %g); 0 is usual", phi, psi);
+    else if (!(cd >= 0))
+        rmap_fail(m, "damping", "must be >= 0 1/s (got %g); 0 = off, about the column's first frequency pi c/(2 H) "
+                  "damps its start-up in a few periods", cd);
+    else if (!(kh >= 0))
+        rmap_fail(m, "permeability", "must be >= 0 m/s (got %g); the Darcy hydraulic conductivity k_h", kh);
+    else if (!(mat->friction >= 0))
+        rmap_fail(m, "friction", "must be >= 0 (got %g); the soil-DEM friction coefficient mu_phi", mat->friction);
+}
+
 static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"density", "model", "young", "poisson", "kn", "kt_ratio", "restitution",
-                                       "friction", NULL};
-    static const char *const models[] = {"linear", "hertz", NULL};
+                                       "friction", "friction_angle", "cohesion", "dilatancy", "permeability", "damping",
+                                       NULL};
+    static const char *const models[] = {"linear", "hertz", "soil", NULL};
+    static const char *const soil_only[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping", NULL};
+    static const char *const dem_only[] = {"kn", "kt_ratio", "restitution", NULL};
     rmap top;
     if (rmap_open(r, n, "materials", &top) != 0)
         return;
@@ -442,6 +497,14 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
         mat->model = (lahar_contact_model)rmap_enum(&m, "model", models, 0, LAHAR_CONTACT_HERTZ);
         if (r->failed)
             return;
+        if (mat->model == LAHAR_CONTACT_SOIL) {
+            read_soil_material(&m, mat, dem_only);
+            continue;
+        }
+        for (int k = 0; soil_only[k] && !r->failed; k++)
+            if (rmap_get(&m, soil_only[k]))
+                rmap_fail(&m, soil_only[k], "is a key of an SPH soil (model: soil), but this material uses model: "
+                          "%s; remove it or set model: soil", models[mat->model]);
         if (mat->model == LAHAR_CONTACT_HERTZ) {
             if (rmap_get(&m, "kn"))
                 rmap_fail(&m, "kn", "is the stiffness of model: linear, but this material uses model: hertz; "
@@ -963,6 +1026,11 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
             rmap_fail(&m, "material", "unknown material '%s'; define it in materials: (defined: %s)", mat, list);
         return;
     }
+    if (c->materials[b->material].model == LAHAR_CONTACT_SOIL) {
+        rmap_fail(&m, "material", "'%s' is an SPH soil (model: soil); a body needs a DEM material (model: hertz or "
+                  "linear)", mat);
+        return;
+    }
 
     double pos[3] = {0, 0, 0}, vel[3] = {0, 0, 0}, omega[3] = {0, 0, 0};
     rmap_vec(&m, "position", dim, pos, 0, "");
@@ -1270,9 +1338,38 @@ static void read_block_stl(reader *r, yaml_node_t *sn, const char *prefix, lahar
     lahar_particle_block_bounds(pb, 3);
 }
 
+/* phase: water (default) | soil, and for soil the model: soil material it is made of. */
+static void read_block_phase(rmap *bm, lahar_particle_block *pb, const char *const *phases, const lahar_case *c)
+{
+    pb->phase = rmap_enum(bm, "phase", phases, 0, 0);
+    pb->material = -1;
+    if (bm->r->failed)
+        return;
+    if (pb->phase == 0) {
+        if (rmap_get(bm, "material"))
+            rmap_fail(bm, "material", "water blocks take sph.density and sph.viscosity; a material is for phase: soil "
+                      "(remove it, or add `phase: soil`)");
+        return;
+    }
+    const char *name = rmap_str(bm, "material", 1, NULL, "sand   (a materials: entry with model: soil)");
+    if (bm->r->failed)
+        return;
+    pb->material = lahar_case_find_material(c, name);
+    if (pb->material < 0)
+        rmap_fail(bm, "material", "unknown material '%s'; define it in materials: with model: soil", name);
+    else if (c->materials[pb->material].model != LAHAR_CONTACT_SOIL)
+        rmap_fail(bm, "material", "'%s' is a DEM material; a soil block needs a material with model: soil "
+                  "(young, poisson, friction_angle, cohesion, dilatancy)", name);
+    for (int j = 0; j < c->nblock - 1 && !bm->r->failed && pb->material >= 0; j++)
+        if (c->blocks[j].phase == 1 && c->blocks[j].material != pb->material)
+            rmap_fail(bm, "material", "'%s' differs from the soil of sph.blocks[%d] ('%s'); one soil material per "
+                      "case is implemented", name, j, c->materials[c->blocks[j].material].name);
+}
+
 static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
 {
-    static const char *const bkeys[] = {"name", "box", "polygon", "stl", "velocity", NULL};
+    static const char *const bkeys[] = {"name", "box", "polygon", "stl", "velocity", "phase", "material", NULL};
+    static const char *const phases[] = {"water", "soil", NULL};
     static const char *const boxkeys[] = {"lo", "hi", NULL};
     const int dim = r->dim;
     lahar_particle_block *pb = &c->blocks[i];
@@ -1288,6 +1385,7 @@ static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
         if (strcmp(c->blocks[j].name, pb->name) == 0)
             rmap_fail(&bm, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
     rmap_vec(&bm, "velocity", dim, pb->v, 0, "");
+    read_block_phase(&bm, pb, phases, c);
     yaml_node_t *bx = rmap_get(&bm, "box"), *pg = rmap_get(&bm, "polygon"), *st = rmap_get(&bm, "stl");
     if (r->failed)
         return;
@@ -1463,8 +1561,8 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
             }
         for (int j = 0; j < i; j++) {
             const lahar_particle_block *o = &c->blocks[j];
-            if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX)
-                continue;
+            if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX || b->phase != o->phase)
+                continue; /* water may fill the pores of a soil block (paper 000 section 2.3) */
             int overlap = 1;
             for (int a = 0; a < dim; a++)
                 overlap = overlap && b->lo[a] < o->hi[a] - 1e-9 * dx && o->lo[a] < b->hi[a] - 1e-9 * dx;
@@ -1664,9 +1762,12 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"fields", "forces", NULL};
     /* bit i = field_names[i], matching LAHAR_PFIELD_* in output.h */
-    static const char *const field_names[] = {"velocity", "density", "pressure", "phase", "id", NULL};
+    static const char *const field_names[] = {"velocity", "density", "pressure", "phase", "id", "stress", NULL};
     static const char *const forces_names[] = {"none", "all", NULL};
-    c->output_fields = 0x1f;
+    int has_soil = 0;
+    for (int b = 0; b < c->nblock; b++)
+        has_soil |= c->blocks[b].phase == 1;
+    c->output_fields = has_soil ? 0x3f : 0x1f; /* LAHAR_PFIELD_*: all, and stress when there is soil */
     c->output_forces = 1;
     if (!n)
         return;
@@ -1698,6 +1799,11 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
             const char *near = it->type == YAML_SCALAR_NODE ? closest_name(scalar(it), field_names) : NULL;
             rd_fail(r, it, key, "unknown field%s%s%s; fields are: %s", near ? "; did you mean '" : "",
                     near ? near : "", near ? "'?" : "", list);
+            return;
+        }
+        if (found == 5 && !has_soil) {
+            rd_fail(r, it, key, "stress is the effective stress of soil particles, but the case has no soil block "
+                    "(phase: soil); remove it");
             return;
         }
         c->output_fields |= 1u << found;

@@ -173,6 +173,12 @@ static int check_load_particles(const char *outdir, lahar_check_data *d, char *e
     p->vx = vel ? malloc(nm) : NULL, p->vy = vel ? malloc(nm) : NULL, p->vz = vel ? malloc(nm) : NULL;
     p->density = (p->fields & LAHAR_PFIELD_DENSITY) ? malloc(nm) : NULL;
     p->pressure = (p->fields & LAHAR_PFIELD_PRESSURE) ? malloc(nm) : NULL;
+    p->phase = (p->fields & LAHAR_PFIELD_PHASE) ? malloc((size_t)(p->nmax ? p->nmax : 1) * sizeof *p->phase) : NULL;
+    p->stress = (p->fields & LAHAR_PFIELD_STRESS) ? malloc(nm * 6) : NULL;
+    if (((p->fields & LAHAR_PFIELD_PHASE) && !p->phase) || ((p->fields & LAHAR_PFIELD_STRESS) && !p->stress)) {
+        snprintf(err, n, "out of memory for %" PRId64 " particles", p->nmax);
+        return -1;
+    }
     if (!p->x || !p->y || !p->z || (vel && (!p->vx || !p->vy || !p->vz)) ||
         ((p->fields & LAHAR_PFIELD_DENSITY) && !p->density) || ((p->fields & LAHAR_PFIELD_PRESSURE) && !p->pressure)) {
         snprintf(err, n, "out of memory for %" PRId64 " particles", p->nmax);
@@ -208,6 +214,14 @@ int lahar_check_particles_read(lahar_check_particles *p, int64_t k, char *err, s
             snprintf(err, n, "particles.h5: %s/%s missing or not %" PRId64 " values", name, col[i].name, p->n[k]);
             rc = -1;
         }
+    if (rc == 0 && p->phase && cnt > 0 && check_read(s, "phase", H5T_NATIVE_INT32, cnt, p->phase)) {
+        snprintf(err, n, "particles.h5: %s/phase missing or not %" PRId64 " values", name, p->n[k]);
+        rc = -1;
+    }
+    if (rc == 0 && p->stress && cnt > 0 && check_read(s, "stress", H5T_NATIVE_DOUBLE, cnt * 6, p->stress)) {
+        snprintf(err, n, "particles.h5: %s/stress missing or not %" PRId64 " x 6 values", name, p->n[k]);
+        rc = -1;
+    }
     H5Gclose(s);
     p->cur = rc ? -1 : k;
     p->cur_n = rc ? 0 : p->n[k];
@@ -299,7 +313,7 @@ static void check_particles_free(lahar_check_particles *p)
     if (p->file > 0)
         H5Fclose((hid_t)p->file);
     free(p->t), free(p->n), free(p->x), free(p->y), free(p->z), free(p->vx), free(p->vy), free(p->vz);
-    free(p->density), free(p->pressure);
+    free(p->density), free(p->pressure), free(p->phase), free(p->stress);
     free(p);
 }
 
@@ -723,6 +737,14 @@ static const lahar_check_reference check_references[] = {
      lahar_check_sinking_disc},
     {"dam_break", "collapsing water column: particle count conserved, no particle escapes, front monotonic",
      "escaped_particles", 0.0, lahar_check_dam_break},
+    {"soil_geostatic", "soil column at rest under gravity: sigma_v vs rho g z, sigma_h vs K0 sigma_v, no creep",
+     "sigma_v_rel_error", 0.05, lahar_check_soil_geostatic},
+    {"soil_slide", "soil block on a fixed floor under tilted gravity: sliding acceleration vs g (sin - mu_phi cos)",
+     "accel_rel_error", 0.05, lahar_check_soil_slide},
+    {"granular_collapse", "soil column collapsing from a wall onto a floor: run-out, deposit profile, settled at or "
+     "below the angle of repose", "escaped_particles", 0.0, lahar_check_granular_collapse},
+    {"darcy", "water driven through a soil: seepage velocity vs Darcy's k_h i", "darcy_velocity_rel_error", 0.05,
+     lahar_check_darcy},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

@@ -32,6 +32,8 @@ typedef struct {
     int64_t cur;               /* snapshot in the buffers (-1: none) */
     int64_t cur_n;
     double *x, *y, *z, *vx, *vy, *vz, *density, *pressure; /* [nmax]; NULL for fields not stored */
+    int32_t *phase;            /* [nmax]; NULL when not stored */
+    double *stress;            /* [nmax][6] soil stress (xx, xy, xz, yy, yz, zz); NULL when not stored */
     int64_t file;              /* hid_t of the open file */
 } lahar_check_particles;
 
@@ -125,6 +127,11 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
 int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+/* The soil references (common/check_soil.c; documented there and in cases/README.md). */
+int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 
 /* Dimensionless drag K = F/(mu U) of a square array of cylinders at solid fraction c (Sangani &
  * Acrivos 1982 Table 1, shared/reference/01: ln K interpolated linearly in c between tabulated

@@ -509,8 +509,19 @@ int lahar_link_wait(lahar_link *l, int sender, int type, int64_t step, int timeo
         }
         double now = lahar_now();
         if (link_check_lost(l, now)) {
-            rc = LAHAR_LINK_LOST;
-            break;
+            /* Before calling a peer lost, read what is already queued: when this process itself
+             * was descheduled (an overloaded machine), the peer's frames wait in the socket and
+             * would otherwise count as silence. */
+            link_pump(l, 0);
+            if (link_find(l, sender, type, step, out)) {
+                rc = LAHAR_LINK_OK;
+                break;
+            }
+            now = lahar_now();
+            if (link_check_lost(l, now)) {
+                rc = LAHAR_LINK_LOST;
+                break;
+            }
         }
         if (now >= deadline) {
             rc = LAHAR_LINK_TIMEOUT;

@@ -722,7 +722,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     }
     o->xml = xml;
     o->xmf.fd = -1;
-    o->fields = fields & LAHAR_PFIELD_ALL;
+    o->fields = fields & (LAHAR_PFIELD_ALL | LAHAR_PFIELD_STRESS);
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
     hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
@@ -737,7 +737,8 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
         rc = -1;
     else {
         rc |= out_attr_int64(h, "fields", o->fields);
-        rc |= out_attr_string(h, "field_bits", "1 velocity (vx,vy,vz), 2 density, 4 pressure, 8 phase, 16 id");
+        rc |= out_attr_string(h, "field_bits", "1 velocity (vx,vy,vz), 2 density, 4 pressure, 8 phase, 16 id, "
+                                               "32 stress (n x 6: xx, xy, xz, yy, yz, zz)");
         rc |= out_attr_double(h, "dx", c->sph_dx);
         rc |= out_attr_double(h, "rest_density", c->sph_density);
         H5Gclose(h);
@@ -759,6 +760,27 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
         return NULL;
     }
     return o;
+}
+
+/* The soil stress as one n x 6 dataset (rows xx, xy, xz, yy, yz, zz), interleaved from the SoA
+ * arrays of the view in a buffer that lives for this snapshot only. */
+static int out_particle_stress(hid_t g, const lahar_particles_view *p)
+{
+    hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
+    for (int a = 0; a < 6; a++)
+        if (!p->stress[a] && n > 0) {
+            fprintf(stderr, "lahar: particle snapshot: field stress selected but not given\n");
+            return -1;
+        }
+    double *buf = malloc((n > 0 ? n : 1) * 6 * sizeof *buf);
+    if (!buf)
+        return -1;
+    for (hsize_t i = 0; i < n; i++)
+        for (int a = 0; a < 6; a++)
+            buf[i * 6 + (hsize_t)a] = p->stress[a][i];
+    int rc = out_dataset(g, "stress", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, n, 6, buf);
+    free(buf);
+    return rc;
 }
 
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
@@ -817,6 +839,8 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
             }
             rc |= out_dataset(g, col[k].name, col[k].mt, col[k].ft, 1, n, 0, col[k].data);
         }
+        if (!rc && (o->fields & LAHAR_PFIELD_STRESS))
+            rc |= out_particle_stress(g, p);
         H5Gclose(g);
     }
     if (H5Fclose(f) < 0)

@@ -39,7 +39,9 @@ enum {
     LAHAR_PFIELD_PRESSURE = 1 << 2,
     LAHAR_PFIELD_PHASE = 1 << 3,    /* int32 */
     LAHAR_PFIELD_ID = 1 << 4,       /* int64 */
-    LAHAR_PFIELD_ALL = 0x1f
+    LAHAR_PFIELD_STRESS = 1 << 5,   /* soil effective stress, n x 6: xx, xy, xz, yy, yz, zz (Pa, tension
+                                       positive; 0 for water particles) */
+    LAHAR_PFIELD_ALL = 0x1f         /* every field of a water-only scene; soil scenes add STRESS */
 };
 
 /* One snapshot of particles as structure-of-arrays. Arrays for fields not selected at open may
@@ -51,6 +53,7 @@ typedef struct {
     const double *density, *pressure;
     const int32_t *phase;
     const int64_t *id;
+    const double *stress[6]; /* SoA xx, xy, xz, yy, yz, zz; NULL without soil (then not written) */
 } lahar_particles_view;
 
 typedef struct lahar_particle_output lahar_particle_output;

@@ -9,7 +9,7 @@
 #define LAHAR_NAME_MAX 64
 
 typedef enum { LAHAR_MOTION_FREE = 0, LAHAR_MOTION_FIXED = 1, LAHAR_MOTION_PRESCRIBED = 2 } lahar_motion;
-typedef enum { LAHAR_CONTACT_LINEAR = 0, LAHAR_CONTACT_HERTZ = 1 } lahar_contact_model;
+typedef enum { LAHAR_CONTACT_LINEAR = 0, LAHAR_CONTACT_HERTZ = 1, LAHAR_CONTACT_SOIL = 2 } lahar_contact_model;
 
 /* Contact properties of a material. A pair of materials combines them (see dem_node/README.md):
  * E* and R* as in Hertz theory, restitution and friction as the minimum of the two. */
@@ -21,8 +21,15 @@ typedef struct {
     double kn;          /* N/m (3D) or N/m per m (2D), linear model normal stiffness */
     double kt_ratio;    /* tangential/normal stiffness ratio, default 2/7 */
     double restitution; /* normal coefficient of restitution e in (0, 1] */
-    double friction;    /* Coulomb coefficient mu >= 0 */
-    lahar_contact_model model;
+    double friction;    /* Coulomb coefficient mu >= 0; soil: mu_phi against DEM surfaces (paper 000 eq. 24) */
+    lahar_contact_model model; /* LAHAR_CONTACT_SOIL: an SPH soil (model: soil), not a DEM contact law */
+    /* soil only (model: soil; sph_node/sph_soil.h): elastic-perfectly plastic Drucker-Prager matched
+     * to Mohr-Coulomb; young and poisson above are its elastic constants */
+    double friction_angle;  /* phi, radians (case: degrees) */
+    double cohesion;        /* c, Pa */
+    double dilatancy;       /* psi, radians (case: degrees) */
+    double permeability;    /* k_h, Darcy hydraulic conductivity, m/s (0: no seepage) */
+    double damping;         /* c_d, 1/s: velocity damping -c_d v of the soil (quasi-static start; 0 = off) */
 } lahar_material;
 
 /* A sphero-polyhedron: a convex (or, for fixed bodies, any) set of vertices, edges and faces
@@ -77,6 +84,8 @@ typedef struct {
     int ntri;             /* mesh triangles (vertex indices, outward orientation not required) */
     int (*tri)[3];
     char source[256];     /* mesh: the STL file as written in the case, for messages */
+    int phase;            /* 0 water (default), 1 soil (case: phase: soil) */
+    int material;         /* soil: index into lahar_case.materials (a model: soil material), else -1 */
 } lahar_particle_block;
 
 /* Weakly compressible SPH and the SPH-DEM coupling (section sph: of a case; every key is

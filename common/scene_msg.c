@@ -114,6 +114,11 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->restitution = a->restitution;
         b->friction = a->friction;
         b->model = (int8_t)a->model;
+        b->friction_angle = a->friction_angle;
+        b->cohesion = a->cohesion;
+        b->dilatancy = a->dilatancy;
+        b->permeability = a->permeability;
+        b->damping = a->damping;
     }
     for (int i = 0; i < c->nbody; i++) {
         const lahar_body *a = &c->bodies[i];
@@ -161,6 +166,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         memcpy(b->hi, a->hi, sizeof b->hi);
         memcpy(b->v, a->v, sizeof b->v);
         b->source = (char *)a->source;
+        b->phase = (int8_t)a->phase;
+        b->material = a->material;
         b->nvert = a->nvert;
         b->ntri = a->ntri;
         b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
@@ -244,6 +251,11 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         b->restitution = a->restitution;
         b->friction = a->friction;
         b->model = (lahar_contact_model)a->model;
+        b->friction_angle = a->friction_angle;
+        b->cohesion = a->cohesion;
+        b->dilatancy = a->dilatancy;
+        b->permeability = a->permeability;
+        b->damping = a->damping;
     }
     c->nbody = m->nbody;
     for (int i = 0; i < m->nbody; i++) {
@@ -310,6 +322,13 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         memcpy(b->hi, a->hi, sizeof b->hi);
         memcpy(b->v, a->v, sizeof b->v);
         snprintf(b->source, sizeof b->source, "%s", a->source ? a->source : "");
+        if (a->phase < 0 || a->phase > 1 || (a->phase == 1 && (a->material < 0 || a->material >= m->nmaterial))) {
+            snprintf(err, errlen, "malformed scene message (particle block %d: phase/material)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        b->phase = a->phase;
+        b->material = a->material;
         if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
             goto oom;
         b->nvert = a->nvert;

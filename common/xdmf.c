@@ -192,6 +192,14 @@ size_t lahar_xdmf_particles_grid(char *buf, size_t cap, const lahar_xdmf_particl
                              p->h5name, path);
         XAPPEND("     </Attribute>\n");
     }
+    if (p->fields & LAHAR_PFIELD_STRESS) { /* soil effective stress, n x 6 (xx, xy, xz, yy, yz, zz) */
+        char dims6[40];
+        snprintf(dims6, sizeof dims6, "%" PRId64 " 6", n);
+        XAPPEND("     <Attribute Name=\"stress\" AttributeType=\"Tensor6\" Center=\"Node\">\n");
+        snprintf(path, sizeof path, "/snapshots/%06" PRId64 "/stress", snap);
+        pos += xdmf_dataitem(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0, dims6, "Float", 8, p->h5name, path);
+        XAPPEND("     </Attribute>\n");
+    }
     XAPPEND("    </Grid>\n");
     return pos;
 }

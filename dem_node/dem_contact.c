@@ -8,6 +8,12 @@ static double harmonic_mean(double a, double b) { return (a > 0.0 && b > 0.0) ? 
 int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair_law *out,
                       char *err, size_t errlen)
 {
+    if (a->model == LAHAR_CONTACT_SOIL || b->model == LAHAR_CONTACT_SOIL) {
+        /* an SPH soil (sph_node/sph_soil.h): no body is made of it (the case loader refuses one),
+         * so this pair never meets; an inert law keeps the table complete */
+        *out = (dem_pair_law){.model = LAHAR_CONTACT_LINEAR};
+        return 0;
+    }
     /* Hertz when either material asks for it. A material without E (a linear one, as the case
      * loader fills it) counts as rigid in 1/E*; a linear pair uses the kn of the side that has one
      * when the other has none. So rocks with Hertz can meet walls with the linear law. */

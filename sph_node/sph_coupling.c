@@ -133,7 +133,48 @@ void sph_coupling_free(sph_coupling *c)
     free(c->slot_body);
     free(c->slot);
     free(c->contacts);
+    free(c->soil_hist_body);
+    free(c->soil_hist_d);
     memset(c, 0, sizeof *c);
+}
+
+int sph_coupling_enable_soil(sph_coupling *c, double mu_phi)
+{
+    const size_t n = (size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE;
+    free(c->soil_hist_body);
+    free(c->soil_hist_d);
+    c->soil_hist_body = malloc(n * sizeof *c->soil_hist_body);
+    c->soil_hist_d = calloc(n, sizeof *c->soil_hist_d);
+    if (!c->soil_hist_body || !c->soil_hist_d) {
+        free(c->soil_hist_body), free(c->soil_hist_d);
+        c->soil_hist_body = NULL, c->soil_hist_d = NULL;
+        return -1;
+    }
+    for (size_t k = 0; k < n; k++)
+        c->soil_hist_body[k] = -1;
+    c->mu_phi = mu_phi;
+    return 0;
+}
+
+/* The tangential spring of soil particle `id` on body b (sph_coupling.h, eq. 22-25): from its
+ * last value (0 for a new pair) to this step's, capped; returns the tangential force on the
+ * particle, -K_n delta_tau*, and the new spring in d_out. */
+static vec3 coupling_soil_tangential(const sph_coupling *c, int64_t id, int b, vec3 n, vec3 urel, double fn, double kn,
+                                     double dt, double d_out[3])
+{
+    vec3 d = v3(0, 0, 0);
+    const int64_t base = id * SPH_COUPLING_MAX_PER_PARTICLE;
+    for (int s = 0; s < SPH_COUPLING_MAX_PER_PARTICLE; s++)
+        if (c->soil_hist_body[base + s] == b)
+            d = v3_load(c->soil_hist_d[base + s]);
+    d = v3_sub(d, v3_scale(n, v3_dot(d, n)));          /* onto the current tangent plane */
+    vec3 ut = v3_sub(urel, v3_scale(n, v3_dot(urel, n))); /* eq. 22 */
+    d = v3_axpy(dt, ut, d);                             /* eq. 23 */
+    double len = v3_norm(d), lim = c->mu_phi * fn / kn;
+    if (len > lim)                                      /* eq. 24: slip */
+        d = len > 0.0 ? v3_scale(d, lim / len) : v3(0, 0, 0);
+    v3_store(d, d_out);
+    return v3_scale(d, -kn);                            /* eq. 25 */
 }
 
 /* 1 when p lies inside the closed core: a convex polyhedron (all face planes) in 3D, a closed
@@ -183,6 +224,10 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         int ns = 0;
         vec3 xi = v3(p->x[i], p->y[i], p->z[i]);
         vec3 ftot = v3(0, 0, 0);
+        /* soil-DEM springs of this evaluation (sph_coupling_enable_soil) */
+        const int soil = p->phase[i] != 0 && c->soil_hist_body;
+        int nh = 0, hist_b[SPH_COUPLING_MAX_PER_PARTICLE];
+        double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
         for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
             const lahar_body *body = &c->bodies[b];
             const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
@@ -236,7 +281,12 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             else /* eq. 17 as printed */
                 coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
                        kernel_dwdr(&c->k, dv) / w0;
-            vec3 ft = v3_scale(urel, p->m[i] * coef); /* m_i a_tau (eq. 19) */
+            /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
+            vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
+            if (soil && delta > 0.0) {
+                ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, kn * delta, kn, dt, hist_d[nh]);
+                hist_b[nh++] = b;
+            }
             vec3 f = v3_add(fn, ft);
             ftot = v3_add(ftot, f);
             int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;
@@ -249,6 +299,14 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             ns++;
         }
         c->slot_n[i] = ns;
+        if (soil) { /* the springs of the pairs in contact now; the others are released */
+            const int64_t base = p->id[i] * SPH_COUPLING_MAX_PER_PARTICLE;
+            for (int s = 0; s < SPH_COUPLING_MAX_PER_PARTICLE; s++) {
+                c->soil_hist_body[base + s] = s < nh ? hist_b[s] : -1;
+                if (s < nh)
+                    memcpy(c->soil_hist_d[base + s], hist_d[s], sizeof hist_d[s]);
+            }
+        }
         double inv_m = 1.0 / p->m[i];
         p->ax[i] += ftot.x * inv_m;
         p->ay[i] += ftot.y * inv_m;

@@ -83,6 +83,11 @@ typedef struct {
     int cross_body;            /* first crossing (lowest particle index): body, particle id, depth */
     int64_t cross_particle_id;
     double cross_depth;        /* how far inside the swept surface (m, > 0) */
+    /* soil-DEM friction (sph_coupling_enable_soil; NULL/0 without soil): per particle id, up to
+     * SPH_COUPLING_MAX_PER_PARTICLE (body, delta_tau) pairs of the last evaluation */
+    double mu_phi;
+    int *soil_hist_body;       /* -1: empty slot */
+    double (*soil_hist_d)[3];
 } sph_coupling;
 
 /* Shapes with more features than this get a feature grid (geom_point_body_core_near). */
@@ -101,6 +106,21 @@ void sph_coupling_free(sph_coupling *c);
  * contact list and the crossing count. Returns the number of crossings, or -1 when the contact
  * list cannot grow (out of memory). */
 int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt);
+
+/* Soil-DEM friction (paper 000 section 4.2, eq. 22-27) for the soil particles (phase != 0): instead
+ * of the water's viscous term, a tangential spring with a history per (particle, body) pair, kept
+ * by particle id (so it survives the sort):
+ *   u_tau = u_rel - (u_rel . n) n                                        (eq. 22)
+ *   delta_tau = P_n(delta_tau) + dt u_tau                                (eq. 23; the old spring is
+ *               projected onto the current tangent plane, P_n = I - n n^T, as the contact turns)
+ *   delta_tau* = mu_phi |F_n| / K_n  delta_tau / |delta_tau|  when longer (eq. 24; stick below)
+ *   F on the particle = F_n - K_n delta_tau*                             (eq. 25)
+ *   F on the body = -F (eq. 26) at x_s, torque (x_s - x_dem) x (-F)     (eq. 27 as r x F)
+ * A pair exists while the particle is inside the halo (delta > 0, F_n > 0); when it leaves, the
+ * spring is released. The spring is advanced once per evaluation (sph_coupling_apply), i.e. once
+ * per step; the extra evaluations at t_0 add dt u_tau of the initial state. Allocates the
+ * history for the particle cap of the coupling. Returns 0 or -1 (out of memory). */
+int sph_coupling_enable_soil(sph_coupling *c, double mu_phi);
 
 /* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d);

@@ -58,6 +58,16 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         for (int a = 0; a < 6; a++)
             f->sps_tau[a] = buf + (size_t)f->p.cap * (size_t)(a + 1);
     }
+    if (p->soil) { /* stress arrays only when the scene has soil */
+        if (sph_soil_init(&f->soil, &p->soil_mat, p->dim, &f->k, p->dx, &f->p) != 0) {
+            free(f->sps_nut);
+            sph_cells_free(&f->cells);
+            sph_particles_free(&f->p);
+            snprintf(err, (size_t)errlen, "out of memory for the soil stress of %lld particles", (long long)cap);
+            return -1;
+        }
+        f->has_soil = 1;
+    }
     return 0;
 }
 
@@ -74,6 +84,10 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
+    if (f->has_soil && sph_coupling_enable_soil(&f->cpl, f->prm.soil_mat.mu_phi) != 0) { /* 000 section 4.2 */
+        sph_coupling_free(&f->cpl);
+        return -1;
+    }
     f->has_bodies = 1;
     f->primed = 0;
     return 0;
@@ -84,6 +98,8 @@ void sph_fluid_free(sph_fluid *f)
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
     free(f->sps_nut);
+    if (f->has_soil)
+        sph_soil_free(&f->soil);
     sph_cells_free(&f->cells);
     sph_particles_free(&f->p);
     memset(f, 0, sizeof *f);
@@ -98,8 +114,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
 
 /* Sums over the neighbours of particle i (gather). `kind` is a compile-time constant at each call
  * site of the switch in fluid_pass, so the kernel evaluation inlines without a branch per pair. */
-static inline int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, int64_t i,
-                                     double out[4])
+static inline int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind, const int sps, const int soil,
+                                     int64_t i, double out[4])
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
@@ -124,6 +140,8 @@ static inline int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind,
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
     int64_t nnb = 0; /* neighbours summed over (work counter) */
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        if (soil && p->phase[j] != 0) /* soil neighbours: sph_soil.h (fluid-soil: paper 000 section 2.3) */
+            continue;
         nnb++;
         double r = sqrt(r2);
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0; /* W'/r */
@@ -216,18 +234,27 @@ static void fluid_pass(sph_fluid *f)
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
     const int sps = f->prm.sps != 0;
+    const int soil = f->has_soil;
     int64_t neighbours = 0;
 #pragma omp parallel for schedule(static) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
-        /* kind and sps constant per call site: the pair loop inlines without their branches */
-        switch (kind * 2 + sps) {
-        case KERNEL_QUINTIC * 2: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, i, out); break;
-        case KERNEL_QUINTIC * 2 + 1: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, i, out); break;
-        case KERNEL_WENDLAND2 * 2: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, i, out); break;
-        case KERNEL_WENDLAND2 * 2 + 1: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, i, out); break;
-        case KERNEL_CUBIC * 2 + 1: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, i, out); break;
-        default: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, i, out); break;
+        if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
+            continue;
+        /* kind, sps and soil constant per call site: the pair loop inlines without their branches */
+        switch ((kind * 2 + sps) * 2 + soil) {
+        case KERNEL_QUINTIC * 4: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, 0, i, out); break;
+        case KERNEL_QUINTIC * 4 + 1: neighbours += fluid_particle(f, KERNEL_QUINTIC, 0, 1, i, out); break;
+        case KERNEL_QUINTIC * 4 + 2: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, 0, i, out); break;
+        case KERNEL_QUINTIC * 4 + 3: neighbours += fluid_particle(f, KERNEL_QUINTIC, 1, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 4: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 1: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 0, 1, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 2: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, 0, i, out); break;
+        case KERNEL_WENDLAND2 * 4 + 3: neighbours += fluid_particle(f, KERNEL_WENDLAND2, 1, 1, i, out); break;
+        case KERNEL_CUBIC * 4 + 1: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, 1, i, out); break;
+        case KERNEL_CUBIC * 4 + 2: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, 0, i, out); break;
+        case KERNEL_CUBIC * 4 + 3: neighbours += fluid_particle(f, KERNEL_CUBIC, 1, 1, i, out); break;
+        default: neighbours += fluid_particle(f, KERNEL_CUBIC, 0, 0, i, out); break;
         }
         p->drho[i] = out[0];
         p->ax[i] = out[1];
@@ -272,7 +299,32 @@ static void fluid_rates_particles(sph_fluid *f)
         p->p[i] = sph_fluid_pressure(&prm, p->rho[i]);
     if (prm.sps)
         fluid_sps_pass(f);
+    if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
+        sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k);
     fluid_pass(f);
+    if (f->has_soil) {
+        int64_t soil_water = 0;
+        f->work_neighbours_soil += sph_soil_momentum(&f->soil, p, &f->cells, &f->k, &soil_water);
+        /* 000 eq. 8, when k_h > 0 */
+        f->work_neighbours_fluid_soil += soil_water + sph_soil_water_seepage(&f->soil, p, &f->cells, &f->k);
+    }
+}
+
+/* The soil stress in the leapfrog (sph_soil.h): begin = the half kick and the prediction, else the
+ * final half kick. */
+static void fluid_soil_kick(sph_fluid *f, double hdt, int begin)
+{
+    sph_particles *p = &f->p;
+    const int64_t n = p->n;
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
+    for (int64_t i = 0; i < n; i++) {
+        if (p->phase[i] != SPH_SOIL_PHASE)
+            continue;
+        if (begin)
+            sph_soil_kick_begin(&f->soil, p, i, hdt);
+        else
+            sph_soil_kick_end(&f->soil, p, i, hdt);
+    }
 }
 
 /* The coupling with the bodies at `states`, and vmax/amax: the rest of the rates. */
@@ -338,6 +390,8 @@ int sph_fluid_step_begin(sph_fluid *f, double dt)
         p->vz[i] = d3 ? p->vhz[i] + hdt * p->az[i] : 0.0;
         p->rho[i] = p->rhoh[i] + hdt * p->drho[i];
     }
+    if (f->has_soil)
+        fluid_soil_kick(f, hdt, 1);
     if (sph_cells_sort(&f->cells, p) != 0)
         return -1;
     fluid_rates_particles(f);
@@ -365,6 +419,8 @@ int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *stat
         p->vz[i] = d3 ? p->vhz[i] + hdt * p->az[i] : 0.0;
         p->rho[i] = p->rhoh[i] + hdt * p->drho[i];
     }
+    if (f->has_soil)
+        fluid_soil_kick(f, hdt, 0);
     f->t += dt;
     f->step++;
     if (f->prm.shepard_every > 0 && f->step % f->prm.shepard_every == 0)
@@ -391,6 +447,10 @@ double sph_fluid_dt(const sph_fluid *f)
     const sph_params *prm = &f->prm;
     double h = f->k.h;
     double dt = prm->cfl * h / (prm->c0 + f->vmax);
+    if (f->has_soil) /* the soil's P-wave speed (sph_soil.h) */
+        dt = fmin(dt, prm->cfl * h / (f->soil.cs + f->vmax));
+    if (f->has_soil && f->soil.seep > 0.0) /* the seepage drag rate g / k_h (sph_soil.h) */
+        dt = fmin(dt, 0.25 * f->soil.mat.kh / f->soil.mat.g_ref);
     if (f->amax > 0.0)
         dt = fmin(dt, prm->cfl_force * sqrt(h / f->amax));
     if (f->nut_max > 0.0) /* SPS: the eddy viscosity adds to the laminar one */

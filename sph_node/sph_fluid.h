@@ -45,6 +45,7 @@
 #include "scene.h"
 #include "sph_coupling.h"
 #include "sph_particles.h"
+#include "sph_soil.h"
 
 typedef enum { SPH_EOS_LINEAR = 0, SPH_EOS_TAIT = 1 } sph_eos;
 
@@ -68,6 +69,8 @@ typedef struct {
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
+    int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
+    sph_soil_material soil_mat;
 } sph_params;
 
 typedef struct {
@@ -89,13 +92,19 @@ typedef struct {
     double *sps_nut;
     double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
     double *sps_tau[6];
+    /* soil (prm.soil only; sph_soil.h): its passes run after the water pass, which then skips soil
+     * particles and soil neighbours; sigma is integrated in the same leapfrog as v and rho */
+    int has_soil;
+    sph_soil soil;
     /* Work counters (cumulative since init; read by the SPH node for its STATUS work fields):
      * particle-particle passes, and the neighbours (i, j), j != i, within the kernel support that
      * the water pass summed over, counted once per particle i (each pair twice in gather form).
      * The count is a register increment in the pair loop summed by the pass's reduction: integer,
-     * so the same for any thread count. A soil pass adds its own counts next to these. */
+     * so the same for any thread count. The soil passes count theirs the same way. */
     int64_t work_passes;
     int64_t work_neighbours_fluid;
+    int64_t work_neighbours_soil;       /* soil pass: soil neighbours of soil particles */
+    int64_t work_neighbours_fluid_soil; /* seepage: water neighbours of soil + soil neighbours of water */
 } sph_fluid;
 
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the
@@ -148,7 +157,8 @@ int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *stat
 /* Apply the Shepard density filter now (particles sorted, cells valid). */
 void sph_fluid_shepard(sph_fluid *f);
 
-/* The step this state allows (see above). Call after a step (or sph_fluid_rates). */
+/* The step this state allows (see above; with soil also C_cfl h / (c_s + |v|max), sph_soil.h).
+ * Call after a step (or sph_fluid_rates). */
 double sph_fluid_dt(const sph_fluid *f);
 
 #endif

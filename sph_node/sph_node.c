@@ -94,15 +94,20 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         free(rho);
         return -1;
     }
-    const double m = c->sph_density * pow(c->sph_dx, c->dim);
     int rc = 0;
     for (int b = 0; b < c->nblock && !rc; b++) {
         int64_t n = lahar_case_block_lattice(c, b, pts, most);
         rc = n < 0 ? -1 : 0;
-        if (n > 0)
+        /* soil blocks (sph_soil.h): at the rest density of their material, stress-free */
+        const int soil = c->blocks[b].phase == SPH_SOIL_PHASE;
+        const double rho_b = soil ? c->materials[c->blocks[b].material].density : c->sph_density;
+        const double m = rho_b * pow(c->sph_dx, c->dim);
+        if (n > 0 && !soil)
             sph_node_block_density(c, (const double(*)[3])pts, n, rho);
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, rho[i], 0) < 0 ? -1 : 0;
+            rc = sph_particles_add(p, pts[i], c->blocks[b].v, m, soil ? rho_b : rho[i], soil ? SPH_SOIL_PHASE : 0) < 0
+                     ? -1
+                     : 0;
     }
     free(pts);
     free(rho);
@@ -161,6 +166,19 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->shepard_every = o->shepard_interval;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
+    for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */
+        if (c->blocks[b].phase == SPH_SOIL_PHASE && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial) {
+            const lahar_material *mt = &c->materials[c->blocks[b].material];
+            prm->soil = 1;
+            prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
+                                                .phi = mt->friction_angle, .cohesion = mt->cohesion,
+                                                .psi = mt->dilatancy, .kh = mt->permeability, .mu_phi = mt->friction,
+                                                .damping = mt->damping, .rho_water = c->sph_density,
+                                                .gravity = {c->gravity[0], c->gravity[1], c->gravity[2]},
+                                                .g_ref = v3_norm(v3_load(c->gravity)) > 0.0
+                                                             ? v3_norm(v3_load(c->gravity))
+                                                             : 9.81};
+        }
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {
         snprintf(err, errlen, "sph.halo: the coupling uses eps = dx/2 = %g m; another halo (%g m) is not implemented yet",
@@ -210,6 +228,8 @@ typedef struct {
     double kinetic_energy;       /* of the last snapshot (J, J/m in 2D) */
 } sph_node;
 
+static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t);
+
 /* A particle snapshot of the fields the case writes (output.fields), nothing else: unselected
  * fields are neither gathered nor computed. The pressure written is the EOS of the density
  * written (000 eq. 3 / 003 eq. 19), computed here only when the case writes pressure: the
@@ -228,16 +248,34 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
         .pressure = NULL,
         .phase = fields & LAHAR_PFIELD_PHASE ? p->phase : NULL,
         .id = fields & LAHAR_PFIELD_ID ? p->id : NULL,
+        .stress = {NULL, NULL, NULL, NULL, NULL, NULL}, /* soil only, below */
     };
     if ((fields & LAHAR_PFIELD_PRESSURE) && s->out_pressure) {
         const sph_params *prm = &s->f.prm;
-        for (int64_t i = 0; i < p->n; i++)
-            s->out_pressure[i] = sph_fluid_pressure(prm, p->rho[i]);
+        for (int64_t i = 0; i < p->n; i++) /* soil (sph_soil.h): the mean stress -tr(sigma)/3 */
+            s->out_pressure[i] = p->sig[0] && p->phase[i] == SPH_SOIL_PHASE
+                                     ? -(p->sig[0][i] + p->sig[3][i] + p->sig[5][i]) / 3.0
+                                     : sph_fluid_pressure(prm, p->rho[i]);
         s->work_output_derived += p->n;
         v.pressure = s->out_pressure;
     }
+    if ((fields & LAHAR_PFIELD_STRESS) && p->sig[0])
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            v.stress[a] = p->sig[a];
     s->last_snapshot = step;
-    return lahar_particle_output_snapshot(s->out, step, t, &v);
+    int rc = lahar_particle_output_snapshot(s->out, step, t, &v);
+    /* fixed bodies only: the body snapshot of the same step, as the DEM node would write it */
+    if (s->fixed_only && sph_node_fixed_snapshot(s, step, t) != 0)
+        rc = -1;
+    return rc;
+}
+
+/* Mark the last snapshot of the files this node writes (common/output.h). */
+static void sph_node_mark_last(const sph_node *s, const char *name, const char *text)
+{
+    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", name, text);
+    if (s->fixed_only)
+        lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", name, text);
 }
 
 static int sph_node_wait_stop(sph_node *s)
@@ -531,14 +569,15 @@ static double sph_node_kinetic_energy(const sph_particles *p)
 }
 
 /* The work counters of STATUS (cumulative since set-up; lcm_types/status_t.lcm). Pairs are the
- * solver's neighbour counts halved: the water pass visits each pair from both ends. No soil
- * phase yet: its pair counts stay 0 until a soil pass counts them. */
+ * solver's neighbour counts halved: every pass visits each pair from both ends (soil-soil: the
+ * soil pass; fluid-soil: the soil pass's water neighbours and the seepage pass's soil ones, both
+ * only when the soil has k_h > 0, i.e. there is seepage work). */
 static void sph_node_work(const sph_node *s, lahar_status_t *st)
 {
     st->work_passes = s->f.work_passes;
     st->work_pairs_fluid = s->f.work_neighbours_fluid / 2;
-    st->work_pairs_soil = 0;
-    st->work_pairs_fluid_soil = 0;
+    st->work_pairs_soil = s->f.work_neighbours_soil / 2;
+    st->work_pairs_fluid_soil = s->f.work_neighbours_fluid_soil / 2;
     st->work_particle_body = s->work_particle_body;
     st->work_body_body = 0;
     st->work_output_derived = s->work_output_derived;
@@ -608,16 +647,20 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
 {
     const sph_particles *p = &s->f.p;
     const int64_t n = p->n;
-    const double rho0 = s->ns.scene.sph_density;
+    const double rho_water = s->ns.scene.sph_density;
+    /* rho0 of particle I: the water's; soil particles (sph_soil.h) have no EOS, so their density
+     * (from continuity, thinning where the soil spreads) cannot blow up a pressure: they are held
+     * to finite values only (an infinite band) */
+#define SPH_NODE_RHO0(I) (s->f.has_soil && p->phase[I] == SPH_SOIL_PHASE ? NAN : rho_water)
     const double *band = s->ns.scene.stability.density_band;
-    const double lo = band[0] * rho0, hi = band[1] * rho0;
     int64_t bad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : bad) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         /* a NaN or an infinity in any component makes the sum non-finite; a NaN density fails
          * the band test too */
-        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i];
-        bad += !(isfinite(sum) && p->rho[i] >= lo && p->rho[i] <= hi);
+        double sum = p->x[i] + p->y[i] + p->z[i] + p->vx[i] + p->vy[i] + p->vz[i], rho0 = SPH_NODE_RHO0(i);
+        bad += !(isfinite(sum) && isfinite(p->rho[i]) &&
+                 (isnan(rho0) || (p->rho[i] >= band[0] * rho0 && p->rho[i] <= band[1] * rho0)));
     }
     if (bad == 0)
         return 0;
@@ -628,8 +671,9 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
         if (!isfinite(sum) || !isfinite(p->rho[i])) {
             if (worst_nf < 0 || p->id[i] < p->id[worst_nf])
                 worst_nf = i;
-        } else if (!(p->rho[i] >= lo && p->rho[i] <= hi)) {
-            double dev = fabs(log(p->rho[i] / rho0));
+        } else if (!isnan(SPH_NODE_RHO0(i)) &&
+                   !(p->rho[i] >= band[0] * SPH_NODE_RHO0(i) && p->rho[i] <= band[1] * SPH_NODE_RHO0(i))) {
+            double dev = fabs(log(p->rho[i] / SPH_NODE_RHO0(i)));
             if (dev > dev_max || (dev == dev_max && p->id[i] < p->id[worst])) {
                 dev_max = dev;
                 worst = i;
@@ -643,7 +687,8 @@ static int64_t sph_node_check_particles(const sph_node *s, int64_t k, double t, 
     u->x[0] = p->x[i], u->x[1] = p->y[i], u->x[2] = p->z[i];
     u->step = k;
     u->t = t;
-    const double r = p->rho[i] / rho0;
+    const double r = p->rho[i] / SPH_NODE_RHO0(i);
+#undef SPH_NODE_RHO0
     if (worst_nf >= 0) {
         snprintf(u->what, sizeof u->what, "non-finite state");
         u->value = NAN;
@@ -677,14 +722,9 @@ static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int
     int reason = lahar_node_stop_reason(stop, why, sizeof why);
     if (reason <= 0 || s->f.begun)
         return;
-    if (s->last_snapshot != k) {
-        /* fixed bodies only: their snapshots go with the particles' (this node writes both) */
-        if (sph_node_snapshot(s, k, t) != 0 || (s->fixed_only && sph_node_fixed_snapshot(s, k, t) != 0))
-            return;
-    }
-    lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "stopped", why);
-    if (s->fixed_only)
-        lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", "stopped", why);
+    if (s->last_snapshot != k && sph_node_snapshot(s, k, t) != 0)
+        return;
+    sph_node_mark_last(s, "stopped", why);
 }
 
 static int sph_node_loop(sph_node *s)
@@ -777,21 +817,12 @@ static int sph_node_loop(sph_node *s)
          * or at t_k when the step was not taken (unless a snapshot of t_k exists) */
         if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
-            snprintf(err, sizeof err, "cannot write a particle snapshot in %s", s->ns.output_dir);
+            snprintf(err, sizeof err, "cannot write a snapshot in %s", s->ns.output_dir);
         } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
-        /* fixed bodies only: their snapshots, as the DEM node writes them (after each step) */
-        if (s->fixed_only && (step.write_output || st.error) && sph_node_fixed_snapshot(s, k + 1, step.t_next) != 0 &&
-            !st.error) {
-            st.error = 1;
-            snprintf(err, sizeof err, "cannot write a body snapshot in %s", s->ns.output_dir);
-        }
-        if (unstable && s->last_snapshot == k + 1) {
-            lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", "instability", u.text);
-            if (s->fixed_only)
-                lahar_output_mark_last_snapshot(s->ns.output_dir, "bodies.h5", "stopped", u.text);
-        }
+        if (unstable && s->last_snapshot == k + 1)
+            sph_node_mark_last(s, "instability", u.text);
         st.dt_proposed = sph_fluid_dt(&s->f);
         st.dt_stable = st.dt_proposed;
         st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
@@ -918,9 +949,9 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     }
     char desc[256];
     if (s.fluid_ready)
-        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s",
+        snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s%s",
                  (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody,
-                 s.f.prm.sps ? ", SPS turbulence" : "");
+                 s.f.prm.sps ? ", SPS turbulence" : "", s.f.has_soil ? ", Drucker-Prager soil" : "");
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;

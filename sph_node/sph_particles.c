@@ -37,8 +37,29 @@ int sph_particles_init(sph_particles *p, int64_t cap)
     return 0;
 }
 
+int sph_particles_alloc_stress(sph_particles *p)
+{
+    if (p->sig[0])
+        return 0;
+    int ok = 1;
+    for (int k = 0; k < SPH_NSTRESS; k++) {
+        ok &= (p->sig[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
+        ok &= (p->sigh[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
+    }
+    if (!ok) {
+        for (int k = 0; k < SPH_NSTRESS; k++) {
+            free(p->sig[k]), free(p->sigh[k]);
+            p->sig[k] = p->sigh[k] = NULL;
+        }
+        return -1;
+    }
+    return 0;
+}
+
 void sph_particles_free(sph_particles *p)
 {
+    for (int k = 0; k < SPH_NSTRESS; k++)
+        free(p->sig[k]), free(p->sigh[k]);
     double **a[SPH_NDOUBLE];
     particle_doubles(p, a);
     for (int k = 0; k < SPH_NDOUBLE; k++)
@@ -239,6 +260,9 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     particle_doubles(p, a);
     for (int k = 0; k < SPH_NDOUBLE; k++)
         gather_d(a[k], &p->scratch_d, c->perm, n);
+    if (p->sig[0]) /* soil stress, its half-step value and the soil-DEM contact memory */
+        for (int k = 0; k < SPH_NSTRESS; k++)
+            gather_d(&p->sig[k], &p->scratch_d, c->perm, n), gather_d(&p->sigh[k], &p->scratch_d, c->perm, n);
     for (int64_t k = 0; k < n; k++)
         p->scratch_i[k] = p->id[c->perm[k]];
     int64_t *ti = p->id;

@@ -15,6 +15,8 @@
 #define SPH_OMP_MIN_HEAVY 2048
 #define SPH_OMP_MIN_LIGHT 32768
 
+#define SPH_NSTRESS 6 /* symmetric tensor components xx, xy, xz, yy, yz, zz */
+
 typedef struct {
     int64_t n, cap;
     /* state */
@@ -23,8 +25,12 @@ typedef struct {
     double *ax, *ay, *az, *drho;
     /* half-step state of the integrator */
     double *vhx, *vhy, *vhz, *rhoh;
-    int32_t *phase; /* 0 = water */
+    int32_t *phase; /* 0 = water, 1 = soil (sph_soil.h) */
     int64_t *id;    /* stable across sorts */
+    /* soil only (NULL until sph_particles_alloc_stress; a water-only scene never allocates them):
+     * effective stress sigma (xx, xy, xz, yy, yz, zz; Pa, tension positive) and its half-step
+     * value of the integrator, permuted by the sort like every other particle array */
+    double *sig[SPH_NSTRESS], *sigh[SPH_NSTRESS];
     /* sort scratch */
     double *scratch_d;
     int64_t *scratch_i;
@@ -34,6 +40,9 @@ typedef struct {
 /* Allocate room for cap particles (n = 0). Returns 0 or -1 (out of memory; nothing allocated). */
 int sph_particles_init(sph_particles *p, int64_t cap);
 void sph_particles_free(sph_particles *p);
+/* Allocate the soil stress arrays (sig, sigh) for cap particles, zeroed; no-op when present.
+ * Returns 0 or -1 (out of memory; none allocated). */
+int sph_particles_alloc_stress(sph_particles *p);
 /* Append one particle at rest density rho with mass m; returns its index, or -1 when full. */
 int64_t sph_particles_add(sph_particles *p, const double x[3], const double v[3], double m, double rho,
                           int32_t phase);

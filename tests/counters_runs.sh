@@ -3,7 +3,7 @@
 # ("work", coordinator/README.md) against independent counts, through `lahar run --in-process`.
 #
 #   counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: water_only | fixed_bodies | output_fields | dem_contacts
+#   TEST: water_only | soil_water | fixed_bodies | processes | output_fields | dem_contacts
 #
 # water_only    a block of water without bodies, one step, 2D and 3D: no DEM node, no soil or
 #               seepage work (soil-soil and fluid-soil pairs 0), no particle-body or body-body
@@ -11,6 +11,8 @@
 #               than the kernel support (2 h) counted by brute force over the particle positions
 #               of the snapshots, summed over the particle-particle passes (the set-up pass at
 #               t_0 and the step's pass at t_1).
+# soil_water    a soil block with k_h > 0 beside a water block, one step: fluid-fluid, soil-soil
+#               and fluid-soil (seepage) pair counts each equal the brute-force count by phase.
 # fixed_bodies  water in a tank of fixed walls: no DEM node is started and no per-step body
 #               message is sent (no LOADS, BODY_STATE, and STATUS only from the SPH node); the
 #               particle-body count equals the particles within the support of each wall's
@@ -19,6 +21,9 @@
 #               the DEM node back): particles.h5 and contacts.h5 bitwise equal, the walls' force
 #               rows in forces.h5 equal to 1e-12 (the DEM node averages them over its
 #               substeps), the same body poses; the far body adds no particle-body work.
+# processes     the one-step tank run as processes (lahar's private network namespace): only
+#               lahar-sph joins (HELLO from the coordinator and the SPH node only), the particles
+#               are bitwise those of the in-process run.
 # output_fields the tank with output fields [velocity] and with every field: particles.h5
 #               holds only the fields asked for, no value is computed for output without
 #               pressure (output_derived 0) and one pressure per particle and snapshot with it;
@@ -132,6 +137,48 @@ for out, support in zip(sys.argv[1::2], map(float, sys.argv[2::2])):
           "body work 0" % (out, n, counts[0], counts[1], support, w["pairs_fluid_fluid"]))
 PY
     ;;
+soil_water)
+    # a soil block (k_h > 0: seepage) beside a water block, one step
+    cat > sw.yaml <<'YAML'
+dimensions: 2
+gravity: [0, -9.81]
+time: {end: 1e-6, dt_max: 1e-3, output_interval: 1e-6}
+materials:
+  sand: {model: soil, density: 2000, young: 1.0e6, poisson: 0.3, friction_angle: 30, cohesion: 0, permeability: 0.01}
+sph:
+  dx: 0.01
+  kernel: cubic
+  h_over_dx: 1.3
+  c0: 15
+  blocks:
+    - {name: soil, phase: soil, material: sand, box: {lo: [0, 0], hi: [0.1, 0.06]}}
+    - {name: water, box: {lo: [0.1, 0], hi: [0.2, 0.06]}}
+YAML
+    run sw.yaml sw
+    "$python" - sw 0.026 <<'PY' || fail "soil and water work"
+import json, sys
+import h5py, numpy as np
+out, support = sys.argv[1], float(sys.argv[2])
+s = json.load(open(out + "/summary.json"))
+w = s["work"]
+assert s["status"] == "finished" and s["steps"] == 1, (s["status"], s["steps"], s["message"])
+def pairs(x, ph):
+    d2 = ((x[:, None, :] - x[None, :, :]) ** 2).sum(axis=2)
+    iu = np.triu_indices(len(x), 1)
+    near = d2[iu] < support * support
+    a, b = ph[iu[0]], ph[iu[1]]
+    return (int((near & (a == 0) & (b == 0)).sum()), int((near & (a != 0) & (b != 0)).sum()),
+            int((near & (a != b)).sum()))
+with h5py.File(out + "/particles.h5", "r") as f:
+    c = [pairs(np.stack([np.asarray(g[a]) for a in "xy"], axis=1), np.asarray(g["phase"]))
+         for g in (f["snapshots"][k] for k in sorted(f["snapshots"]))]
+assert len(c) == 2 and w["sph_passes"] == 2, (len(c), w["sph_passes"])
+got = (w["pairs_fluid_fluid"], w["pairs_soil_soil"], w["pairs_fluid_soil"])
+expect = tuple(c[0][i] + c[1][i] for i in range(3))
+assert got == expect and min(expect) > 0, (got, expect)
+print("soil_water: fluid-fluid %d, soil-soil %d, fluid-soil %d pairs = brute force over both states" % got)
+PY
+    ;;
 fixed_bodies)
     write_tank one.yaml 1e-4 1e-4
     run one.yaml one
@@ -205,6 +252,27 @@ with h5py.File(a + "/bodies.h5", "r") as fa, h5py.File(b + "/bodies.h5", "r") as
             assert np.array_equal(x, y), (k, d, x, y)
 print("fixed_bodies: %d steps without a DEM node (0 LOADS) = with one (%d LOADS): particles.h5 and contacts.h5 "
       "bitwise, wall forces to 1e-12" % (sa["steps"], cb["LAHAR_LOADS"]["messages"]))
+PY
+    ;;
+processes)
+    # the same one-step tank as `lahar run` without --in-process: nodes as processes in lahar's
+    # own private network namespace; only lahar-sph is started
+    write_tank one.yaml 1e-4 1e-4
+    "$bin/lahar" run one.yaml -o proc -q --threads 1 || fail "lahar run (processes) failed"
+    run one.yaml ip
+    "$python" "$tools/h5_compare.py" --quiet ip/particles.h5 proc/particles.h5 || fail "processes and in-process differ"
+    "$python" - proc <<'PY' || fail "processes: a DEM node took part"
+import json, sys
+s = json.load(open(sys.argv[1] + "/summary.json"))
+w, ch = s["work"], s["work"]["channels"]
+assert s["status"] == "finished" and s["mode"] == "processes", (s["status"], s["mode"])
+assert list(s["nodes"]) == ["sph"] and not w["dem_node"], list(s["nodes"])
+# HELLO: the coordinator's announcement and the SPH node's answer, no DEM node's
+assert ch["LAHAR_HELLO"]["messages"] == 2, ch["LAHAR_HELLO"]
+assert ch["LAHAR_STATUS"]["messages"] == s["steps"] + 1, ch["LAHAR_STATUS"]
+assert ch["LAHAR_LOADS"]["messages"] == 0 and ch["LAHAR_BODY_STATE"]["messages"] == 0, ch
+print("processes: only lahar-sph joined (2 HELLO, %d STATUS for %d step), same particles as in-process"
+      % (ch["LAHAR_STATUS"]["messages"], s["steps"]))
 PY
     ;;
 output_fields)

@@ -1,0 +1,334 @@
+/* SPH soil: Drucker-Prager stress, its rates and the soil momentum (sph_soil.h). */
+#include "sph_soil.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* component index of the symmetric tensor (xx, xy, xz, yy, yz, zz) */
+static const int SYM[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+
+void sph_soil_constants(const sph_soil_material *m, double *G, double *K, double *cs, double *alpha_phi,
+                        double *kc, double *alpha_psi)
+{
+    *G = m->young / (2.0 * (1.0 + m->poisson));
+    *K = m->young / (3.0 * (1.0 - 2.0 * m->poisson));
+    *cs = sqrt((*K + 4.0 / 3.0 * *G) / m->density);
+    /* plane-strain match of Drucker-Prager to Mohr-Coulomb (Bui 2008 eq. 20; shared/papers/README.md) */
+    double tp = tan(m->phi), tpsi = tan(m->psi);
+    double d = sqrt(9.0 + 12.0 * tp * tp);
+    *alpha_phi = tp / d;
+    *kc = 3.0 * m->cohesion / d;
+    *alpha_psi = tpsi / sqrt(9.0 + 12.0 * tpsi * tpsi);
+}
+
+int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel *k, double dx, sph_particles *p)
+{
+    memset(s, 0, sizeof *s);
+    s->mat = *m;
+    s->dim = dim;
+    sph_soil_constants(m, &s->G, &s->K, &s->cs, &s->alpha_phi, &s->kc, &s->alpha_psi);
+    s->w_dx = kernel_w(k, dx);
+    s->seep = m->kh > 0.0 ? m->rho_water * m->g_ref / m->kh : 0.0;
+    s->cap = p->cap;
+    if (sph_particles_alloc_stress(p) != 0)
+        return -1;
+    int ok = 1;
+    for (int a = 0; a < SPH_NSTRESS; a++) {
+        ok &= (s->dsig[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
+        ok &= (s->rart[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
+    }
+    if (!ok) {
+        sph_soil_free(s);
+        return -1;
+    }
+    return 0;
+}
+
+void sph_soil_free(sph_soil *s)
+{
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        free(s->dsig[a]), free(s->rart[a]);
+    memset(s, 0, sizeof *s);
+}
+
+void sph_soil_return(const sph_soil *s, double sig[SPH_NSTRESS])
+{
+    const double ap = s->alpha_phi, kc = s->kc;
+    double i1 = sig[0] + sig[3] + sig[5];
+    /* tension cracking: move the stress along the hydrostatic axis to the apex I1 = k_c / alpha_phi */
+    if (ap > 0.0 && -ap * i1 + kc < 0.0) {
+        double shift = (i1 - kc / ap) / 3.0;
+        sig[0] -= shift, sig[3] -= shift, sig[5] -= shift;
+        i1 = sig[0] + sig[3] + sig[5];
+    }
+    /* return to the yield surface by scaling the deviatoric stress */
+    double m = i1 / 3.0;
+    double sxx = sig[0] - m, syy = sig[3] - m, szz = sig[5] - m;
+    double j2 = 0.5 * (sxx * sxx + syy * syy + szz * szz) + sig[1] * sig[1] + sig[2] * sig[2] + sig[4] * sig[4];
+    double rj2 = sqrt(j2), lim = -ap * i1 + kc;
+    if (rj2 > lim && rj2 > 0.0) {
+        double r = lim > 0.0 ? lim / rj2 : 0.0;
+        sig[0] = m + r * sxx, sig[3] = m + r * syy, sig[5] = m + r * szz;
+        sig[1] *= r, sig[2] *= r, sig[4] *= r;
+    }
+}
+
+/* Artificial stress of one particle (sph_soil.h): eigen-decomposition of the symmetric stress by
+ * cyclic Jacobi rotations (a fixed, small number of sweeps: deterministic), R'_aa from the tensile
+ * principal stresses, rotated back. out is R / rho^2 * (-eps) applied: the term added to the pair sum. */
+static void soil_artificial_stress(const double sig[SPH_NSTRESS], double rho, double out[SPH_NSTRESS])
+{
+    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            a[i][j] = sig[SYM[i][j]];
+    for (int sweep = 0; sweep < 8; sweep++) {
+        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if (off <= 1e-30 * diag || off == 0.0)
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0.0)
+                    continue;
+                double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                double t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; k++) { /* a = J^T a J, columns then rows */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    double r[3];
+    for (int k = 0; k < 3; k++)
+        r[k] = a[k][k] > 0.0 ? -SPH_SOIL_AS_EPS * a[k][k] / (rho * rho) : 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = i; j < 3; j++)
+            out[SYM[i][j]] = v[i][0] * r[0] * v[j][0] + v[i][1] * r[1] * v[j][1] + v[i][2] * r[2] * v[j][2];
+}
+
+static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int64_t i)
+{
+    const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
+    const kernel_kind kind = k->kind;
+    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
+    double L[3][3] = {{0.0}}; /* L[a][b] = d v_a / d x_b */
+    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        if (p->phase[j] != SPH_SOIL_PHASE)
+            continue;
+        double r = sqrt(r2);
+        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
+        double w = p->m[j] / p->rho[j] * fij;
+        double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
+        double xr[3] = {rx, ry, rz};
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                L[a][b] += w * dv[a] * xr[b];
+    });
+    double sig[3][3], eps[3][3], spin[3][3];
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            sig[a][b] = p->sig[SYM[a][b]][i];
+            eps[a][b] = 0.5 * (L[a][b] + L[b][a]);
+            spin[a][b] = 0.5 * (L[a][b] - L[b][a]);
+        }
+    const double G = s->G, K = s->K, ap = s->alpha_phi, aps = s->alpha_psi;
+    double tre = eps[0][0] + eps[1][1] + eps[2][2];
+    double i1 = sig[0][0] + sig[1][1] + sig[2][2], m = i1 / 3.0;
+    double dev[3][3], j2 = 0.0, sde = 0.0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            dev[a][b] = sig[a][b] - (a == b ? m : 0.0);
+            j2 += 0.5 * dev[a][b] * dev[a][b];
+            sde += dev[a][b] * eps[a][b];
+        }
+    double rj2 = sqrt(j2);
+    /* plastic multiplier (000 eq. 7) on the yield surface, when loading */
+    double lam = 0.0;
+    double lim = -ap * i1 + s->kc;
+    if (rj2 > 0.0 && rj2 >= lim * (1.0 - 1e-9)) {
+        lam = (3.0 * ap * K * tre + G / rj2 * sde) / (9.0 * ap * aps * K + G);
+        if (lam < 0.0)
+            lam = 0.0;
+    }
+    for (int a = 0; a < 3; a++)
+        for (int b = a; b < 3; b++) {
+            double jau = 0.0;
+            for (int g = 0; g < 3; g++)
+                jau += sig[a][g] * spin[b][g] + sig[g][b] * spin[a][g];
+            double el = 2.0 * G * (eps[a][b] - (a == b ? tre / 3.0 : 0.0)) + (a == b ? K * tre : 0.0);
+            double pl = lam > 0.0 ? lam * ((a == b ? 3.0 * K * aps : 0.0) + G / rj2 * dev[a][b]) : 0.0;
+            s->dsig[SYM[a][b]][i] = jau + el - pl; /* 000 eq. 6 */
+        }
+    double own[SPH_NSTRESS];
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        own[a] = p->sig[a][i];
+    double rart[SPH_NSTRESS];
+    soil_artificial_stress(own, p->rho[i], rart);
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        s->rart[a][i] = rart[a];
+    p->p[i] = -m;
+}
+
+void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+{
+    const int64_t n = p->n;
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++)
+        if (p->phase[i] == SPH_SOIL_PHASE)
+            soil_stress_particle(s, p, c, k, i);
+}
+
+/* Returns the soil neighbours summed over; *nwater the water neighbours (seepage only). */
+static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                                      int64_t i, int64_t *nwater)
+{
+    const double *g = s->mat.gravity;
+    const double h = k->h, inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
+    const kernel_kind kind = k->kind;
+    const double eta2 = 0.01 * h * h, cs = s->cs, inv_wdx = 1.0 / s->w_dx;
+    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
+    const double rhoi = p->rho[i], irhoi2 = 1.0 / (rhoi * rhoi);
+    double si[SPH_NSTRESS], ri[SPH_NSTRESS];
+    for (int a = 0; a < SPH_NSTRESS; a++) {
+        si[a] = p->sig[a][i] * irhoi2;
+        ri[a] = s->rart[a][i];
+    }
+    double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    const double seep = s->seep, wnorm = k->norm;
+    int64_t nsoil = 0, nw = 0; /* work counters */
+    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        if (p->phase[j] != SPH_SOIL_PHASE) {
+            if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
+                nw++;
+                double r = sqrt(r2), q = r * inv_h;
+                double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
+                double c1 = p->m[j] / (p->rho[j] * rhoi);
+                double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = -c1 * p->p[j] * fij;
+                ax += sw * (p->vx[j] - vxi) + pw * rx;
+                ay += sw * (p->vy[j] - vyi) + pw * ry;
+                az += sw * (p->vz[j] - vzi) + pw * rz;
+            }
+            continue;
+        }
+        nsoil++;
+        double r = sqrt(r2);
+        double q = r * inv_h;
+        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
+        double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
+        double rhoj = p->rho[j], mj = p->m[j], irhoj2 = 1.0 / (rhoj * rhoj);
+        double vdotr = vx * rx + vy * ry + vz * rz;
+        drho += rhoi * mj / rhoj * vdotr * fij; /* continuity without the delta term */
+        double pi_ij = 0.0;
+        if (vdotr < 0.0) { /* Monaghan 1992 */
+            double mu = h * vdotr / (r2 + eta2);
+            pi_ij = (-SPH_SOIL_AV_ALPHA * cs * mu + SPH_SOIL_AV_BETA * mu * mu) / (0.5 * (rhoi + rhoj));
+        }
+        double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
+        double t[SPH_NSTRESS];
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            t[a] = si[a] + p->sig[a][j] * irhoj2 + (ri[a] + s->rart[a][j]) * fn;
+        t[0] -= pi_ij, t[3] -= pi_ij, t[5] -= pi_ij;
+        double mf = mj * fij; /* grad_i W_ij = F_ij x_ij */
+        ax += mf * (t[0] * rx + t[1] * ry + t[2] * rz);
+        ay += mf * (t[1] * rx + t[3] * ry + t[4] * rz);
+        az += mf * (t[2] * rx + t[4] * ry + t[5] * rz);
+    });
+    p->drho[i] = drho;
+    const double cd = s->mat.damping;
+    p->ax[i] = ax + g[0] - cd * vxi;
+    p->ay[i] = ay + g[1] - cd * vyi;
+    p->az[i] = az + g[2] - cd * vzi;
+    *nwater = nw;
+    return nsoil;
+}
+
+int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                          int64_t *water_neighbours)
+{
+    const int64_t n = p->n;
+    int64_t nsoil = 0, nwater = 0; /* integer sums: exact in any order */
+#pragma omp parallel for schedule(static) reduction(+ : nsoil, nwater) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++)
+        if (p->phase[i] == SPH_SOIL_PHASE) {
+            int64_t nw = 0;
+            nsoil += soil_momentum_particle(s, p, c, k, i, &nw);
+            nwater += nw;
+        }
+    *water_neighbours = nwater;
+    return nsoil;
+}
+
+int64_t sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+{
+    const int64_t n = p->n;
+    const double seep = s->seep, inv_h = k->inv_h, dnorm = k->dnorm, wnorm = k->norm, s2 = k->support * k->support;
+    const kernel_kind kind = k->kind;
+    if (!(seep > 0.0))
+        return 0;
+    int64_t nsoil = 0; /* work counter: soil neighbours of the water particles */
+#pragma omp parallel for schedule(static) reduction(+ : nsoil) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        if (p->phase[i] == SPH_SOIL_PHASE)
+            continue;
+        const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i], rhoi = p->rho[i], pi_ = p->p[i];
+        double ax = 0.0, ay = 0.0, az = 0.0;
+        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
+            if (p->phase[j] != SPH_SOIL_PHASE)
+                continue;
+            nsoil++;
+            double r = sqrt(r2), q = r * inv_h;
+            double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0; /* grad_f W_fs = F x_fs */
+            double c1 = p->m[j] / (rhoi * p->rho[j]);
+            double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = c1 * pi_ * fij;
+            ax -= sw * (vxi - p->vx[j]) + pw * rx;
+            ay -= sw * (vyi - p->vy[j]) + pw * ry;
+            az -= sw * (vzi - p->vz[j]) + pw * rz;
+        });
+        p->ax[i] += ax;
+        p->ay[i] += ay;
+        p->az[i] += az;
+    }
+    return nsoil;
+}
+
+void sph_soil_kick_begin(const sph_soil *s, sph_particles *p, int64_t i, double hdt)
+{
+    double sig[SPH_NSTRESS];
+    for (int a = 0; a < SPH_NSTRESS; a++) {
+        p->sigh[a][i] = p->sig[a][i] + hdt * s->dsig[a][i];
+        sig[a] = p->sigh[a][i];
+    }
+    sph_soil_return(s, sig);
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        p->sigh[a][i] = sig[a];
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        sig[a] = p->sigh[a][i] + hdt * s->dsig[a][i];
+    sph_soil_return(s, sig);
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        p->sig[a][i] = sig[a];
+}
+
+void sph_soil_kick_end(const sph_soil *s, sph_particles *p, int64_t i, double hdt)
+{
+    double sig[SPH_NSTRESS];
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        sig[a] = p->sigh[a][i] + hdt * s->dsig[a][i];
+    sph_soil_return(s, sig);
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        p->sig[a][i] = sig[a];
+}

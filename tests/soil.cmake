@@ -1,0 +1,46 @@
+# Soil phase (issue 5, brief SOIL): the Drucker-Prager SPH soil of sph_node/sph_soil.[ch] against
+# closed forms (return mapping, elastic and Jaumann stress rates, equilibrium of a uniform
+# stress), and its cases end to end through `lahar check` at CI resolution (the cases' own bounds;
+# measured values in cases/README.md, "Soil").
+add_executable(test_sph_soil ${LAHAR_TEST_DIR}/test_sph_soil.c)
+target_link_libraries(test_sph_soil PRIVATE lahar_sph)
+add_test(NAME soil_sph_unit COMMAND test_sph_soil)
+set_tests_properties(soil_sph_unit PROPERTIES LABELS "fast;soil" TIMEOUT 120)
+
+if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
+  set(LAHAR_OUTPUT_PYTHON python3)
+endif()
+# Geostatic layer: sigma_v = rho g z and sigma_h = K0 sigma_v within 5 %, no creep (4 s wall).
+add_test(NAME soil_geostatic_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_geostatic_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/geostatic_2d)
+set_tests_properties(soil_geostatic_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Soil-DEM friction (paper 000 eq. 22-27): a soil block on a 30 deg plane with mu_phi = 0.3 slides
+# at g (sin - mu_phi cos) within 5 %; on a 15 deg plane with mu_phi = 0.5 it stays put (|a| within
+# 5 % of g sin theta), and moves less than 1 mm in 0.4 s.
+add_test(NAME soil_block_incline_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_block_incline_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/block_incline_2d)
+add_test(NAME soil_block_incline_stick_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar>
+          ${CMAKE_SOURCE_DIR}/cases/soil_block_incline_stick_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/soil/block_incline_stick_2d
+          displacement_m<=0.001 displacement_m>=-0.001)
+set_tests_properties(soil_block_incline_2d soil_block_incline_stick_2d PROPERTIES LABELS "validation;slow;soil"
+  TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Granular collapse (Bui 2008 aluminium bars, reference 04a) at dx = 10 mm: no particle through the
+# floor or the wall, settled, deposit at or below the angle of repose; the run-out is reported.
+add_test(NAME soil_granular_collapse_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_collapse_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_collapse_2d dx=0.01 runout_m>=0.25)
+set_tests_properties(soil_granular_collapse_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Darcy (paper 000 eq. 8-10): water driven through a soil at i = 0.5 flows at k_h i within 5 %.
+add_test(NAME soil_darcy_column_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/darcy_column_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/darcy_column_2d)
+set_tests_properties(soil_darcy_column_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

@@ -1,0 +1,243 @@
+/* SPH soil (sph_node/sph_soil.h) against closed forms:
+ *  1. return mapping (Bui 2008 section 3.3): a stress beyond the Drucker-Prager surface is scaled
+ *     back onto it (|f| < 1e-12 of the stress scale) with I1 and the direction of s kept; a
+ *     tensile stress of a cohesionless soil goes to zero; with cohesion to the apex
+ *     I1 = k_c / alpha_phi; a stress inside is left bitwise alone. The plane-strain constants
+ *     equal tan(phi)/sqrt(9 + 12 tan^2 phi) and 3c/sqrt(9 + 12 tan^2 phi) (30 deg: 0.160128, 0.832050 c).
+ *  2. elastic stress rate of a uniform velocity gradient (2D lattice, quintic kernel, interior
+ *     particle): dsigma = 2G e + K tr(eps) I, the plane-strain dsigma_zz = (K - 2G/3) tr(eps) too,
+ *     within 1 % of |dsigma| (the lattice gradient sum of the kernel, ~0.3 %);
+ *  3. Jaumann rate of a rigid rotation v = w x (-y, x) of a pre-stressed soil (sigma_xx = -s0):
+ *     dsigma = W sigma - sigma W, dsigma_xy = -s0 w, no elastic part, within 1 %;
+ *  4. a uniform stress exerts no force on an interior particle: |a - g| < 1e-9 s0/(rho dx);
+ *  5. a water-only fluid allocates no stress arrays;
+ *  6. seepage (000 eq. 8-10): water moving at u through a resting soil on the same periodic
+ *     lattice: the water's acceleration is -(g/k_h) u (sum_s V_s W = 1) within 1 %, and the
+ *     water-soil forces cancel pair by pair: |sum_i m_i (a_i - b_i)| < 1e-12 of sum_water m |a - b|. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "sph_fluid.h"
+
+#include "test_util.h"
+
+static const double DX = 0.01, RHO = 2000.0, PI = 3.14159265358979323846;
+
+static sph_soil_material sand(double phi_deg, double c)
+{
+    return (sph_soil_material){.density = RHO, .young = 1e6, .poisson = 0.3, .phi = phi_deg * PI / 180.0,
+                               .cohesion = c, .psi = 0.0, .mu_phi = 0.5, .gravity = {0.0, -9.81, 0.0}};
+}
+
+static double yield_f(const sph_soil *s, const double sig[6])
+{
+    double i1 = sig[0] + sig[3] + sig[5], m = i1 / 3.0;
+    double a = sig[0] - m, b = sig[3] - m, c = sig[5] - m;
+    double j2 = 0.5 * (a * a + b * b + c * c) + sig[1] * sig[1] + sig[2] * sig[2] + sig[4] * sig[4];
+    return s->alpha_phi * i1 + sqrt(j2) - s->kc;
+}
+
+static void test_return(void)
+{
+    sph_soil s;
+    memset(&s, 0, sizeof s);
+    s.mat = sand(30.0, 100.0);
+    sph_soil_constants(&s.mat, &s.G, &s.K, &s.cs, &s.alpha_phi, &s.kc, &s.alpha_psi);
+    CHECK(fabs(s.alpha_phi - 0.1601281538) < 1e-9 && fabs(s.kc - 83.20502943) < 1e-6,
+          "plane-strain constants alpha_phi %.10f k_c %.8f", s.alpha_phi, s.kc);
+    double sig[6] = {-1000.0, 600.0, 0.0, -1000.0, 0.0, -1000.0}; /* sqrt(J2) = 600 > 0.16 * 3000 + 83 */
+    double before[6];
+    memcpy(before, sig, sizeof sig);
+    CHECK(yield_f(&s, sig) > 0.0, "start outside the surface");
+    sph_soil_return(&s, sig);
+    CHECK(fabs(yield_f(&s, sig)) < 1e-12 * 1000.0, "on the surface after the return: f = %g", yield_f(&s, sig));
+    CHECK(fabs(sig[0] + sig[3] + sig[5] + 3000.0) < 1e-9, "I1 kept");
+    CHECK(sig[1] > 0.0 && fabs(sig[0] - sig[3]) < 1e-9 && sig[2] == 0.0 && sig[4] == 0.0, "direction of s kept");
+    double inside[6] = {-1000.0, 100.0, 0.0, -900.0, 0.0, -950.0}, keep[6];
+    memcpy(keep, inside, sizeof keep);
+    sph_soil_return(&s, inside);
+    CHECK(memcmp(inside, keep, sizeof keep) == 0, "a stress inside the surface is left alone");
+    /* tension: to the apex */
+    double ten[6] = {500.0, 50.0, 0.0, 200.0, 0.0, 100.0};
+    sph_soil_return(&s, ten);
+    double apex = s.kc / s.alpha_phi;
+    CHECK(fabs(ten[0] + ten[3] + ten[5] - apex) < 1e-9 * apex && fabs(yield_f(&s, ten)) < 1e-9 * apex,
+          "tension with cohesion goes to the apex I1 = %g (got I1 %g, f %g)", apex, ten[0] + ten[3] + ten[5],
+          yield_f(&s, ten));
+    s.mat = sand(30.0, 0.0);
+    sph_soil_constants(&s.mat, &s.G, &s.K, &s.cs, &s.alpha_phi, &s.kc, &s.alpha_psi);
+    double ten0[6] = {500.0, 50.0, 0.0, 200.0, 0.0, 100.0};
+    sph_soil_return(&s, ten0);
+    double mx = 0.0;
+    for (int a = 0; a < 6; a++)
+        mx = fmax(mx, fabs(ten0[a]));
+    CHECK(mx < 1e-9, "tension of a cohesionless soil vanishes (max |sigma| %g)", mx);
+    (void)before;
+}
+
+/* A 2D soil lattice of n x n particles, velocity v(x) = L x about the centre, stress sig0 on every
+ * particle; rates evaluated; returns the index of the centre particle. */
+static int64_t soil_lattice(sph_fluid *f, int n, const double L[2][2], const double sig0[6])
+{
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.kernel = "quintic";
+    prm.h_over_dx = 1.0;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    prm.body_force[1] = -9.81;
+    prm.soil = 1;
+    prm.soil_mat = sand(30.0, 0.0);
+    char err[256];
+    if (sph_fluid_init(f, &prm, (int64_t)n * n, err, sizeof err) != 0) {
+        CHECK(0, "init: %s", err);
+        return -1;
+    }
+    double c = 0.5 * n * DX;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            double x[3] = {(i + 0.5) * DX, (j + 0.5) * DX, 0.0};
+            double rx = x[0] - c, ry = x[1] - c;
+            double v[3] = {L[0][0] * rx + L[0][1] * ry, L[1][0] * rx + L[1][1] * ry, 0.0};
+            sph_particles_add(&f->p, x, v, RHO * DX * DX, RHO, SPH_SOIL_PHASE);
+        }
+    int64_t centre_id = (int64_t)(n / 2) * n + n / 2;
+    sph_cells_sort(&f->cells, &f->p);
+    for (int64_t i = 0; i < f->p.n; i++)
+        for (int a = 0; a < 6; a++)
+            f->p.sig[a][i] = sig0[a];
+    sph_fluid_rates(f, NULL, 1e-5);
+    for (int64_t i = 0; i < f->p.n; i++)
+        if (f->p.id[i] == centre_id)
+            return i;
+    return -1;
+}
+
+static void test_elastic_rate(void)
+{
+    const double L[2][2] = {{1e-3, 4e-4}, {-2e-4, -3e-4}}, zero[6] = {0};
+    sph_fluid f;
+    int64_t i = soil_lattice(&f, 13, L, zero);
+    if (i < 0) {
+        sph_fluid_free(&f);
+        return;
+    }
+    const sph_soil *s = &f.soil;
+    double exx = L[0][0], eyy = L[1][1], exy = 0.5 * (L[0][1] + L[1][0]), tr = exx + eyy;
+    double ref[6] = {2 * s->G * (exx - tr / 3) + s->K * tr, 2 * s->G * exy, 0.0, 2 * s->G * (eyy - tr / 3) + s->K * tr,
+                     0.0, (s->K - 2.0 / 3.0 * s->G) * tr};
+    double scale = 0.0, err = 0.0;
+    for (int a = 0; a < 6; a++) {
+        scale = fmax(scale, fabs(ref[a]));
+        err = fmax(err, fabs(s->dsig[a][i] - ref[a]));
+    }
+    CHECK(err < 0.01 * scale, "elastic stress rate: max error %g of %g (xx %g vs %g, xy %g vs %g, zz %g vs %g)", err,
+          scale, s->dsig[0][i], ref[0], s->dsig[1][i], ref[1], s->dsig[5][i], ref[5]);
+    printf("elastic stress rate: max error %.3g %% of |dsigma|\n", 100.0 * err / scale);
+    sph_fluid_free(&f);
+}
+
+static void test_jaumann_and_uniform(void)
+{
+    const double w = 0.01, s0 = 1000.0;
+    const double L[2][2] = {{0.0, -w}, {w, 0.0}}; /* v = w (-y, x) */
+    const double sig0[6] = {-s0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    sph_fluid f;
+    int64_t i = soil_lattice(&f, 13, L, sig0);
+    if (i < 0) {
+        sph_fluid_free(&f);
+        return;
+    }
+    const sph_soil *s = &f.soil;
+    double ref_xy = -s0 * w;
+    CHECK(fabs(s->dsig[1][i] - ref_xy) < 0.01 * fabs(ref_xy) && fabs(s->dsig[0][i]) < 0.01 * fabs(ref_xy) &&
+              fabs(s->dsig[3][i]) < 0.01 * fabs(ref_xy),
+          "Jaumann rate of a rigid rotation: xy %g (ref %g), xx %g, yy %g", s->dsig[1][i], ref_xy, s->dsig[0][i],
+          s->dsig[3][i]);
+    printf("Jaumann: dsigma_xy %.6g vs %.6g\n", s->dsig[1][i], ref_xy);
+    /* 4. uniform stress: no net force on the interior particle (a rigid rotation adds no
+     * artificial viscosity: v_ij . x_ij = 0) */
+    double da = hypot(f.p.ax[i] - 0.0, f.p.ay[i] + 9.81);
+    CHECK(da < 1e-9 * s0 / (RHO * DX), "uniform stress: |a - g| = %g", da);
+    sph_fluid_free(&f);
+}
+
+static void test_water_only(void)
+{
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    sph_fluid f;
+    char err[256];
+    CHECK(sph_fluid_init(&f, &prm, 100, err, sizeof err) == 0, "init");
+    CHECK(f.p.sig[0] == NULL && !f.has_soil, "a water-only fluid has no stress arrays");
+    sph_fluid_free(&f);
+}
+
+static void test_seepage(void)
+{
+    const int n = 10;
+    const double kh = 0.01, g = 9.81, u = 2e-3;
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    prm.periodic[0] = prm.periodic[1] = 1;
+    prm.hi[0] = prm.hi[1] = n * DX;
+    prm.soil = 1;
+    prm.soil_mat = sand(30.0, 1e4);
+    prm.soil_mat.kh = kh;
+    prm.soil_mat.g_ref = g;
+    prm.soil_mat.rho_water = 1000.0;
+    prm.soil_mat.gravity[1] = 0.0;
+    sph_fluid f;
+    char err[256];
+    if (sph_fluid_init(&f, &prm, 2 * n * n, err, sizeof err) != 0) {
+        CHECK(0, "init: %s", err);
+        return;
+    }
+    for (int ph = 0; ph < 2; ph++)
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double x[3] = {(i + 0.5) * DX, (j + 0.5) * DX, 0.0}, v[3] = {ph == 0 ? u : 0.0, 0.0, 0.0};
+                double rho = ph == 0 ? 1000.0 : RHO;
+                sph_particles_add(&f.p, x, v, rho * DX * DX, rho, ph == 0 ? 0 : SPH_SOIL_PHASE);
+            }
+    sph_cells_sort(&f.cells, &f.p);
+    sph_fluid_rates(&f, NULL, 1e-5);
+    double ref = -g / kh * u, worst = 0.0, mom[2] = {0.0, 0.0}, scale = 0.0;
+    for (int64_t i = 0; i < f.p.n; i++) {
+        mom[0] += f.p.m[i] * f.p.ax[i];
+        mom[1] += f.p.m[i] * f.p.ay[i];
+        if (f.p.phase[i] == 0) {
+            worst = fmax(worst, fabs(f.p.ax[i] - ref) / fabs(ref));
+            scale += f.p.m[i] * fabs(f.p.ax[i]);
+        }
+    }
+    CHECK(worst < 0.01, "water seepage acceleration: worst relative error %g (reference %g m/s^2)", worst, ref);
+    CHECK(hypot(mom[0], mom[1]) < 1e-12 * scale, "water-soil forces cancel: |sum m a| = %g of %g",
+          hypot(mom[0], mom[1]), scale);
+    printf("seepage: water acceleration within %.3g %% of -(g/k_h) u; net force %.3g of %.3g\n", 100.0 * worst,
+           hypot(mom[0], mom[1]), scale);
+    sph_fluid_free(&f);
+}
+
+int main(void)
+{
+    test_return();
+    test_elastic_rate();
+    test_jaumann_and_uniform();
+    test_water_only();
+    test_seepage();
+    if (failures)
+        fprintf(stderr, "%d check(s) failed\n", failures);
+    return failures != 0;
+}
