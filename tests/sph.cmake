@@ -27,7 +27,7 @@ set_tests_properties(sph_hydrostatic PROPERTIES LABELS "fast;sph" TIMEOUT 120)
 
 add_executable(test_sph_hydrostatic3d ${LAHAR_TEST_DIR}/test_sph_hydrostatic3d.c)
 target_link_libraries(test_sph_hydrostatic3d PRIVATE lahar_sph)
-add_test(NAME sph_hydrostatic3d COMMAND test_sph_hydrostatic3d)
+add_test(NAME sph_hydrostatic3d COMMAND test_sph_hydrostatic3d 10 3 ghost)
 set_tests_properties(sph_hydrostatic3d PROPERTIES LABELS "slow;sph" TIMEOUT 600)
 
 add_executable(test_sph_couette ${LAHAR_TEST_DIR}/test_sph_couette.c)
