@@ -492,6 +492,10 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
  *                               load of the arriving front plus the whole mass's weight along the
  *                               chute (the static load of the deposit if the bed held none of it);
  *                               a missing or spiky wall force (no coupling, a blow-up) is far off
+ *   first_impact_outside_s      how far the first impact lies outside [t_ritter, t_block] (s): the
+ *                               frictionless dam-break front on the slope, s = 2 sqrt(g_n H) t + g_t
+ *                               t^2/2, arrives first; a rigid block sliding from rest with mu_phi,
+ *                               s = (g_t - mu_phi g_n) t^2/2, last (0)
  * Paper 000 Fig. 14-15 are images without numbers in the text (shared/papers/000): no published
  * peak force is compared; the peak, its time and the first impact are reported. */
 
@@ -730,8 +734,18 @@ int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, 
     lahar_check_value(r, "dx_m", dx);
     lahar_check_value(r, "wall_face_m", s_wall);
     lahar_check_value(r, "wall_top_m", h_top);
-    /* a rigid block sliding with mu_phi from rest: the time its front would need to reach the wall */
-    lahar_check_value(r, "sliding_block_arrival_s", a_block > 0.0 ? sqrt(2.0 * travel / a_block) : INFINITY);
+    /* bounds on the arrival of the front: no later than a rigid block sliding from rest with mu_phi
+     * (t_block; the flowing front runs ahead of the block it was), no earlier than the frictionless
+     * dam-break front on a slope, s = 2 sqrt(g_n H) t + g_t t^2 / 2 (Ritter's front speed 2 sqrt(g H)
+     * of a column of height H plus the free acceleration along the chute; the fastest a mass without
+     * any friction spreads) */
+    const double t_block = a_block > 0.0 ? sqrt(2.0 * travel / a_block) : INFINITY;
+    const double c_front = 2.0 * sqrt(-c->gravity[up] * (hi[up] + 0.5 * dx - bed));
+    const double t_ritter = (-c_front + sqrt(c_front * c_front + 2.0 * gtm * travel)) / gtm;
+    lahar_check_value(r, "first_impact_outside_s",
+                      isnan(t_first) ? INFINITY : fmax(0.0, fmax(t_ritter - t_first, t_first - t_block)));
+    lahar_check_value(r, "sliding_block_arrival_s", t_block);
+    lahar_check_value(r, "frictionless_front_arrival_s", t_ritter);
     snprintf(r->note, sizeof r->note, "slope %.1f deg, travel %.3g m from the block's front to the wall; paper 000 "
              "Fig. 14-15 give no numbers in the text: no published peak compared", theta, travel);
     snprintf(r->convention, sizeof r->convention, "F = force of the soil on the body `wall` along the chute, "
