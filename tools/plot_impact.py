@@ -1,4 +1,4 @@
-#!/usr/bin/python3
+#!/usr/bin/env python3
 """Impact force of granular_impact_3d runs at several slopes (paper 000 section 5.3, Fig. 14-15).
 
 usage: plot_impact.py OUT.png RUN_DIR [RUN_DIR ...]
@@ -9,17 +9,34 @@ the check's own (the wall's force along the chute, 10 ms moving average; common/
 and prints a Markdown table: slope, dx, first impact, peak force and its time, the momentum flux
 estimate rho u^2 A, and the run's metrics. Left panel: F(t) per slope; right panel: peak force
 against the slope. Paper 000 Fig. 14-15 are images whose numbers are not in the paper's text
-(shared/papers/000), so no published curve is drawn. Needs matplotlib (/usr/bin/python3)."""
+(shared/papers/000), so no published curve is drawn."""
 import json
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("matplotlib")
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def fail(msg):
+    print("plot_impact: " + msg, file=sys.stderr)
+    sys.exit(2)
+
 
 def load(run):
-    with open(os.path.join(run, "check.json")) as f:
-        chk = json.load(f)
-    if chk.get("reference") != "granular_impact":
-        raise SystemExit("%s: not a granular_impact check (reference %r)" % (run, chk.get("reference")))
+    try:
+        with open(os.path.join(run, "check.json")) as f:
+            chk = json.load(f)
+    except (OSError, ValueError) as e:
+        fail("%s: no readable check.json (%s)" % (run, e))
+    if chk.get("reference") != "granular_impact" or "info" not in chk:
+        fail("%s: not a finished granular_impact check (reference %r)" % (run, chk.get("reference")))
     info = dict(chk["info"])
     info.update({k: v["value"] for k, v in chk["metrics"].items()})
     curve = chk["plot"]["panels"][0]["curves"][0]
@@ -30,10 +47,6 @@ def main(argv):
     if len(argv) < 3:
         print(__doc__, file=sys.stderr)
         return 2
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     runs = []
     for run in argv[2:]:
         chk, info, curve = load(run)
