@@ -13,6 +13,7 @@ lahar_stress_test(density_band)
 lahar_stress_test(dt_collapse)
 lahar_stress_test(overlap)
 lahar_stress_test(runaway)
+lahar_stress_test(soil_wall)
 lahar_stress_test(stable)
 
 add_executable(test_instability ${LAHAR_TEST_DIR}/test_instability.c)

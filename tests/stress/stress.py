@@ -365,12 +365,44 @@ def sweep_density_ratio(args):
           "stable density ratios: %s" % stable)
 
 
+def soil_wall_case(v0, dx, end):
+    """2D: a 0.1 x 0.05 m block of the granular_collapse_2d bars (Bui et al. 2008: rho 2650,
+    E 0.84 MPa, nu 0.3, phi 19.8 deg) sliding on a floor at v0 into a fixed wall 0.05 m ahead."""
+    soil = load_case("granular_collapse_2d.yaml")["materials"]["bars"]
+    return {
+        "dimensions": 2, "gravity": [0, -9.81],
+        "time": {"end": end, "dt_max": 1e-3, "output_interval": end / 10},
+        "materials": {"wall": {"density": 2700, "model": "linear", "kn": 1e6, "restitution": 0.5, "friction": 0.3},
+                      "bars": dict(soil)},
+        "bodies": [
+            {"name": "floor", "shape": "box", "motion": "fixed", "material": "wall", "radius": 0.001,
+             "size": [0.44, 0.02], "position": [0.2, -0.01]},
+            {"name": "wall", "shape": "box", "motion": "fixed", "material": "wall", "radius": 0.001,
+             "size": [0.02, 0.3], "position": [0.21, 0.15]},
+        ],
+        "sph": {"dx": dx, "blocks": [{"name": "block", "phase": "soil", "material": "bars",
+                                      "box": {"lo": [0.05, 0], "hi": [0.15, 0.05]}, "velocity": [v0, 0]}]},
+        "output": {"fields": ["velocity", "density", "id"]},
+    }
+
+
 def sweep_soil(args):
-    """A fast soil flow hitting a wall: needs the soil phase (issue 5), not there yet."""
-    print("\n== soil_wall: SKIPPED: a fast soil flow hitting a wall needs the soil phase of issue 5, which "
-          "lahar does not have yet (no soil material or soil block in the case format). Nothing was run.")
-    with open(os.path.join(args.out, "limits.txt"), "a") as f:
-        f.write("soil_wall: SKIPPED (soil phase arrives with issue 5)\n")
+    """A fast soil flow hitting a wall: the block of soil_wall_case at speeds up to 20 m/s (debris
+    flows reach 10-20 m/s); accuracy: the largest soil density error max |rho/rho0 - 1|."""
+    dx, end = (0.0025, 0.1) if args.full else (0.005, 0.06)
+    values = [1, 2, 5, 10, 20, 40]
+    rows, runs = [], []
+    for v0 in values:
+        r = Run(args, soil_wall_case(v0, dx, end), os.path.join(args.out, "soil_wall", str(v0)),
+                "soil block at %g m/s into a wall" % v0)
+        runs.append(r)
+        err, p99 = density_errors(r.particles(), 2650.0)
+        rows.append([v0, r.status, r.summary.get("steps", 0), "%.3g" % r.summary.get("sim_time", 0),
+                     "%.3f" % err, "%.4f" % p99, "%.1f" % r.wall, r.caught()])
+    best = largest_stable(values, runs)
+    table(args, "soil_wall", "2D soil block (bars of granular_collapse_2d) into a wall (dx %g m, %g s)" % (dx, end),
+          ["v0", "status", "steps", "t_end", "max|rho/rho0-1|", "p99", "wall_s", "caught"], rows,
+          "fastest impact that finishes: %s m/s" % best)
 
 
 def sweep_hydrostatic_long(args):
@@ -430,7 +462,7 @@ def fail(msg):
     sys.exit(1)
 
 
-def check_caught(r, what, kind):
+def check_caught(r, what, kind, rho0=1000.0):
     """An unstable run: exit 1, status "unstable", the report's fields, the final snapshots readable,
     marked, at the failing step, and (for a particle) holding the named particle where the report
     says."""
@@ -474,7 +506,7 @@ def check_caught(r, what, kind):
                     fail("particle %d at %s in the snapshot, the report says %s" % (u["where"]["id"], pos,
                                                                                    u["where"]["position"]))
                 if what == "density out of band":
-                    rho = float(g["density"][i]) / 1000.0
+                    rho = float(g["density"][i]) / rho0
                     if abs(rho - u["value"]) > 1e-5 * rho:
                         fail("rho/rho0 %.6g in the snapshot, the report says %.6g" % (rho, u["value"]))
                     if 0.5 <= rho <= 2.0 and u["limit"] in (0.5, 2.0):
@@ -524,6 +556,19 @@ def ci(args):
         u = r.summary["instability"]
         if u["where"]["name"] != "bullet" or u["where"]["id"] != 1 or not u["where"]["position"][0] > 1e12 * 0.999:
             fail("runaway report %r" % u)
+    elif name == "soil_wall":
+        # a soil block into a wall at 20 m/s (about the soil's P-wave speed, 20.7 m/s): squeezed past
+        # 2 x its rest density against the wall, caught; at 2 m/s it finishes (its density only
+        # thins where the block spreads, which the band allows soil)
+        r = Run(args, soil_wall_case(20, 0.005, 0.06), os.path.join(args.out, name, "fast"), "soil wall 20 m/s")
+        check_caught(r, "density out of band", "particle", 2650.0)
+        u = r.summary["instability"]
+        if not (u["value"] > 2.0 and u["limit"] == 2.0 and "soil particle" in u["message"]):
+            fail("soil report %r" % u)
+        r = Run(args, soil_wall_case(2, 0.005, 0.06), os.path.join(args.out, name, "slow"), "soil wall 2 m/s")
+        if not r.stable or r.inst:
+            fail("2 m/s: exit %d status %s: %s" % (r.rc, r.status, r.summary.get("message", "")))
+        print("2 m/s: finished, %d steps to t = %g s" % (r.summary["steps"], r.summary["sim_time"]))
     elif name == "stable":
         # the same scenes at safe settings finish
         for label, case in (("dam_break", dam_break(args, 0.005, 0.3)), ("dem", dem_drop_case(1e9, 0.02, 5.0))):
@@ -539,7 +584,7 @@ def ci(args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("command", choices=["sweep", "ci"])
-    ap.add_argument("name", nargs="?", help="ci: the check (density_band, dt_collapse, overlap, stable)")
+    ap.add_argument("name", nargs="?", help="ci: the check (density_band, dt_collapse, overlap, runaway, soil_wall, stable)")
     ap.add_argument("--full", action="store_true", help="sweep: finer resolutions, longer runs, the 10^6-step tank")
     ap.add_argument("--only", help="sweep: comma-separated sweeps (%s)" % ", ".join(SWEEPS))
     ap.add_argument("--out", default="stress_out")
