@@ -743,6 +743,8 @@ static const lahar_check_reference check_references[] = {
      "accel_rel_error", 0.05, lahar_check_soil_slide},
     {"granular_collapse", "soil column collapsing from a wall onto a floor: run-out, deposit profile, settled at or "
      "below the angle of repose", "escaped_particles", 0.0, lahar_check_granular_collapse},
+    {"granular_impact", "soil flowing down a chute onto a fixed wall: impact force history and peak, first impact, "
+     "momentum balance, nothing through the wall", "escaped_particles", 0.0, lahar_check_granular_impact},
     {"darcy", "water driven through a soil: seepage velocity vs Darcy's k_h i", "darcy_velocity_rel_error", 0.05,
      lahar_check_darcy},
 };

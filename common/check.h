@@ -131,6 +131,7 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
 int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 
 /* Dimensionless drag K = F/(mu U) of a square array of cylinders at solid fraction c (Sangani &
