@@ -411,6 +411,7 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
     double psi = rmap_num(m, "dilatancy", 0, 0.0, "0");
     double kh = rmap_num(m, "permeability", 0, 0.0, "1e-3");
     double cd = rmap_num(m, "damping", 0, 0.0, "100");
+    double ava = rmap_num(m, "av_alpha", 0, 0.1, "1.0"), avb = rmap_num(m, "av_beta", 0, 0.0, "1.0");
     if (m->r->failed)
         return;
     mat->friction = rmap_num(m, "friction", 0, tan(phi * deg), "0.5");
@@ -421,6 +422,8 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
     mat->dilatancy = psi * deg;
     mat->permeability = kh;
     mat->damping = cd;
+    mat->av_alpha = ava;
+    mat->av_beta = avb;
     mat->restitution = 1.0;
     mat->kt_ratio = 2.0 / 7.0;
     if (!(mat->density > 0))
@@ -440,6 +443,11 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
     else if (!(cd >= 0))
         rmap_fail(m, "damping", "must be >= 0 1/s (got %g); 0 = off, about the column's first frequency pi c/(2 H) "
                   "damps its start-up in a few periods", cd);
+    else if (!(ava >= 0))
+        rmap_fail(m, "av_alpha", "must be >= 0 (got %g); Monaghan's alpha of the soil, 0.1 by default, 1 in paper 000's "
+                  "granular impact", ava);
+    else if (!(avb >= 0))
+        rmap_fail(m, "av_beta", "must be >= 0 (got %g); Monaghan's beta of the soil, 0 by default", avb);
     else if (!(kh >= 0))
         rmap_fail(m, "permeability", "must be >= 0 m/s (got %g); the Darcy hydraulic conductivity k_h", kh);
     else if (!(mat->friction >= 0))
@@ -450,9 +458,10 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"density", "model", "young", "poisson", "kn", "kt_ratio", "restitution",
                                        "friction", "friction_angle", "cohesion", "dilatancy", "permeability", "damping",
-                                       NULL};
+                                       "av_alpha", "av_beta", NULL};
     static const char *const models[] = {"linear", "hertz", "soil", NULL};
-    static const char *const soil_only[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping", NULL};
+    static const char *const soil_only[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping",
+                                            "av_alpha", "av_beta", NULL};
     static const char *const dem_only[] = {"kn", "kt_ratio", "restitution", NULL};
     rmap top;
     if (rmap_open(r, n, "materials", &top) != 0)

@@ -30,6 +30,7 @@ typedef struct {
     double dilatancy;       /* psi, radians (case: degrees) */
     double permeability;    /* k_h, Darcy hydraulic conductivity, m/s (0: no seepage) */
     double damping;         /* c_d, 1/s: velocity damping -c_d v of the soil (quasi-static start; 0 = off) */
+    double av_alpha, av_beta; /* Monaghan artificial viscosity of the soil (paper 000 section 5.3: 1, 1) */
 } lahar_material;
 
 /* A sphero-polyhedron: a convex (or, for fixed bodies, any) set of vertices, edges and faces

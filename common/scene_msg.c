@@ -121,6 +121,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->dilatancy = a->dilatancy;
         b->permeability = a->permeability;
         b->damping = a->damping;
+        b->av_alpha = a->av_alpha;
+        b->av_beta = a->av_beta;
     }
     for (int i = 0; i < c->nbody; i++) {
         const lahar_body *a = &c->bodies[i];
@@ -258,6 +260,8 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         b->dilatancy = a->dilatancy;
         b->permeability = a->permeability;
         b->damping = a->damping;
+        b->av_alpha = a->av_alpha;
+        b->av_beta = a->av_beta;
     }
     c->nbody = m->nbody;
     for (int i = 0; i < m->nbody; i++) {

@@ -181,7 +181,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
             prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
                                                 .phi = mt->friction_angle, .cohesion = mt->cohesion,
                                                 .psi = mt->dilatancy, .kh = mt->permeability, .mu_phi = mt->friction,
-                                                .damping = mt->damping, .rho_water = c->sph_density,
+                                                .damping = mt->damping, .av_alpha = mt->av_alpha,
+                                                .av_beta = mt->av_beta, .rho_water = c->sph_density,
                                                 .gravity = {c->gravity[0], c->gravity[1], c->gravity[2]},
                                                 .g_ref = v3_norm(v3_load(c->gravity)) > 0.0
                                                              ? v3_norm(v3_load(c->gravity))

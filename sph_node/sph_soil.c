@@ -236,7 +236,7 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
         double pi_ij = 0.0;
         if (vdotr < 0.0) { /* Monaghan 1992 */
             double mu = h * vdotr / (r2 + eta2);
-            pi_ij = (-SPH_SOIL_AV_ALPHA * cs * mu + SPH_SOIL_AV_BETA * mu * mu) / (0.5 * (rhoi + rhoj));
+            pi_ij = (-s->mat.av_alpha * cs * mu + s->mat.av_beta * mu * mu) / (0.5 * (rhoi + rhoj));
         }
         double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
         double t[SPH_NSTRESS];

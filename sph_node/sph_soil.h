@@ -57,8 +57,6 @@
 #include "sph_particles.h"
 
 #define SPH_SOIL_PHASE 1
-#define SPH_SOIL_AV_ALPHA 0.1   /* Monaghan artificial viscosity of the soil (Bui 2008 section 4.1) */
-#define SPH_SOIL_AV_BETA 0.0
 #define SPH_SOIL_AS_EPS 0.3     /* artificial stress coefficient (Gray et al. 2001) */
 #define SPH_SOIL_AS_N 2.55      /* its exponent n of f_ij^n */
 
@@ -69,6 +67,8 @@ typedef struct {
     double kh;             /* Darcy hydraulic conductivity, m/s (0: none) */
     double mu_phi;         /* soil-DEM friction coefficient (paper 000 eq. 24) */
     double damping;        /* c_d, 1/s: dv/dt += -c_d v (0 = off) */
+    double av_alpha, av_beta; /* Monaghan artificial viscosity (Bui 2008 section 4.1; the case's
+                               * defaults 0.1, 0; paper 000 section 5.3 uses 1, 1) */
     double g_ref;          /* g of k = k_h mu / (rho_w g), m/s^2 */
     double gravity[3];     /* m/s^2: the soil's body force (sph.body_force drives the water only) */
     double rho_water;      /* rho_w of the same, kg/m^3 */

@@ -32,7 +32,7 @@ static const double DX = 0.01, RHO = 2000.0, PI = 3.14159265358979323846;
 static sph_soil_material sand(double phi_deg, double c)
 {
     return (sph_soil_material){.density = RHO, .young = 1e6, .poisson = 0.3, .phi = phi_deg * PI / 180.0,
-                               .cohesion = c, .psi = 0.0, .mu_phi = 0.5, .gravity = {0.0, -9.81, 0.0}};
+                               .cohesion = c, .psi = 0.0, .mu_phi = 0.5, .av_alpha = 0.1, .gravity = {0.0, -9.81, 0.0}};
 }
 
 static double yield_f(const sph_soil *s, const double sig[6])
