@@ -170,31 +170,35 @@ static int face_world(const lahar_shape *s, const double x[3], const double q[4]
 double geom_point_body_core(const lahar_shape *s, const double x[3], const double q[4], vec3 p,
                             vec3 *c, int *feature)
 {
+    /* in the shape's frame: one rotation of p instead of one per vertex, edge end and face
+     * corner (for a fixed body, x = 0 and q = identity, the frames coincide bit for bit) */
+    quat qq = q_load(q);
+    vec3 pb = q_rotate_inv(qq, v3_sub(p, v3_load(x)));
     double best = DBL_MAX;
-    vec3 bc = v3_load(x);
+    vec3 bc = v3(0.0, 0.0, 0.0);
     int bf = 0;
     for (int i = 0; i < s->nv; i++) {
-        vec3 w = geom_world_vertex(s, x, q, i);
-        double d = v3_norm(v3_sub(p, w));
+        vec3 w = v3_load(s->v[i]);
+        double d = v3_norm(v3_sub(pb, w));
         if (d < best) { best = d; bc = w; bf = 0; }
     }
     for (int i = 0; i < s->ne; i++) {
-        vec3 a = geom_world_vertex(s, x, q, s->e[i][0]), b = geom_world_vertex(s, x, q, s->e[i][1]);
         vec3 cc;
         double t;
-        double d = geom_point_segment_param(p, a, b, &cc, &t);
+        double d = geom_point_segment_param(pb, v3_load(s->v[s->e[i][0]]), v3_load(s->v[s->e[i][1]]), &cc, &t);
         if (d < best && t > 0.0 && t < 1.0) { best = d; bc = cc; bf = 1; }
     }
     vec3 poly[GEOM_FACE_MAX];
     for (int f = 0; f < s->nf; f++) {
-        int m = face_world(s, x, q, f, poly);
-        vec3 n = q_rotate(q_load(q), geom_face_normal(s, f));
+        int b = s->face_start[f], m = s->face_start[f + 1] - b;
+        if (m > GEOM_FACE_MAX) m = GEOM_FACE_MAX;
+        for (int j = 0; j < m; j++) poly[j] = v3_load(s->v[s->face_v[b + j]]);
         vec3 cc;
         int in;
-        double d = geom_point_polygon(p, poly, m, n, &cc, &in);
+        double d = geom_point_polygon(pb, poly, m, geom_face_normal(s, f), &cc, &in);
         if (in && d < best) { best = d; bc = cc; bf = 2; }
     }
-    if (c) *c = bc;
+    if (c) *c = v3_add(v3_load(x), q_rotate(qq, bc));
     if (feature) *feature = bf;
     return best;
 }

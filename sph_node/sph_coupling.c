@@ -419,14 +419,14 @@ static vec3 coupling_soil_tangential(const sph_coupling *c, int64_t id, int b, v
 static int inside_core(const lahar_body *body, const double x[3], const double q[4], vec3 p, int dim)
 {
     const lahar_shape *s = &body->shape;
+    /* in the shape's frame (one rotation of p; fixed bodies: the same frame bit for bit) */
+    const vec3 pb = q_rotate_inv(q_load(q), v3_sub(p, v3_load(x)));
     if (dim == 3) {
         if (s->nf < 4 || !body->convex)
             return 0;
-        quat qq = q_load(q);
         for (int f = 0; f < s->nf; f++) {
-            vec3 n = q_rotate(qq, geom_face_normal(s, f));
-            vec3 a = geom_world_vertex(s, x, q, s->face_v[s->face_start[f]]);
-            if (v3_dot(v3_sub(p, a), n) >= 0.0)
+            vec3 a = v3_load(s->v[s->face_v[s->face_start[f]]]);
+            if (v3_dot(v3_sub(pb, a), geom_face_normal(s, f)) >= 0.0)
                 return 0;
         }
         return 1;
@@ -435,10 +435,10 @@ static int inside_core(const lahar_body *body, const double x[3], const double q
         return 0;
     int in = 0;
     for (int e = 0; e < s->ne; e++) {
-        vec3 a = geom_world_vertex(s, x, q, s->e[e][0]), b = geom_world_vertex(s, x, q, s->e[e][1]);
-        if ((a.y > p.y) != (b.y > p.y)) {
-            double xc = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if (p.x < xc)
+        vec3 a = v3_load(s->v[s->e[e][0]]), b = v3_load(s->v[s->e[e][1]]);
+        if ((a.y > pb.y) != (b.y > pb.y)) {
+            double xc = a.x + (pb.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if (pb.x < xc)
                 in = !in;
         }
     }
@@ -483,6 +483,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
              * (plus the support) is outside the domain and has none either. */
             int nlo[3] = {0, 0, 0}, nhi[3] = {0, 0, 0};
             for (int a = 0; a < 3; a++) {
+                if (!c->periodic[a])
+                    continue;
                 /* the range of the body along a: its world box when fixed (tight), else its sphere */
                 const double *bb = c->box[b];
                 int boxed = body->motion == LAHAR_MOTION_FIXED && isfinite(bb[a]) && isfinite(bb[3 + a]);
@@ -497,18 +499,24 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             }
             const int nx = nhi[0] - nlo[0] + 1, ny = nhi[1] - nlo[1] + 1, nimg = nx * ny * (nhi[2] - nlo[2] + 1);
             for (int img = 0; img < nimg && ns < SPH_COUPLING_MAX_PER_PARTICLE; img++) {
-                const int ix = nlo[0] + img % nx, iy = nlo[1] + img / nx % ny, iz = nlo[2] + img / (nx * ny);
-                /* without images (ix = iy = iz = 0) xi is the particle's position bit for bit */
+                /* without images (ix = iy = iz = 0) xi is the particle's position bit for bit; the
+                 * divisions only where there are several images (most particles have one) */
+                const int ix = nlo[0] + (nimg > 1 ? img % nx : 0), iy = nlo[1] + (nimg > 1 ? img / nx % ny : 0),
+                          iz = nlo[2] + (nimg > 1 ? img / (nx * ny) : 0);
                 vec3 xi = v3(xp.x - ix * c->period[0], xp.y - iy * c->period[1], xp.z - iz * c->period[2]);
-                /* bounding sphere; fixed bodies keep world-frame vertices (x = origin of that frame) */
-                if (v3_norm(v3_sub(xi, xb)) > c->bound[b] + support)
-                    continue;
+                /* culling, cheapest test first (a particle culled here is at least the support from
+                 * the surface, so the tests' order and form change no result): fixed bodies have
+                 * a tight world box, every body a bounding sphere (fixed bodies keep world-frame
+                 * vertices, x = origin of that frame) */
                 if (body->motion == LAHAR_MOTION_FIXED) {
                     const double *bb = c->box[b];
                     if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support ||
                         xi.y > bb[4] + support || xi.z < bb[2] - support || xi.z > bb[5] + support)
                         continue;
                 }
+                const double reach = c->bound[b] + support;
+                if (v3_norm2(v3_sub(xi, xb)) > reach * reach)
+                    continue;
                 vec3 core = xb;
                 /* big shapes (terrain, flumes): only the features near the particle */
                 double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
