@@ -97,6 +97,23 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
  * per candidate), then the body for those within the support. */
 #define SPH_NB_CHUNK 64
 
+/* Squared distance from coordinate X of a particle along axis A to the slab of cell row K, which
+ * lies D (the sign of K minus the particle's row) rows away: 0 for its own row. K is unwrapped
+ * (may lie outside 0 .. nc - 1 on a periodic axis: the image slab). The slab is widened by 1e-9 of
+ * a cell against rounding in the binning (sph_cells_coord), so a skipped row holds no particle
+ * within the support: the neighbours and their order are those of the full stencil, bit for bit.
+ * Particles clamped into an edge row lie beyond its outer face, farther still. */
+#define SPH_CELL_GAP2(C, A, K, D, X)                                                                \
+    ((D) == 0 ? 0.0                                                                                \
+              : sph_cell_gap2_((D) > 0 ? (C)->lo[A] + (K) * (C)->size[A] - (X)                     \
+                                       : (X) - ((C)->lo[A] + ((K) + 1) * (C)->size[A]),            \
+                               (C)->size[A]))
+static inline double sph_cell_gap2_(double gap, double size)
+{
+    gap -= 1e-9 * size;
+    return gap > 0.0 ? gap * gap : 0.0;
+}
+
 /* Loop over the neighbours j != i of particle i (sorted, cell_of valid) within sqrt(S2) of it, in
  * cell order (deterministic). The body is the last (variadic) argument; inside it: j, and rx, ry,
  * rz, r2 = x_i - (image of x_j) and its squared length. Particle i is at (XI, YI, ZI). Periodic
@@ -145,6 +162,10 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
         const int nc_zr_ = ((DIM) ? (DIM) : nc_c_->dim) == 3 ? nc_re_ : 0;                         \
         for (int nc_dz_ = -nc_zr_; nc_dz_ <= nc_zr_; nc_dz_++) {                                   \
             int nc_jz_ = nc_cz_ + nc_dz_;                                                          \
+            /* rows of cells wholly beyond the support are skipped (SPH_CELL_GAP2) */              \
+            const double nc_gz2_ = SPH_CELL_GAP2(nc_c_, 2, nc_jz_, nc_dz_, nc_zi_);                 \
+            if (nc_gz2_ >= nc_s2_)                                                                 \
+                continue;                                                                          \
             double nc_sz_ = 0.0;                                                                   \
             if (nc_jz_ < 0 || nc_jz_ >= nc_n2_) {                                                  \
                 if (!nc_c_->periodic[2])                                                           \
@@ -154,6 +175,10 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
             }                                                                                      \
             for (int nc_dy_ = -nc_re_; nc_dy_ <= nc_re_; nc_dy_++) {                               \
                 int nc_jy_ = nc_cy_ + nc_dy_;                                                      \
+                /* 3D only: in 2D a row is (nearly) never beyond the support, and the test costs */ \
+                const double nc_gyz2_ = nc_zr_ > 0 ? nc_gz2_ + SPH_CELL_GAP2(nc_c_, 1, nc_jy_, nc_dy_, nc_yi_) : 0.0; \
+                if (nc_gyz2_ >= nc_s2_)                                                            \
+                    continue;                                                                      \
                 double nc_sy_ = 0.0;                                                               \
                 if (nc_jy_ < 0 || nc_jy_ >= nc_n1_) {                                              \
                     if (!nc_c_->periodic[1])                                                       \
@@ -165,16 +190,24 @@ static inline int sph_cells_coord(const sph_cells *c, int a, double x)
                 int64_t nc_sb_[2 * SPH_CELLS_PER_SUPPORT + 1], nc_se_[2 * SPH_CELLS_PER_SUPPORT + 1]; \
                 double nc_ss_[2 * SPH_CELLS_PER_SUPPORT + 1];                                      \
                 int nc_nseg_ = 0;                                                                  \
-                if (!nc_c_->periodic[0] || (nc_cx_ >= nc_re_ && nc_cx_ + nc_re_ < nc_n0_)) {       \
-                    const int nc_a_ = nc_cx_ > nc_re_ ? nc_cx_ - nc_re_ : 0,                       \
-                              nc_b_ = nc_cx_ + nc_re_ < nc_n0_ ? nc_cx_ + nc_re_ : nc_n0_ - 1;     \
+                /* along x, the cells within the support left by the row's gap */                \
+                int nc_xa_ = nc_cx_ - nc_re_, nc_xb_ = nc_cx_ + nc_re_;                            \
+                if (nc_zr_ > 0) { /* 3D (in 2D the corner cells saved do not pay for the tests) */ \
+                    while (nc_xa_ < nc_cx_ && nc_gyz2_ + SPH_CELL_GAP2(nc_c_, 0, nc_xa_, -1, nc_xi_) >= nc_s2_) \
+                        nc_xa_++;                                                                  \
+                    while (nc_xb_ > nc_cx_ && nc_gyz2_ + SPH_CELL_GAP2(nc_c_, 0, nc_xb_, 1, nc_xi_) >= nc_s2_) \
+                        nc_xb_--;                                                                  \
+                }                                                                                  \
+                if (!nc_c_->periodic[0] || (nc_xa_ >= 0 && nc_xb_ < nc_n0_)) {                     \
+                    const int nc_a_ = nc_xa_ > 0 ? nc_xa_ : 0,                                     \
+                              nc_b_ = nc_xb_ < nc_n0_ ? nc_xb_ : nc_n0_ - 1;                       \
                     nc_sb_[0] = nc_start_[nc_row_ + nc_a_];                                        \
                     nc_se_[0] = nc_start_[nc_row_ + nc_b_ + 1];                                    \
                     nc_ss_[0] = 0.0;                                                               \
                     nc_nseg_ = 1;                                                                  \
                 } else {                                                                           \
-                    for (int nc_dx_ = -nc_re_; nc_dx_ <= nc_re_; nc_dx_++) {                       \
-                        int nc_jx_ = nc_cx_ + nc_dx_;                                              \
+                    for (int nc_jx0_ = nc_xa_; nc_jx0_ <= nc_xb_; nc_jx0_++) {                     \
+                        int nc_jx_ = nc_jx0_;                                                      \
                         double nc_sx_ = 0.0;                                                       \
                         if (nc_jx_ < 0 || nc_jx_ >= nc_n0_) {                                      \
                             nc_sx_ = (nc_jx_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[0] - nc_c_->lo[0]);    \
