@@ -35,7 +35,9 @@ static void usage(FILE *f)
             "                     from $LCM_DEFAULT_URL). Set ttl yourself (ttl=0: this host only) and\n"
             "                     recv_buf_size=8388608\n"
             "  --wait S           seconds to wait for the nodes to join (default 30)\n"
-            "  -q, --quiet        no progress line and no closing hints\n\n"
+            "  -q, --quiet        no progress line and no closing hints\n"
+            "  --evaluate-only    (check) do not simulate: evaluate the check: section on the output\n"
+            "                     already in OUT (e.g. after changing a bound, or of a run on a cluster)\n\n"
             "By default lahar creates a private network namespace (unshare of user + network namespaces)\n"
             "with multicast on its loopback and uses %s\n"
             "inside it: nothing leaves the machine and two runs never hear each other. The nodes are\n"
@@ -108,10 +110,10 @@ int main(int argc, char **argv)
         {"in-process", no_argument, NULL, 'i'},   {"no-spawn", no_argument, NULL, 'n'},
         {"lcm-url", required_argument, NULL, 'u'}, {"wait", required_argument, NULL, 'w'},
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
+        {"evaluate-only", no_argument, NULL, 'e'}, {NULL, 0, NULL, 0},
     };
     optind = 2;
-    int c;
+    int c, evaluate_only = 0;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
         switch (c) {
         case 'o': o.outdir = optarg; break;
@@ -121,6 +123,7 @@ int main(int argc, char **argv)
         case 'u': o.lcm_url = optarg; break;
         case 'w': o.join_wait_s = atof(optarg); break;
         case 'q': o.quiet = 1; break;
+        case 'e': evaluate_only = 1; break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
@@ -135,6 +138,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "lahar %s: missing -o OUT (output directory)\n", cmd);
         return 2;
     }
+    if (evaluate_only && !is_check) {
+        fprintf(stderr, "lahar %s: --evaluate-only belongs to `lahar check`\n", cmd);
+        return 2;
+    }
     if (o.in_process && (o.no_spawn || o.lcm_url)) {
         fprintf(stderr, "lahar %s: --in-process runs without network; it excludes --no-spawn and --lcm-url\n", cmd);
         return 2;
@@ -147,7 +154,7 @@ int main(int argc, char **argv)
         printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,
                cs.t_end);
     } else {
-        status = lahar_coord_run(&cs, &o);
+        status = evaluate_only ? 0 : lahar_coord_run(&cs, &o);
         if (is_check && status == 0) {
             if (!cs.check.enabled) {
                 fprintf(stderr, "lahar check: %s has no check: section\n", case_path);

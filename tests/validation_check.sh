@@ -3,6 +3,7 @@
 # overrides applied (the case's check: bounds are left as they are), runs the check in-process and
 # exits with its status (0 = every metric within its bound). The main cases stay the single source
 # of the set-up; only the resolution, the duration and the cylinder radius change.
+# After a passing run, `lahar check --evaluate-only` on OUT/run must write the same check.json.
 # usage: validation_check.sh LAHAR CASE OUT [dx=M] [end=S] [c=SOLID_FRACTION] [threads=N] [paraview=1]
 #   dx=M   sph.dx (particle spacing)             end=S  time.end
 #   c=F    cylinder_array: disc radius r = L sqrt(F / pi), L = 0.2 m (the case's cell)
@@ -47,6 +48,13 @@ start=$(date +%s)
 "$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q $threads
 rc=$?
 echo "validation_check: $(basename "$case") $* -> exit $rc, $(( $(date +%s) - start )) s wall"
+if [ $rc -eq 0 ]; then
+    # `lahar check --evaluate-only` on the same output must give the same check.json
+    cp "$out/run/check.json" "$out/check.run.json" &&
+        "$lahar" check "$out/case.yaml" -o "$out/run" --evaluate-only -q > "$out/evaluate.log" 2>&1 &&
+        cmp -s "$out/run/check.json" "$out/check.run.json" ||
+        { echo "validation_check: lahar check --evaluate-only did not reproduce check.json (see $out/evaluate.log)"; exit 1; }
+fi
 if [ $rc -eq 0 ] && [ -n "$paraview" ]; then
     grep -q "particles.h5:" "$out/run/lahar.xmf" && grep -q "bodies.h5:" "$out/run/lahar.xmf" ||
         { echo "validation_check: $out/run/lahar.xmf does not show both particles and bodies"; exit 1; }
