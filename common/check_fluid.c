@@ -798,15 +798,56 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
 
 /* ---------------------------------------------------------------- floating box ---------- */
 
-/* A free box floating in water (shared/reference/05 section 5.6): draft = free-surface level
- * (columns at least dx clear of the box) - lowest point of the box's swept surface, averaged over
- * the late window of the snapshots; reference rho_b h / rho_f with rho_b the box material's
- * density, h its height along gravity (core extent + 2 sweep radius; rounded corners of radius R
- * change the displaced area by (4 - pi) R^2, ignored). draft_spread_rel: (largest - smallest
- * draft) / reference over the window, how far the heave has settled. */
+/* A free box floating in water (shared/reference/05 section 5.6): draft = free-surface level -
+ * lowest point of the box's swept surface, averaged over the late window of the snapshots;
+ * reference rho_b h / rho_f with rho_b the box material's density, h its height along gravity
+ * (core extent + 2 sweep radius; rounded corners of radius R change the displaced area by
+ * (4 - pi) R^2, ignored). The free surface is the level where the water's pressure is zero,
+ * extrapolated by a least-squares line p(height) through the particles clear of every body (3 dx)
+ * and of the surface and floor (3 dx): Archimedes' draft is the depth at which the hydrostatic
+ * pressure carries the box, p = rho_f g d. The column tops + dx/2 (fluid_surface) are reported as
+ * draft_columns: on a disordered surface a column without its top particle, and the rows against
+ * the walls, move that level by up to dx/4, 2.5 % of this draft at dx = 10 mm.
+ * draft_spread_rel: (largest - smallest draft) / reference over the window, how far the heave
+ * has settled. */
+/* Level where a least-squares line p(height) through the particles of the buffers at least 3 dx
+ * from every body (snapshot kb), 3 dx below `level` and 3 dx above the lowest particle, reaches
+ * zero; the slope over rho_f g into *gradient. Returns 0, or -1 with fewer than 10 particles. */
+static int fluid_pressure_zero_level(const lahar_case *c, const lahar_check_data *d, int64_t kb, vec3 up,
+                                     double dx, double level, double *zero, double *gradient)
+{
+    const lahar_check_particles *p = d->particles;
+    double hmin = INFINITY;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        hmin = fmin(hmin, v3_dot(fluid_pos(p, i), up));
+    double sh = 0.0, sp = 0.0, shh = 0.0, shp = 0.0;
+    int64_t n = 0;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        vec3 x = fluid_pos(p, i);
+        double hgt = v3_dot(x, up);
+        if (hgt < hmin + 3.0 * dx || hgt > level - 3.0 * dx)
+            continue;
+        int near = 0;
+        for (int j = 0; j < c->nbody && !near; j++)
+            near = fluid_depth(c, d, j, c->bodies[j].motion == LAHAR_MOTION_FIXED ? -1 : kb, x) > -3.0 * dx;
+        if (near)
+            continue;
+        sh += hgt, sp += p->pressure[i], shh += hgt * hgt, shp += hgt * p->pressure[i], n++;
+    }
+    double den = n * shh - sh * sh;
+    if (n < 10 || !(den > 0.0))
+        return -1;
+    double a = (n * shp - sh * sp) / den, b = (sp - a * sh) / n; /* p = a h + b */
+    if (!(a < 0.0))
+        return -1;
+    *zero = -b / a;
+    *gradient = -a / (c->sph_density * v3_norm(v3_load(c->gravity)));
+    return 0;
+}
+
 int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
 {
-    if (fluid_need(d, 0, "floating_box", r))
+    if (fluid_need(d, LAHAR_PFIELD_PRESSURE, "floating_box", r))
         return -1;
     lahar_check_particles *p = d->particles;
     vec3 up, e1, e2;
@@ -824,6 +865,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     int pd = lahar_check_panel(r, "draft of the box", "t [s]", "draft [m]");
     lahar_check_curve(r, pd, 1, box->name);
     double sum = 0.0, hb = NAN, d_last = NAN, tilt = 0.0, wmin = INFINITY, wmax = -INFINITY;
+    double sum_cols = 0.0, sum_grad = 0.0;
     int nwin = 0;
     fluid_columns cols = {NULL, 0};
     for (int64_t k = 0; k < p->nsnap; k++) {
@@ -842,18 +884,21 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
             free(cols.top);
             return -1;
         }
-        double level, tmin, tmax;
+        double level, tmin, tmax, zero, grad;
         if (!fluid_surface(p, c->dim, up, e1, e2, dx, slo - R - dx, shi + R + dx, &cols, &level, &tmin,
-                           &tmax))
+                           &tmax) ||
+            fluid_pressure_zero_level(c, d, kb, up, dx, level, &zero, &grad) != 0)
             continue;
-        double draft = level - (bot - R);
+        double draft = zero - (bot - R);
         hb = top - bot + 2.0 * R;
         d_last = draft;
         /* rotation angle of the body (2D: about z) */
         tilt = 2.0 * atan2(sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]), fabs(q[0])) * 180.0 / M_PI;
         lahar_check_point(r, p->t[k], draft);
-        if (p->t[k] >= from)
+        if (p->t[k] >= from) {
             sum += draft, nwin++, wmin = fmin(wmin, draft), wmax = fmax(wmax, draft);
+            sum_cols += level - (bot - R), sum_grad += grad;
+        }
     }
     free(cols.top);
     if (nwin == 0) {
@@ -870,13 +915,17 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     lahar_check_value(r, "draft_measured", draft);
     lahar_check_value(r, "draft_last", d_last);
     lahar_check_value(r, "draft_spread_rel", (wmax - wmin) / d_ref);
+    lahar_check_value(r, "draft_columns", sum_cols / nwin);
+    lahar_check_value(r, "draft_columns_rel_error", fabs(sum_cols / nwin - d_ref) / d_ref);
+    lahar_check_value(r, "pressure_gradient_over_rho_g", sum_grad / nwin);
     lahar_check_value(r, "draft_reference", d_ref);
     lahar_check_value(r, "box_height", hb);
     lahar_check_value(r, "box_density", rho_b);
     lahar_check_value(r, "tilt_deg", tilt);
     snprintf(r->note, sizeof r->note,
-             "box %s; draft averaged over the snapshots of the last 10 %% of the run (%d); free surface from the "
-             "columns at least dx beside the box",
+             "box %s; draft averaged over the snapshots of the last 10 %% of the run (%d); free surface: where the "
+             "pressure of the water 3 dx clear of every body extrapolates to zero (draft_columns: mean column top + "
+             "dx/2 instead)",
              box->name, nwin);
     snprintf(r->title, sizeof r->title, "floating_box: draft %.4g m (Archimedes %.4g m)", draft, d_ref);
     return 0;
