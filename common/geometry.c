@@ -192,10 +192,14 @@ double geom_point_body_core(const lahar_shape *s, const double x[3], const doubl
     for (int f = 0; f < s->nf; f++) {
         int b = s->face_start[f], m = s->face_start[f + 1] - b;
         if (m > GEOM_FACE_MAX) m = GEOM_FACE_MAX;
+        vec3 n = geom_face_normal(s, f);
+        /* the distance to a face is at least the distance to its plane: a face whose plane is
+         * farther than the best feature so far cannot be closer (most faces of a box) */
+        if (m >= 3 && fabs(v3_dot(v3_sub(pb, v3_load(s->v[s->face_v[b]])), n)) > best) continue;
         for (int j = 0; j < m; j++) poly[j] = v3_load(s->v[s->face_v[b + j]]);
         vec3 cc;
         int in;
-        double d = geom_point_polygon(pb, poly, m, geom_face_normal(s, f), &cc, &in);
+        double d = geom_point_polygon(pb, poly, m, n, &cc, &in);
         if (in && d < best) { best = d; bc = cc; bf = 2; }
     }
     if (c) *c = v3_add(v3_load(x), q_rotate(qq, bc));
