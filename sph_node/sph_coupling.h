@@ -95,6 +95,8 @@ typedef struct {
     double mu;                 /* fluid dynamic viscosity */
     sph_wall_viscous viscous;
     double gtab[SPH_COUPLING_GTAB + 1], gtab_d0, gtab_dd; /* G(d) on d = d0 + k dd */
+    double **gtab_body;        /* per body: G(d) of a disc/sphere (one core point), layers curved
+                                  with its surface; NULL entries (and NULL): the flat gtab */
     sph_wall_pressure pressure;  /* sph_coupling_set_wall_pressure; default penalty only */
     double body_force[3];        /* b of the ghost pressure extrapolation */
     double *wtab, wtab_dd;       /* GHOST: wall table (sph_coupling.c) on d = gtab_d0 + k wtab_dd */
@@ -177,5 +179,7 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
 
 /* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d);
+/* The same for body b: its curved table when it is a disc or sphere, else the flat one. */
+double sph_coupling_body_halfspace_factor(const sph_coupling *c, int b, double d);
 
 #endif

@@ -117,12 +117,32 @@ int main(void)
         double d = 0.8 * DX, x[3] = {R + d, 0, 0}, v[3] = {0, 0, 0};
         one_particle(&f, 2, x, v, 1, &disc);
         double urel_y = 0.0 - vb - w * R; /* eq. 16 at x_s = (R, 0) */
-        double G = sph_coupling_halfspace_factor(&f.cpl, d), fy = m2 * 2.0 * MU / RHO * G * urel_y;
+        double G = sph_coupling_body_halfspace_factor(&f.cpl, 0, d), fy = m2 * 2.0 * MU / RHO * G * urel_y;
         CHECK(rel(f.p.ay[0] * m2, fy) < 1e-12, "disc: tangential force %g, expected %g", f.p.ay[0] * m2, fy);
+        /* the disc's ghost layers curve away from the particle: fewer ghosts in the support than
+         * on a flat wall, about (d + s)/(2 R) of the first layer (s = dx/2): 13 % at R = 5 dx */
+        double Gflat = sph_coupling_halfspace_factor(&f.cpl, d);
+        CHECK(G / Gflat > 0.80 && G / Gflat < 0.95, "disc R = 5 dx: G / G_flat = %.4f (0.80 .. 0.95)", G / Gflat);
+        printf("disc R = 5 dx: G(0.8 dx) / G_flat = %.4f\n", G / Gflat);
         CHECK(rel(f.cpl.torque[0][2], R * -fy) < 1e-12, "disc torque %g, expected R F = %g", f.cpl.torque[0][2],
               R * -fy);
         printf("disc: u_rel = %.3f m/s, F_t = %.6g N/m (particle), body torque %.6g N m/m\n", urel_y, fy,
                f.cpl.torque[0][2]);
+        sph_fluid_free(&f);
+        lahar_shape_free(&disc.shape);
+    }
+    /* 3b. a disc much larger than the support has the flat wall's layers */
+    {
+        lahar_body disc;
+        const double R = 1000 * DX;
+        disc2d(&disc, R);
+        double x[3] = {R + 0.8 * DX, 0, 0}, v[3] = {0, 0, 0};
+        one_particle(&f, 2, x, v, 1, &disc);
+        for (double d = 0.3 * DX; d < f.k.support; d += 0.4 * DX) {
+            double G = sph_coupling_body_halfspace_factor(&f.cpl, 0, d), Gflat = sph_coupling_halfspace_factor(&f.cpl, d);
+            CHECK(fabs(G - Gflat) <= 2e-3 * fabs(Gflat), "disc R = 1000 dx, d = %.2f dx: G %g, G_flat %g", d / DX, G,
+                  Gflat);
+        }
         sph_fluid_free(&f);
         lahar_shape_free(&disc.shape);
     }
