@@ -520,7 +520,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
     if (n > c->pcap)
         return -1;
 
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         int ns = 0;
         const vec3 xp = v3(p->x[i], p->y[i], p->z[i]);

@@ -269,7 +269,7 @@ static void fluid_sps_pass(sph_fluid *f)
 {
     const int64_t n = f->p.n;
     const kernel_kind kind = f->k.kind;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         switch (kind) {
         case KERNEL_QUINTIC: fluid_sps_particle(f, KERNEL_QUINTIC, i); break;
@@ -287,7 +287,7 @@ static void fluid_pass(sph_fluid *f)
     const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
     const int soil = f->has_soil;
     int64_t neighbours = 0;
-#pragma omp parallel for schedule(static) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double out[4];
         if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
@@ -327,7 +327,7 @@ void sph_fluid_shepard(sph_fluid *f)
     const kernel *k = &f->k;
     const double s2 = k->support * k->support, w0 = kernel_w(k, 0.0);
     /* new densities into rhoh (free outside a step), then copied: gather, no races */
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         double num = p->m[i] * w0, den = p->m[i] / p->rho[i] * w0;
         SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {

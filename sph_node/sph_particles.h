@@ -14,6 +14,12 @@
  * machine). Heavy = neighbour or body sums per particle, light = a few flops per particle. */
 #define SPH_OMP_MIN_HEAVY 2048
 #define SPH_OMP_MIN_LIGHT 32768
+/* Heavy loops hand out particles in chunks of this many, dynamically: the cost per particle
+ * varies with position (full neighbourhoods at the bottom of a column, few at its surface, body
+ * sums only near walls; sorted by cell, a static split gives one thread the floor and the other
+ * the surface). Each particle's result is its own gather and the reductions are integer counts,
+ * so the results do not depend on which thread took which chunk (bench_sph digests unchanged). */
+#define SPH_OMP_CHUNK 256
 
 #define SPH_NSTRESS 6 /* symmetric tensor components xx, xy, xz, yy, yz, zz */
 

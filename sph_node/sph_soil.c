@@ -186,7 +186,7 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
 void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
 {
     const int64_t n = p->n;
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE)
             soil_stress_particle(s, p, c, k, i);
@@ -262,7 +262,7 @@ int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *
 {
     const int64_t n = p->n;
     int64_t nsoil = 0, nwater = 0; /* integer sums: exact in any order */
-#pragma omp parallel for schedule(static) reduction(+ : nsoil, nwater) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) reduction(+ : nsoil, nwater) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE) {
             int64_t nw = 0;
@@ -281,7 +281,7 @@ int64_t sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_ce
     if (!(seep > 0.0))
         return 0;
     int64_t nsoil = 0; /* work counter: soil neighbours of the water particles */
-#pragma omp parallel for schedule(static) reduction(+ : nsoil) if (n >= SPH_OMP_MIN_HEAVY)
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) reduction(+ : nsoil) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         if (p->phase[i] == SPH_SOIL_PHASE)
             continue;
