@@ -676,6 +676,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                     memcpy(c->soil_hist_d[base + s], hist_d[s], sizeof hist_d[s]);
             }
         }
+        if (ns == 0 && drho_g == 0.0) /* far from every body (most particles): nothing to add */
+            continue;
         double inv_m = 1.0 / p->m[i];
         p->drho[i] += drho_g;
         p->ax[i] += ftot.x * inv_m;
