@@ -1599,7 +1599,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "shifting", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1641,6 +1641,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     o->cfl_visc = rmap_num(&m, "cfl_visc", 0, 0.125, "0.125");
     rmap_vec(&m, "body_force", dim, o->body_force, 0, "");
     double shep = rmap_num(&m, "shepard_interval", 0, 0.0, "30");
+    o->shifting = rmap_num(&m, "shifting", 0, 0.0, "0.01");
     o->sps = rmap_bool(&m, "sps", 0);
     o->sps_cs = rmap_num(&m, "sps_cs", 0, 0.12, "0.12");
     o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
@@ -1683,6 +1684,9 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_fail(&m, "shepard_interval", "the Shepard filter is not implemented yet; remove the key or set 0");
     else if (o->sps && !LAHAR_SPH_HAVE_SPS)
         rmap_fail(&m, "sps", "SPS turbulence is not implemented yet; remove the key or set false");
+    else if (!(o->shifting >= 0 && o->shifting <= 0.5))
+        rmap_fail(&m, "shifting", "must be in [0, 0.5] (got %g); 0.01 is usual, 0 = off (particle shifting: "
+                  "confined flows only, lahar detects no free surface)", o->shifting);
     else if (!(o->sps_cs > 0 && o->sps_cs < 1))
         rmap_fail(&m, "sps_cs", "must be in (0, 1) (got %g); 0.12 is usual", o->sps_cs);
     else if (rmap_get(&m, "sps_cs") && !o->sps)
@@ -1701,6 +1705,16 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                   "yet (got %g); remove the key", kd->kappa, o->kernel, o->kappa);
     if (r->failed)
         return;
+    /* particle shifting moves particles from crowded to sparse places: at a free surface that is
+     * outwards. Lahar detects no free surface, so shifting is for flows driven along periodic
+     * axes only (no gravity or body force along a closed axis, where water would settle) */
+    for (int a = 0; a < dim && o->shifting > 0.0; a++)
+        if (!o->periodic[a] && c->gravity[a] + o->body_force[a] != 0.0) {
+            rmap_fail(&m, "shifting", "needs a flow without a free surface, but gravity + body_force acts along the "
+                      "non-periodic axis %c (water there settles under a free surface, which shifting would push "
+                      "outwards); remove shifting or drive the flow along periodic axes only", "xyz"[a]);
+            return;
+        }
     o->shepard_interval = (int)shep;
     for (int a = 0; a < dim && !r->failed; a++) {
         if (!o->periodic[a])

@@ -319,6 +319,63 @@ static void fluid_pass(sph_fluid *f)
     f->work_neighbours_fluid += neighbours; /* integer sum: exact in any order */
 }
 
+/* Particle shifting (Lind et al. 2012, J. Comput. Phys. 231:1499, eq. 17-18 with D = A h^2):
+ * dr_i = -A h^2 grad C_i, grad C_i = sum_j V_j grad_i W_ij, moves water particles from where they
+ * crowd to where they are sparse, against the pairing and clustering that disorder a slow flow.
+ * A body's surface has no particles behind it, so grad C points away from it: within the coupling
+ * range of a body the part of the shift towards the body (along x_i - x_s of each contact of the
+ * last evaluation) is dropped, the particle shifts along the surface only. Lahar detects no free
+ * surface: for confined (periodic, closed) flows. The shift is at most 0.1 dx per step. vhx, vhy,
+ * vhz (free between steps) hold the shifts: no allocation. */
+static void fluid_shift(sph_fluid *f)
+{
+    sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
+    const sph_coupling *cpl = &f->cpl;
+    const int64_t n = p->n;
+    const kernel *k = &f->k;
+    const double s2 = k->support * k->support, coef = -f->prm.shifting * k->h * k->h, cap = 0.1 * f->prm.dx;
+    const int d3 = f->prm.dim == 3;
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        double gx = 0.0, gy = 0.0, gz = 0.0;
+        if (p->phase[i] == 0) {
+            SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
+                if (p->phase[j] != 0)
+                    continue;
+                const double fv = f->vol[j] * kernel_dwdr(k, sqrt(r2)) / sqrt(r2);
+                gx += fv * rx, gy += fv * ry, gz += fv * rz;
+            });
+        }
+        vec3 d = v3(coef * gx, coef * gy, d3 ? coef * gz : 0.0);
+        const int ncontact = cpl->slot_n ? cpl->slot_n[i] : 0; /* no bodies attached: none */
+        for (int s = 0; s < ncontact; s++) {
+            const sph_contact *ct = &cpl->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s];
+            vec3 nrm = v3(p->x[i] - ct->xs[0], p->y[i] - ct->xs[1], d3 ? p->z[i] - ct->xs[2] : 0.0);
+            for (int a = 0; a < 3; a++) /* the particle may be a periodic image away from x_s */
+                if (cpl->periodic[a]) {
+                    double P = cpl->period[a], u = v3_get(nrm, a);
+                    u -= P * floor(u / P + 0.5);
+                    if (a == 0) nrm.x = u; else if (a == 1) nrm.y = u; else nrm.z = u;
+                }
+            double len = v3_norm(nrm), dn = len > 0.0 ? v3_dot(d, nrm) / len : 0.0;
+            if (dn < 0.0) /* towards the body */
+                d = v3_axpy(-dn / len, nrm, d);
+        }
+        double dl = v3_norm(d);
+        if (dl > cap)
+            d = v3_scale(d, cap / dl);
+        p->vhx[i] = d.x, p->vhy[i] = d.y, p->vhz[i] = d.z;
+    }
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
+    for (int64_t i = 0; i < n; i++) {
+        p->x[i] += p->vhx[i];
+        p->y[i] += p->vhy[i];
+        if (d3)
+            p->z[i] += p->vhz[i];
+    }
+}
+
 void sph_fluid_shepard(sph_fluid *f)
 {
     sph_particles *p = &f->p;
@@ -497,6 +554,8 @@ int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *stat
     f->step++;
     if (f->prm.shepard_every > 0 && f->step % f->prm.shepard_every == 0)
         sph_fluid_shepard(f);
+    if (f->prm.shifting > 0.0)
+        fluid_shift(f);
     f->crossings = cross;
     return cross;
 }

@@ -172,6 +172,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
                                                                             : SPH_WALL_PRESSURE_PENALTY;
     prm->shepard_every = o->shepard_interval;
+    prm->shifting = o->shifting;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
     for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */

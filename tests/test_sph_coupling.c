@@ -146,6 +146,40 @@ int main(void)
         sph_fluid_free(&f);
         lahar_shape_free(&disc.shape);
     }
+    /* 3c. particle shifting next to a body: a block of water resting on the plate; the first row
+     * has neighbours only above it, so -A h^2 grad C points into the plate. That part is dropped:
+     * the row may shift along the plate, never towards it. */
+    {
+        sph_params prm = {0};
+        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.c0 = 10, prm.mu = MU, prm.shifting = 0.05;
+        char err[256];
+        if (sph_fluid_init(&f, &prm, 200, err, sizeof err) != 0)
+            abort();
+        double lo[3] = {0.05, 0.0, 0.0}, hi[3] = {0.15, 0.05, 0.0}, v0[3] = {0, 0, 0};
+        sph_particles_add_box(&f.p, 2, DX, RHO, lo, hi, v0);
+        for (int64_t i = 0; i < f.p.n; i++) /* a little disorder, so the rows also shift along the plate */
+            f.p.x[i] += 0.1 * DX * sin(37.0 * (double)i);
+        if (sph_fluid_attach_bodies(&f, 1, &plate) != 0)
+            abort();
+        double y0[200], x0[200];
+        for (int64_t i = 0; i < f.p.n; i++)
+            x0[f.p.id[i]] = f.p.x[i], y0[f.p.id[i]] = f.p.y[i];
+        sph_fluid_step(&f, 1e-8, NULL);
+        double worst_down = 0.0, along = 0.0;
+        int first_row = 0;
+        for (int64_t i = 0; i < f.p.n; i++) {
+            if (y0[f.p.id[i]] > DX)
+                continue;
+            first_row++;
+            worst_down = fmin(worst_down, f.p.y[i] - y0[f.p.id[i]]);
+            along = fmax(along, fabs(f.p.x[i] - x0[f.p.id[i]]));
+        }
+        CHECK(first_row == 10 && worst_down > -1e-12 * DX && along > 1e-6 * DX,
+              "shifting by the plate: %d first-row particles, largest move towards it %.3e m (0), largest along it "
+              "%.3e m (> 0)", first_row, -worst_down, along);
+        printf("shifting by a plate: first row moves along it up to %.3g dx, towards it %.1e m\n", along / DX, -worst_down);
+        sph_fluid_free(&f);
+    }
     /* 4. crossings */
     {
         double x[3] = {0.2, -0.002, 0}, v[3] = {0, 0, 0};
