@@ -269,29 +269,40 @@ static void run_fall(int threads, fall_state *out)
 /* Shepard filter (003 eq. 5): rho_i = sum_j m_j W_ij / sum_j (m_j / rho_j) W_ij (self included).
  * It keeps a uniform density exactly on any particle arrangement, equals this brute-force sum, and
  * smooths noise (the spread of rho - rho0 falls). */
-static void check_shepard(void)
+/* A 12 x 12 lattice of water (dx = 10 mm) in a 0.12 m cell periodic on both axes, every particle
+ * moved by up to +-jitter/2 dx; `shifting` as sph_params.shifting. Returns 0, or -1 (counted). */
+static int disordered_periodic_lattice(sph_fluid *f, double shifting, double jitter)
 {
     sph_params prm = {0};
     prm.dim = 2;
     prm.dx = 0.01;
     prm.rho0 = 1000;
     prm.c0 = 20;
+    prm.shifting = shifting;
     prm.periodic[0] = prm.periodic[1] = 1;
     prm.hi[0] = prm.hi[1] = 0.12;
-    sph_fluid f;
     char err[256];
-    if (sph_fluid_init(&f, &prm, 144, err, sizeof err) != 0) {
+    if (sph_fluid_init(f, &prm, 144, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         failures++;
-        return;
+        return -1;
     }
     double lo[3] = {0, 0, 0}, hi[3] = {0.12, 0.12, 0}, v0[3] = {0, 0, 0};
-    sph_particles_add_box(&f.p, 2, prm.dx, prm.rho0, lo, hi, v0);
-    sph_particles *p = &f.p;
-    for (int64_t i = 0; i < p->n; i++) {
-        p->x[i] += (urand() - 0.5) * 0.6 * prm.dx;
-        p->y[i] += (urand() - 0.5) * 0.6 * prm.dx;
+    sph_particles_add_box(&f->p, 2, prm.dx, prm.rho0, lo, hi, v0);
+    for (int64_t i = 0; i < f->p.n; i++) {
+        f->p.x[i] += (urand() - 0.5) * jitter * prm.dx;
+        f->p.y[i] += (urand() - 0.5) * jitter * prm.dx;
     }
+    return 0;
+}
+
+static void check_shepard(void)
+{
+    sph_fluid f;
+    if (disordered_periodic_lattice(&f, 0.0, 0.6) != 0)
+        return;
+    const sph_params prm = f.prm;
+    sph_particles *p = &f.p;
     if (sph_cells_sort(&f.cells, p) != 0)
         failures++;
     sph_fluid_shepard(&f);
@@ -362,29 +373,12 @@ static double shift_gradc(const sph_fluid *f, int64_t i, double L, double g[2])
 
 static void check_shifting(void)
 {
-    sph_params prm = {0};
-    prm.dim = 2;
-    prm.dx = 0.01;
-    prm.rho0 = 1000;
-    prm.c0 = 20;
-    prm.shifting = 0.05;
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = prm.hi[1] = 0.12;
     const double L = 0.12, dt = 1e-7;
     sph_fluid f;
-    char err[256];
-    if (sph_fluid_init(&f, &prm, 144, err, sizeof err) != 0) {
-        fprintf(stderr, "%s\n", err);
-        failures++;
+    if (disordered_periodic_lattice(&f, 0.05, 0.4) != 0)
         return;
-    }
-    double lo[3] = {0, 0, 0}, hi[3] = {L, L, 0}, v0[3] = {0, 0, 0};
-    sph_particles_add_box(&f.p, 2, prm.dx, prm.rho0, lo, hi, v0);
+    const sph_params prm = f.prm;
     sph_particles *p = &f.p;
-    for (int64_t i = 0; i < p->n; i++) {
-        p->x[i] += (urand() - 0.5) * 0.4 * prm.dx;
-        p->y[i] += (urand() - 0.5) * 0.4 * prm.dx;
-    }
     if (sph_cells_sort(&f.cells, p) != 0 || sph_fluid_rates(&f, NULL, dt) < 0)
         failures++;
     /* first step: the shift of every particle against the brute-force gradient */
