@@ -1781,6 +1781,14 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                       "lower the viscosity or dt_min, or raise dx", dt_v, c->dt_min);
         return;
     }
+    /* water and soil particles share space where they seep (000 section 2.3): a shift of the
+     * water by its own particles only would push it into the soil */
+    for (int b = 0; b < c->nblock && o->shifting > 0.0; b++)
+        if (c->blocks[b].phase == 1) {
+            rmap_fail(&m, "shifting", "is for water-only scenes, but block '%s' is soil (water shifted by its "
+                      "own particles would be pushed into the soil); remove shifting", c->blocks[b].name);
+            return;
+        }
     check_blocks_placement(r, bl, c);
 }
 
