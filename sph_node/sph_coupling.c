@@ -349,6 +349,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->body_start = calloc((size_t)nb + 1, sizeof *c->body_start);
     c->body_fill = calloc((size_t)nb, sizeof *c->body_fill);
     c->slot_n = calloc((size_t)c->pcap, sizeof *c->slot_n);
+    c->near = calloc((size_t)c->pcap, sizeof *c->near);
     c->slot_body = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot_body);
     c->slot = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
     c->contacts_cap = 1024;
@@ -429,6 +430,7 @@ void sph_coupling_free(sph_coupling *c)
     free(c->body_start);
     free(c->body_fill);
     free(c->slot_n);
+    free(c->near);
     free(c->slot_body);
     free(c->slot);
     free(c->contacts);
@@ -509,6 +511,53 @@ static int inside_core(const lahar_body *body, const double x[3], const double q
     return in;
 }
 
+void sph_coupling_mark(sph_coupling *c, const sph_cells *cells, int64_t n, const lahar_body_state *states)
+{
+    c->near_valid = 0;
+    if (!c->near || c->nbody >= 32 || c->periodic[0] || c->periodic[1] || c->periodic[2] || n > c->pcap ||
+        cells->periodic[0] || cells->periodic[1] || cells->periodic[2])
+        return;
+    memset(c->near, 0, (size_t)n * sizeof *c->near);
+    const double support = c->k.support;
+    const int d3 = cells->dim == 3;
+    for (int b = 0; b < c->nbody; b++) {
+        const lahar_body *body = &c->bodies[b];
+        const int fixed = body->motion == LAHAR_MOTION_FIXED;
+        const double *bx = !fixed && states ? states[b].x : body->x;
+        double lo[3], hi[3];
+        int all = 0;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (fixed ? c->box[b][a] : bx[a] - c->bound[b]) - support;
+            hi[a] = (fixed ? c->box[b][3 + a] : bx[a] + c->bound[b]) + support;
+            all |= !isfinite(lo[a]) || !isfinite(hi[a]);
+        }
+        const uint32_t bit = 1u << b;
+        if (all) { /* no finite box: every particle may be near it */
+            for (int64_t i = 0; i < n; i++)
+                c->near[i] |= bit;
+            continue;
+        }
+        /* the cells are bounded by the particles: a box that misses the grid marks nothing */
+        int miss = 0;
+        for (int a = 0; a < (d3 ? 3 : 2); a++)
+            miss |= hi[a] < cells->lo[a] || lo[a] > cells->lo[a] + cells->nc[a] * cells->size[a];
+        if (miss)
+            continue;
+        /* the cell of a coordinate is monotone in it (sph_cells_coord, clamped): a particle inside
+         * [lo, hi] along an axis lies in a cell between those of lo and hi */
+        const int x0 = sph_cells_coord(cells, 0, lo[0]), x1 = sph_cells_coord(cells, 0, hi[0]);
+        const int y0 = sph_cells_coord(cells, 1, lo[1]), y1 = sph_cells_coord(cells, 1, hi[1]);
+        const int z0 = d3 ? sph_cells_coord(cells, 2, lo[2]) : 0, z1 = d3 ? sph_cells_coord(cells, 2, hi[2]) : 0;
+        for (int z = z0; z <= z1; z++)
+            for (int y = y0; y <= y1; y++) {
+                const int64_t row = ((int64_t)z * cells->nc[1] + y) * cells->nc[0];
+                for (int64_t i = cells->start[row + x0]; i < cells->start[row + x1 + 1]; i++)
+                    c->near[i] |= bit;
+            }
+    }
+    c->near_valid = 1;
+}
+
 int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt)
 {
     const int64_t n = p->n;
@@ -520,6 +569,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
     if (n > c->pcap)
         return -1;
 
+    const int near_valid = c->near_valid && c->nbody < 32;
+    c->near_valid = 0; /* the marks serve this evaluation only */
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
         int ns = 0;
@@ -532,7 +583,10 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
         double gd[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
         vec3 gu[SPH_COUPLING_MAX_PER_PARTICLE];
+        const uint32_t near = near_valid ? c->near[i] : ~0u;
         for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
+            if (!(near >> b & 1u)) /* sph_coupling_mark: this body is out of reach */
+                continue;
             const lahar_body *body = &c->bodies[b];
             const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
             const double *bx = st ? st->x : body->x, *bq = st ? st->q : body->q;

@@ -105,6 +105,9 @@ typedef struct {
     /* per-particle slots of the parallel pass */
     int64_t pcap;
     int *slot_n;
+    uint32_t *near;            /* per particle: bit b set when body b may be within the support
+                                  (sph_coupling_mark; bodies < 32, no periodic axis) */
+    int near_valid;            /* near[] is for the particles as they are now (reset by apply) */
     int *slot_body;
     sph_contact *slot;
     /* results of the last evaluation, per body */
@@ -176,6 +179,14 @@ int sph_coupling_enable_soil(sph_coupling *c, double mu_phi);
  * (m/s^2) and the particle spacing dx; GHOST tabulates its integrals here (a fraction of a second
  * in 3D). Returns 0 or -1 (out of memory). */
 int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx);
+
+/* Before sph_coupling_apply, with the cells sorted for the particles' current positions: marks,
+ * per particle, the bodies whose box (fixed: the world box of the swept shape; moving: the
+ * bounding sphere's box at `states`), widened by the kernel support, overlaps the particle's
+ * cell, so that apply skips the others without testing them (a particle outside that box is
+ * farther than the support from the body: results unchanged). Does nothing (apply tests every
+ * body) with 32 bodies or more or a periodic axis. One apply uses the marks, then they lapse. */
+void sph_coupling_mark(sph_coupling *c, const sph_cells *cells, int64_t n, const lahar_body_state *states);
 
 /* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d);

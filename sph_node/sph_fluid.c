@@ -450,6 +450,7 @@ static int64_t fluid_rates_bodies(sph_fluid *f, const lahar_body_state *states, 
     const int64_t n = p->n;
     int64_t cross = 0;
     if (f->has_bodies) {
+        sph_coupling_mark(&f->cpl, &f->cells, n, states);
         cross = sph_coupling_apply(&f->cpl, p, states, dt);
         if (cross < 0)
             return -1;
