@@ -36,7 +36,9 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
     for (int a = 0; a < SPH_NSTRESS; a++) {
         ok &= (s->dsig[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
         ok &= (s->rart[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
+        ok &= (s->sig_rho2[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
     }
+    ok &= (s->tensile = calloc((size_t)s->cap, 1)) != NULL;
     if (!ok) {
         sph_soil_free(s);
         return -1;
@@ -47,7 +49,8 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
 void sph_soil_free(sph_soil *s)
 {
     for (int a = 0; a < SPH_NSTRESS; a++)
-        free(s->dsig[a]), free(s->rart[a]);
+        free(s->dsig[a]), free(s->rart[a]), free(s->sig_rho2[a]);
+    free(s->tensile);
     memset(s, 0, sizeof *s);
 }
 
@@ -178,8 +181,14 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
         own[a] = p->sig[a][i];
     double rart[SPH_NSTRESS];
     soil_artificial_stress(own, p->rho[i], rart);
-    for (int a = 0; a < SPH_NSTRESS; a++)
+    unsigned char tensile = 0;
+    const double irho2 = 1.0 / (p->rho[i] * p->rho[i]);
+    for (int a = 0; a < SPH_NSTRESS; a++) {
+        s->sig_rho2[a][i] = own[a] * irho2;
         s->rart[a][i] = rart[a];
+        tensile |= rart[a] != 0.0;
+    }
+    s->tensile[i] = tensile;
     p->p[i] = -m;
 }
 
@@ -202,12 +211,13 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
     const double eta2 = 0.01 * h * h, cs = s->cs, inv_wdx = 1.0 / s->w_dx;
     const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
-    const double rhoi = p->rho[i], irhoi2 = 1.0 / (rhoi * rhoi);
+    const double rhoi = p->rho[i];
     double si[SPH_NSTRESS], ri[SPH_NSTRESS];
     for (int a = 0; a < SPH_NSTRESS; a++) {
-        si[a] = p->sig[a][i] * irhoi2;
+        si[a] = s->sig_rho2[a][i];
         ri[a] = s->rart[a][i];
     }
+    const unsigned char tensile_i = s->tensile[i];
     double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
     const double seep = s->seep, wnorm = k->norm;
     int64_t nsoil = 0, nw = 0; /* work counters */
@@ -230,7 +240,7 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
         double q = r * inv_h;
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
         double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
-        double rhoj = p->rho[j], mj = p->m[j], irhoj2 = 1.0 / (rhoj * rhoj);
+        double rhoj = p->rho[j], mj = p->m[j];
         double vdotr = vx * rx + vy * ry + vz * rz;
         drho += rhoi * mj / rhoj * vdotr * fij; /* continuity without the delta term */
         double pi_ij = 0.0;
@@ -238,10 +248,15 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
             double mu = h * vdotr / (r2 + eta2);
             pi_ij = (-s->mat.av_alpha * cs * mu + s->mat.av_beta * mu * mu) / (0.5 * (rhoi + rhoj));
         }
-        double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
         double t[SPH_NSTRESS];
-        for (int a = 0; a < SPH_NSTRESS; a++)
-            t[a] = si[a] + p->sig[a][j] * irhoj2 + (ri[a] + s->rart[a][j]) * fn;
+        if (tensile_i | s->tensile[j]) { /* the artificial stress; pow is ~20 % of a soil step */
+            double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
+            for (int a = 0; a < SPH_NSTRESS; a++)
+                t[a] = si[a] + s->sig_rho2[a][j] + (ri[a] + s->rart[a][j]) * fn;
+        } else { /* R_i = R_j = 0 (no tension at either): the same sum without the zero term */
+            for (int a = 0; a < SPH_NSTRESS; a++)
+                t[a] = si[a] + s->sig_rho2[a][j];
+        }
         t[0] -= pi_ij, t[3] -= pi_ij, t[5] -= pi_ij;
         double mf = mj * fij; /* grad_i W_ij = F_ij x_ij */
         ax += mf * (t[0] * rx + t[1] * ry + t[2] * rz);

@@ -83,6 +83,9 @@ typedef struct {
     int64_t cap;
     double *dsig[SPH_NSTRESS];     /* stress rate of the last evaluation (sorted order) */
     double *rart[SPH_NSTRESS];     /* artificial stress R_i (already divided by rho_i^2) */
+    double *sig_rho2[SPH_NSTRESS]; /* sigma_i / rho_i^2 of the last evaluation (pass 1 for pass 2) */
+    unsigned char *tensile;        /* 1 where R_i != 0 (a principal stress in tension): the pairs
+                                    * where neither particle has one skip f_ij^n */
     double seep;                   /* rho_w g / k_h (kg/(m^3 s)), 0 without seepage (k_h = 0) */
 } sph_soil;
 
