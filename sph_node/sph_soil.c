@@ -39,6 +39,13 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
         ok &= (s->sig_rho2[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
     }
     ok &= (s->tensile = calloc((size_t)s->cap, 1)) != NULL;
+    /* soil neighbours of pass 1 for pass 2: room for 1.5 x the lattice's count plus 16 (a soil
+     * compressed beyond that walks the cells again, particle by particle) */
+    const double sr = k->support / dx;
+    const double nominal = dim == 3 ? 4.0 / 3.0 * M_PI * sr * sr * sr : M_PI * sr * sr;
+    s->nb_stride = (int)(1.5 * nominal) + 16;
+    ok &= (s->nb_n = calloc((size_t)s->cap, sizeof *s->nb_n)) != NULL;
+    ok &= (s->nb_j = malloc((size_t)s->cap * (size_t)s->nb_stride * sizeof *s->nb_j)) != NULL;
     if (!ok) {
         sph_soil_free(s);
         return -1;
@@ -51,6 +58,7 @@ void sph_soil_free(sph_soil *s)
     for (int a = 0; a < SPH_NSTRESS; a++)
         free(s->dsig[a]), free(s->rart[a]), free(s->sig_rho2[a]);
     free(s->tensile);
+    free(s->nb_n), free(s->nb_j);
     memset(s, 0, sizeof *s);
 }
 
@@ -122,16 +130,25 @@ static void soil_artificial_stress(const double sig[SPH_NSTRESS], double rho, do
             out[SYM[i][j]] = v[i][0] * r[0] * v[j][0] + v[i][1] * r[1] * v[j][1] + v[i][2] * r[2] * v[j][2];
 }
 
-static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int64_t i)
+static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int record,
+                                 int64_t i)
 {
     const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
     const kernel_kind kind = k->kind;
     const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
     double L[3][3] = {{0.0}}; /* L[a][b] = d v_a / d x_b */
+    int32_t *const list = record ? s->nb_j + (size_t)i * (size_t)s->nb_stride : NULL;
+    const int stride = s->nb_stride;
+    int nlist = 0;
     SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
         if (p->phase[j] != SPH_SOIL_PHASE)
             continue;
+        if (record) {
+            if (nlist < stride)
+                list[nlist] = (int32_t)j;
+            nlist++;
+        }
         double r = sqrt(r2);
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
         double w = p->m[j] / p->rho[j] * fij;
@@ -189,26 +206,76 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
         tensile |= rart[a] != 0.0;
     }
     s->tensile[i] = tensile;
+    if (record)
+        s->nb_n[i] = nlist <= stride ? nlist : -1;
     p->p[i] = -m;
+}
+
+/* Pass 2 may reuse pass 1's soil neighbours when it needs no others (no seepage: water
+ * neighbours are skipped) and x_i - x_j needs no periodic image (the walk's rx = (x_i - shift) -
+ * x_j would not be reproduced bit for bit): the same pairs in the same order, so the same bits. */
+static int soil_list_usable(const sph_soil *s, const sph_cells *c)
+{
+    return !(s->seep > 0.0) && !c->periodic[0] && !c->periodic[1] && !c->periodic[2] && s->cap < INT32_MAX;
 }
 
 void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
 {
     const int64_t n = p->n;
+    const int record = soil_list_usable(s, c);
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE)
-            soil_stress_particle(s, p, c, k, i);
+            soil_stress_particle(s, p, c, k, record, i);
+}
+
+/* The soil-soil pair (i, j) of pass 2 (sph_soil.h, momentum): continuity, stress divergence,
+ * artificial stress and viscosity, added to acc (drho, ax, ay, az). */
+static inline __attribute__((always_inline)) void soil_momentum_pair(const sph_soil *s, const sph_particles *p,
+                                                                     const kernel *k, const double si[SPH_NSTRESS],
+                                                                     const double ri[SPH_NSTRESS], int tensile_i,
+                                                                     double rhoi, double vxi, double vyi,
+                                                                     double vzi, int64_t j, double rx, double ry,
+                                                                     double rz, double r2, double acc[4])
+{
+    const double h = k->h, inv_h = k->inv_h, dnorm = k->dnorm;
+    const kernel_kind kind = k->kind;
+    const double eta2 = 0.01 * h * h, cs = s->cs, inv_wdx = 1.0 / s->w_dx;
+    double r = sqrt(r2);
+    double q = r * inv_h;
+    double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
+    double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
+    double rhoj = p->rho[j], mj = p->m[j];
+    double vdotr = vx * rx + vy * ry + vz * rz;
+    acc[0] += rhoi * mj / rhoj * vdotr * fij; /* continuity without the delta term */
+    double pi_ij = 0.0;
+    if (vdotr < 0.0) { /* Monaghan 1992 */
+        double mu = h * vdotr / (r2 + eta2);
+        pi_ij = (-s->mat.av_alpha * cs * mu + s->mat.av_beta * mu * mu) / (0.5 * (rhoi + rhoj));
+    }
+    double t[SPH_NSTRESS];
+    if (tensile_i | s->tensile[j]) { /* the artificial stress; pow is ~20 % of a soil step */
+        double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            t[a] = si[a] + s->sig_rho2[a][j] + (ri[a] + s->rart[a][j]) * fn;
+    } else { /* R_i = R_j = 0 (no tension at either): the same sum without the zero term */
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            t[a] = si[a] + s->sig_rho2[a][j];
+    }
+    t[0] -= pi_ij, t[3] -= pi_ij, t[5] -= pi_ij;
+    double mf = mj * fij; /* grad_i W_ij = F_ij x_ij */
+    acc[1] += mf * (t[0] * rx + t[1] * ry + t[2] * rz);
+    acc[2] += mf * (t[1] * rx + t[3] * ry + t[4] * rz);
+    acc[3] += mf * (t[2] * rx + t[4] * ry + t[5] * rz);
 }
 
 /* Returns the soil neighbours summed over; *nwater the water neighbours (seepage only). */
 static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
-                                      int64_t i, int64_t *nwater)
+                                      int use_list, int64_t i, int64_t *nwater)
 {
     const double *g = s->mat.gravity;
-    const double h = k->h, inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
+    const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
     const kernel_kind kind = k->kind;
-    const double eta2 = 0.01 * h * h, cs = s->cs, inv_wdx = 1.0 / s->w_dx;
     const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
     const double rhoi = p->rho[i];
@@ -217,57 +284,45 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
         si[a] = s->sig_rho2[a][i];
         ri[a] = s->rart[a][i];
     }
-    const unsigned char tensile_i = s->tensile[i];
-    double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
+    const int tensile_i = s->tensile[i];
+    double acc[4] = {0.0, 0.0, 0.0, 0.0}; /* drho, ax, ay, az */
     const double seep = s->seep, wnorm = k->norm;
     int64_t nsoil = 0, nw = 0; /* work counters */
-    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
-        if (p->phase[j] != SPH_SOIL_PHASE) {
-            if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
-                nw++;
-                double r = sqrt(r2), q = r * inv_h;
-                double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
-                double c1 = p->m[j] / (p->rho[j] * rhoi);
-                double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = -c1 * p->p[j] * fij;
-                ax += sw * (p->vx[j] - vxi) + pw * rx;
-                ay += sw * (p->vy[j] - vyi) + pw * ry;
-                az += sw * (p->vz[j] - vzi) + pw * rz;
+    const int nlist = use_list ? s->nb_n[i] : -1;
+    if (nlist >= 0) { /* pass 1's soil neighbours, in its order (soil_list_usable) */
+        const int32_t *const list = s->nb_j + (size_t)i * (size_t)s->nb_stride;
+        const int dim3 = k->dim == 3;
+        for (int m = 0; m < nlist; m++) {
+            const int64_t j = list[m];
+            const double rx = xi - p->x[j], ry = yi - p->y[j], rz = dim3 ? zi - p->z[j] : 0.0;
+            const double r2 = rx * rx + ry * ry + rz * rz;
+            soil_momentum_pair(s, p, k, si, ri, tensile_i, rhoi, vxi, vyi, vzi, j, rx, ry, rz, r2, acc);
+        }
+        nsoil = nlist;
+    } else {
+        SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+            if (p->phase[j] != SPH_SOIL_PHASE) {
+                if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
+                    nw++;
+                    double r = sqrt(r2), q = r * inv_h;
+                    double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
+                    double c1 = p->m[j] / (p->rho[j] * rhoi);
+                    double sw = c1 * seep * wnorm * kernel_shape(kind, q), pw = -c1 * p->p[j] * fij;
+                    acc[1] += sw * (p->vx[j] - vxi) + pw * rx;
+                    acc[2] += sw * (p->vy[j] - vyi) + pw * ry;
+                    acc[3] += sw * (p->vz[j] - vzi) + pw * rz;
+                }
+                continue;
             }
-            continue;
-        }
-        nsoil++;
-        double r = sqrt(r2);
-        double q = r * inv_h;
-        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;
-        double vx = vxi - p->vx[j], vy = vyi - p->vy[j], vz = vzi - p->vz[j];
-        double rhoj = p->rho[j], mj = p->m[j];
-        double vdotr = vx * rx + vy * ry + vz * rz;
-        drho += rhoi * mj / rhoj * vdotr * fij; /* continuity without the delta term */
-        double pi_ij = 0.0;
-        if (vdotr < 0.0) { /* Monaghan 1992 */
-            double mu = h * vdotr / (r2 + eta2);
-            pi_ij = (-s->mat.av_alpha * cs * mu + s->mat.av_beta * mu * mu) / (0.5 * (rhoi + rhoj));
-        }
-        double t[SPH_NSTRESS];
-        if (tensile_i | s->tensile[j]) { /* the artificial stress; pow is ~20 % of a soil step */
-            double fn = pow(k->norm * kernel_shape(kind, q) * inv_wdx, SPH_SOIL_AS_N);
-            for (int a = 0; a < SPH_NSTRESS; a++)
-                t[a] = si[a] + s->sig_rho2[a][j] + (ri[a] + s->rart[a][j]) * fn;
-        } else { /* R_i = R_j = 0 (no tension at either): the same sum without the zero term */
-            for (int a = 0; a < SPH_NSTRESS; a++)
-                t[a] = si[a] + s->sig_rho2[a][j];
-        }
-        t[0] -= pi_ij, t[3] -= pi_ij, t[5] -= pi_ij;
-        double mf = mj * fij; /* grad_i W_ij = F_ij x_ij */
-        ax += mf * (t[0] * rx + t[1] * ry + t[2] * rz);
-        ay += mf * (t[1] * rx + t[3] * ry + t[4] * rz);
-        az += mf * (t[2] * rx + t[4] * ry + t[5] * rz);
-    });
-    p->drho[i] = drho;
+            nsoil++;
+            soil_momentum_pair(s, p, k, si, ri, tensile_i, rhoi, vxi, vyi, vzi, j, rx, ry, rz, r2, acc);
+        });
+    }
+    p->drho[i] = acc[0];
     const double cd = s->mat.damping;
-    p->ax[i] = ax + g[0] - cd * vxi;
-    p->ay[i] = ay + g[1] - cd * vyi;
-    p->az[i] = az + g[2] - cd * vzi;
+    p->ax[i] = acc[1] + g[0] - cd * vxi;
+    p->ay[i] = acc[2] + g[1] - cd * vyi;
+    p->az[i] = acc[3] + g[2] - cd * vzi;
     *nwater = nw;
     return nsoil;
 }
@@ -276,12 +331,13 @@ int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *
                           int64_t *water_neighbours)
 {
     const int64_t n = p->n;
+    const int use_list = soil_list_usable(s, c);
     int64_t nsoil = 0, nwater = 0; /* integer sums: exact in any order */
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) reduction(+ : nsoil, nwater) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE) {
             int64_t nw = 0;
-            nsoil += soil_momentum_particle(s, p, c, k, i, &nw);
+            nsoil += soil_momentum_particle(s, p, c, k, use_list, i, &nw);
             nwater += nw;
         }
     *water_neighbours = nwater;

@@ -84,6 +84,11 @@ typedef struct {
     double *dsig[SPH_NSTRESS];     /* stress rate of the last evaluation (sorted order) */
     double *rart[SPH_NSTRESS];     /* artificial stress R_i (already divided by rho_i^2) */
     double *sig_rho2[SPH_NSTRESS]; /* sigma_i / rho_i^2 of the last evaluation (pass 1 for pass 2) */
+    int nb_stride;                 /* room per particle in nb_j */
+    int32_t *nb_n;                 /* soil neighbours of each soil particle found by pass 1 (-1: more
+                                    * than nb_stride; 0 where pass 1 did not record) */
+    int32_t *nb_j;                 /* their indices, nb_stride per particle, in the walk's order:
+                                    * pass 2 sums over them instead of walking the cells again */
     unsigned char *tensile;        /* 1 where R_i != 0 (a principal stress in tension): the pairs
                                     * where neither particle has one skip f_ij^n */
     double seep;                   /* rho_w g / k_h (kg/(m^3 s)), 0 without seepage (k_h = 0) */
