@@ -17,7 +17,10 @@
  *  7. soil-DEM friction (000 eq. 22-27) of soil particles sliding on a fixed plate: after one
  *     evaluation F_t = -K_n dt u_tau (to 1e-12), the body takes -F; after enough evaluations the
  *     spring is capped, |F_t| = mu_phi |F_n|; the spring follows its particle id through a sort that
- *     swaps the particles; leaving the halo releases it (a new contact starts from dt u again). */
+ *     swaps the particles; leaving the halo releases it (a new contact starts from dt u again).
+ *  8. pass 2 over pass 1's neighbour list (sph_soil.nb_j) gives the same bits as the cell walk
+ *     (the fallback of a particle whose list overflowed), with stresses in tension at some
+ *     particles so the artificial stress takes part. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -315,6 +318,58 @@ static void test_friction(void)
     lahar_shape_free(&plate.shape);
 }
 
+static void test_list_equals_walk(void)
+{
+    const double L[2][2] = {{2e-3, 7e-4}, {-5e-4, -1e-3}}, zero[6] = {0};
+    sph_fluid f;
+    if (soil_lattice(&f, 13, L, zero) < 0) {
+        sph_fluid_free(&f);
+        return;
+    }
+    sph_particles *p = &f.p;
+    const int64_t n = p->n;
+    /* a stress varying from particle to particle, in tension (xx > 0) at every third, and a
+     * velocity that is not linear */
+    for (int64_t i = 0; i < n; i++) {
+        double x = p->x[i], y = p->y[i];
+        p->sig[0][i] = (i % 3 == 0 ? 300.0 : -800.0) - 2e4 * y;
+        p->sig[1][i] = 150.0 * sin(40.0 * x);
+        p->sig[3][i] = -1200.0 - 1e4 * x;
+        p->sig[5][i] = -900.0;
+        p->vx[i] += 1e-3 * sin(90.0 * y);
+        p->vy[i] += 1e-3 * cos(70.0 * x);
+    }
+    sph_fluid_rates(&f, NULL, 1e-5);
+    int64_t listed = 0, tensile = 0;
+    for (int64_t i = 0; i < n; i++)
+        listed += f.soil.nb_n[i] > 0, tensile += f.soil.tensile[i];
+    CHECK(listed == n && tensile > 0, "neighbour list: %lld of %lld particles listed, %lld in tension", (long long)listed,
+          (long long)n, (long long)tensile);
+    double *ref = malloc((size_t)n * 4 * sizeof(double));
+    if (!ref) {
+        sph_fluid_free(&f);
+        return;
+    }
+    memcpy(ref, p->ax, (size_t)n * sizeof(double));
+    memcpy(ref + n, p->ay, (size_t)n * sizeof(double));
+    memcpy(ref + 2 * n, p->az, (size_t)n * sizeof(double));
+    memcpy(ref + 3 * n, p->drho, (size_t)n * sizeof(double));
+    for (int64_t i = 0; i < n; i++)
+        f.soil.nb_n[i] = -1; /* as if every list had overflowed: pass 2 walks the cells */
+    int64_t nwater = 0;
+    sph_soil_momentum(&f.soil, p, &f.cells, &f.k, &nwater);
+    int same = memcmp(ref, p->ax, (size_t)n * sizeof(double)) == 0 &&
+               memcmp(ref + n, p->ay, (size_t)n * sizeof(double)) == 0 &&
+               memcmp(ref + 2 * n, p->az, (size_t)n * sizeof(double)) == 0 &&
+               memcmp(ref + 3 * n, p->drho, (size_t)n * sizeof(double)) == 0;
+    CHECK(same, "pass 2 over the neighbour list differs from the cell walk");
+    if (same)
+        printf("neighbour list: pass 2 bitwise equal to the cell walk (%lld particles, %lld in tension)\n",
+           (long long)n, (long long)tensile);
+    free(ref);
+    sph_fluid_free(&f);
+}
+
 int main(void)
 {
     test_return();
@@ -323,6 +378,7 @@ int main(void)
     test_water_only();
     test_seepage();
     test_friction();
+    test_list_equals_walk();
     if (failures)
         fprintf(stderr, "%d check(s) failed\n", failures);
     return failures != 0;
