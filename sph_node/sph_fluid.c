@@ -341,9 +341,9 @@ static void fluid_shift(sph_fluid *f)
         double gx = 0.0, gy = 0.0, gz = 0.0;
         if (p->phase[i] == 0) {
             SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
-                if (p->phase[j] != 0)
+                if (p->phase[j] != 0 || !(r2 > 0.0)) /* coincident: no direction (and W'(0)/0) */
                     continue;
-                const double fv = f->vol[j] * kernel_dwdr(k, sqrt(r2)) / sqrt(r2);
+                const double r = sqrt(r2), fv = f->vol[j] * kernel_dwdr(k, r) / r;
                 gx += fv * rx, gy += fv * ry, gz += fv * rz;
             });
         }
