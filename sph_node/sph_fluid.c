@@ -416,7 +416,7 @@ static void fluid_rates_particles(sph_fluid *f)
     if (prm.sps)
         fluid_sps_pass(f);
     if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
-        sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k);
+        sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k, f->vol);
     fluid_pass(f);
     if (f->has_soil) {
         int64_t soil_water = 0;

@@ -130,8 +130,8 @@ static void soil_artificial_stress(const double sig[SPH_NSTRESS], double rho, do
             out[SYM[i][j]] = v[i][0] * r[0] * v[j][0] + v[i][1] * r[1] * v[j][1] + v[i][2] * r[2] * v[j][2];
 }
 
-static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, int record,
-                                 int64_t i)
+static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                                 const double *vol, int record, int64_t i)
 {
     const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
     const kernel_kind kind = k->kind;
@@ -151,7 +151,7 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
         }
         double r = sqrt(r2);
         double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
-        double w = p->m[j] / p->rho[j] * fij;
+        double w = vol[j] * fij;
         double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
         double xr[3] = {rx, ry, rz};
         for (int a = 0; a < 3; a++)
@@ -219,14 +219,14 @@ static int soil_list_usable(const sph_soil *s, const sph_cells *c)
     return !(s->seep > 0.0) && !c->periodic[0] && !c->periodic[1] && !c->periodic[2] && s->cap < INT32_MAX;
 }
 
-void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k)
+void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, const double *vol)
 {
     const int64_t n = p->n;
     const int record = soil_list_usable(s, c);
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++)
         if (p->phase[i] == SPH_SOIL_PHASE)
-            soil_stress_particle(s, p, c, k, record, i);
+            soil_stress_particle(s, p, c, k, vol, record, i);
 }
 
 /* The soil-soil pair (i, j) of pass 2 (sph_soil.h, momentum): continuity, stress divergence,

@@ -103,8 +103,9 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
 void sph_soil_free(sph_soil *s);
 
 /* Pass 1 (before the momentum pass): per soil particle, the stress rate, the artificial stress and
- * p = -tr(sigma)/3. Particles sorted, cells valid. */
-void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
+ * p = -tr(sigma)/3. Particles sorted, cells valid; vol[j] = m_j / rho_j of every particle (the
+ * fluid's, filled with its EOS). */
+void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k, const double *vol);
 /* Pass 2: per soil particle, drho/dt and dv/dt (with the material's gravity) into p->drho, ax, ay,
  * az. Water particles are left alone. Returns the soil neighbours (i, j) within the support summed
  * over (work counter, each soil-soil pair twice) and the water neighbours of the soil particles in
