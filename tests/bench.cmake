@@ -8,7 +8,7 @@ if(NOT LAHAR_BENCH_PYTHON)
   find_program(LAHAR_BENCH_PYTHON python3)
 endif()
 set(LAHAR_BENCH_OUT ${CMAKE_CURRENT_BINARY_DIR}/bench_quick)
-set(LAHAR_BENCH_QUICK_CASES poiseuille_2d,dam_break_2d)
+set(LAHAR_BENCH_QUICK_CASES poiseuille_2d,dam_break_2d,soil_block_incline_2d)
 add_test(NAME bench_quick
   COMMAND sh -c "rm -rf \"$1\" && \"$0\" bench --quick --cases $3 -o \"$1\" && \"$2\" \"$4\" \"$1\" pareto,overhead,subcycle $3"
           $<TARGET_FILE:lahar> ${LAHAR_BENCH_OUT} ${LAHAR_BENCH_PYTHON} ${LAHAR_BENCH_QUICK_CASES}

@@ -11,6 +11,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
 import bench  # noqa: E402  (the column list and error definitions under test)
+import case_override  # noqa: E402
 
 failures = []
 
@@ -68,6 +69,12 @@ def check_case(out, name):
         want = max(vals[k] for k in bench.BENCH[name]["error"])
         check(math.isclose(num(r["error"]), want, rel_tol=1e-5) and 0.0 <= want < 10.0,
               f"{lab}: error {r['error']} = max of check.json {bench.BENCH[name]['error']} ({want:.6g})")
+        # a soil setting reached the case's own soil material (bench.SOIL_SETTINGS, `{soil}`)
+        if r["family"] == "soil_av":
+            case = case_override.load_case(os.path.join(out, "runs", name, r["label"] + ".yaml"))
+            mat = case["materials"][bench.BENCH[name]["soil"]]
+            check(mat.get("av_alpha") == 1.0 and mat.get("av_beta") == 1.0,
+                  f"{lab}: the copy's soil material has the paper's av_alpha, av_beta = 1, 1 ({mat})")
         # the copy has the run's dx: the particle count follows the lattice, n ~ dx^-D
         ref = min(base, key=lambda b: num(b["dx"]))
         if r["family"] == "base" and r is not ref:

@@ -8,7 +8,9 @@ usage: lahar bench -o OUT [--quick] [--sections pareto,overhead,subcycle] [--cas
 Sections (default: all three):
   pareto    every validation case at >= 4 resolutions (the case's settings) plus one-at-a-time
             changes of the settings that trade speed for accuracy (kernel, CFL number, delta-SPH,
-            artificial sound speed c0) at two resolutions; each run is `lahar check --in-process`
+            artificial sound speed c0; for soil the artificial viscosity: lahar's 0.1, 0 against
+            the paper's 1, 1; only the settings that mean something for the scene) at two
+            resolutions; each run is `lahar check --in-process`
             on a copy of the case (tools/case_override.py) with a shorter time.end. Writes
             OUT/<case>.csv, OUT/<case>_pareto.png (error against wall time, Pareto front drawn) and
             OUT/summary.md (the cheapest setting within a stated error per case).
@@ -20,7 +22,7 @@ Sections (default: all three):
             (time.dt_max = dt_stable): OUT/subcycle.csv, .md.
 --quick: 2 resolutions and few settings per case, overhead and subcycle at small sizes (a smoke
 test of the tool, about 1-3 min; the numbers are not the benchmark's). The default run needs
-about 780 s of CPU (7-15 min on 2 idle cores).
+about 840 s of CPU for the pareto section (7-15 min on 2 idle cores).
 Speed figures are wall times on whatever machine runs this: on a shared or loaded machine they
 are noisy (each row records the load average at its start and the CPU time used).
 Exit status: 0 done (runs that fail are recorded in the CSV with their exit status), 2 bad
@@ -63,7 +65,13 @@ SETTINGS = [
     ("c0", "x0.5", {"sph.c0": 0.5}),
     ("c0", "x2", {"sph.c0": 2.0}),
 ]
-QUICK_SETTINGS = ["kernel=wendland2", "cfl=0.4"]
+QUICK_SETTINGS = ["kernel=wendland2", "cfl=0.4", "soil_av=paper"]
+# The soil's own trade (Drucker-Prager SPH, sph_node/sph_soil.h): lahar's default artificial
+# viscosity alpha = 0.1, beta = 0 against the paper's alpha = beta = 1 (000 section 5.3);
+# `{soil}` is replaced by the name of the case's soil material.
+SOIL_SETTINGS = [
+    ("soil_av", "paper", {"materials.{soil}.av_alpha": 1.0, "materials.{soil}.av_beta": 1.0}),
+]
 
 BENCH = {
     "poiseuille_2d": dict(
@@ -75,7 +83,7 @@ BENCH = {
         file="cylinder_array_2d.yaml", overrides={},
         dx=[0.2 / 20, 0.2 / 25, 0.2 / 32, 0.2 / 40], vary_at=[0, 1],
         error=["K_rel_error"], target=0.05,
-        error_note="K against Sangani & Acrivos at c = 0.1 after the case's 100 s"),
+        error_note="K against Sangani & Acrivos at c = 0.1 after the case's 200 s (with its particle shifting)"),
     "hydrostatic_2d": dict(
         file="hydrostatic_2d.yaml", overrides={"time.end": 1.0},
         dx=[0.02, 0.0125, 0.01, 0.0075, 0.005], vary_at=[1, 2],
@@ -94,6 +102,23 @@ BENCH = {
         error=["front_rel_error"], target=0.15,
         error_note="surge front against Martin & Moyce 1952 (n^2 = 2; column 0.1 x 0.25 x 0.2 m instead of the "
                    "case's 0.3 m wide one), t <= 0.35 s"),
+    # soil cases (issue 5): `families` names the settings that mean something for the scene (the
+    # soil has no delta-SPH and no c0: its sound speed is the P-wave speed of its material)
+    "soil_geostatic_2d": dict(
+        file="soil_geostatic_2d.yaml", overrides={}, soil="sand",  # the 0.1 m period needs dx <= 0.0128
+        dx=[0.1 / 8, 0.1 / 10, 0.1 / 20, 0.1 / 40], vary_at=[1, 2], families=["kernel", "cfl", "soil_av"],
+        error=["sigma_v_rel_error", "K0_rel_error", "creep_rel"], target=0.05,
+        error_note="max(sigma_v against rho g z, K0 against nu/(1-nu), creep) of the soil at rest, 1 s"),
+    "soil_block_incline_2d": dict(
+        file="soil_block_incline_2d.yaml", overrides={}, soil="block",
+        dx=[0.01, 0.005, 0.0025, 0.00125], vary_at=[0, 1], families=["kernel", "cfl", "soil_av"],
+        error=["accel_rel_error"], target=0.05,
+        error_note="sliding block's acceleration against g (sin theta - mu_phi cos theta) (000 eq. 22-27)"),
+    "darcy_column_2d": dict(
+        file="darcy_column_2d.yaml", overrides={}, soil="skeleton",
+        dx=[0.1 / 8, 0.1 / 10, 0.1 / 20, 0.1 / 40], vary_at=[1, 2], families=["kernel", "cfl", "delta", "c0", "soil_av"],
+        error=["darcy_velocity_rel_error"], target=0.05,
+        error_note="water's velocity through the soil against Darcy k_h i (000 eq. 8-10)"),
 }
 QUICK = {
     "poiseuille_2d": dict(dx=[0.1 / 10, 0.1 / 16], vary_at=[0], overrides={"time.end": 10.0}),
@@ -102,6 +127,9 @@ QUICK = {
     "dam_break_2d": dict(dx=[0.1 / 10, 0.1 / 14], vary_at=[0], overrides={"time.end": 0.25}),
     "dam_break_3d": dict(dx=[0.1 / 3, 0.1 / 4], vary_at=[0],
                          overrides={"time.end": 0.2, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]}),
+    "soil_geostatic_2d": dict(dx=[0.1 / 8, 0.1 / 10], vary_at=[0], overrides={"time.end": 0.3}),
+    "soil_block_incline_2d": dict(dx=[0.01, 0.005], vary_at=[0], overrides={}),
+    "darcy_column_2d": dict(dx=[0.1 / 8, 0.1 / 10], vary_at=[0], overrides={"time.end": 0.05}),
 }
 
 COST_KEY = {"wall": "wall_s", "cpu": "cpu_s"}
@@ -234,12 +262,17 @@ def plan_case(name, spec, quick):
     c0 = case_override.get_path(doc, "sph.c0")
     for i, dx in enumerate(spec["dx"]):
         runs.append((f"base_dx{dx:.5g}", "base", "case", dx, {}))
+    families = spec.get("families")
     for i in spec["vary_at"]:
         dx = spec["dx"][i]
-        for family, value, ov in SETTINGS:
+        for family, value, ov in SETTINGS + SOIL_SETTINGS:
+            if families is None and family in (f for f, _, _ in SOIL_SETTINGS):
+                continue  # a water case: no soil to set
+            if families is not None and family not in families:
+                continue
             if quick and f"{family}={value}" not in QUICK_SETTINGS:
                 continue
-            ov = dict(ov)
+            ov = {k.replace("{soil}", spec.get("soil", "")): v for k, v in ov.items()}
             if family == "c0":
                 if not isinstance(c0, (int, float)):
                     continue
@@ -340,8 +373,8 @@ def plot_pareto(path, name, spec, rows, cost="wall_s"):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=90)
-    markers = {"base": "o", "kernel": "s", "cfl": "^", "delta": "D", "c0": "v"}
-    fam_order = ["base", "kernel", "cfl", "delta", "c0"]
+    markers = {"base": "o", "kernel": "s", "cfl": "^", "delta": "D", "c0": "v", "soil_av": "P"}
+    fam_order = ["base", "kernel", "cfl", "delta", "c0", "soil_av"]
     for fam in fam_order:
         for setting in sorted({r["setting"] for r in rows if r["family"] == fam}):
             pts = [r for r in rows if r["family"] == fam and r["setting"] == setting
