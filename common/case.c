@@ -1451,7 +1451,10 @@ static void read_periodic(reader *r, yaml_node_t *n, lahar_sph_options *o)
 }
 
 /* Characteristic speed for the default c0: the free-fall speed over the fluid's height under
- * gravity + body force, or the fastest initial velocity. */
+ * gravity + body force, the fastest initial velocity of a block, or the fastest point of a
+ * moving body at t = 0 (|v| + |w| times its farthest core vertex plus its sweep radius): a body
+ * faster than the water's sound speed outruns its pressure waves and crosses it (README,
+ * "Stability limits": a 20 m/s boulder needs c0 >= 40 m/s). */
 static double sph_reference_speed(const lahar_case *c)
 {
     double g = 0, vmax = 0, lo = INFINITY, hi = -INFINITY;
@@ -1464,6 +1467,19 @@ static double sph_reference_speed(const lahar_case *c)
         /* height: extent along the vertical axis (y in 2D, z in 3D) */
         lo = fmin(lo, b->lo[c->dim - 1]);
         hi = fmax(hi, b->hi[c->dim - 1]);
+    }
+    for (int i = 0; i < c->nbody; i++) {
+        const lahar_body *bd = &c->bodies[i];
+        if (bd->motion == LAHAR_MOTION_FIXED)
+            continue;
+        double reach = 0.0;
+        for (int k = 0; k < bd->shape.nv; k++)
+            reach = fmax(reach, sqrt(bd->shape.v[k][0] * bd->shape.v[k][0] + bd->shape.v[k][1] * bd->shape.v[k][1] +
+                                     bd->shape.v[k][2] * bd->shape.v[k][2]));
+        reach += bd->shape.radius;
+        double v = sqrt(bd->v[0] * bd->v[0] + bd->v[1] * bd->v[1] + bd->v[2] * bd->v[2]),
+               w = sqrt(bd->w[0] * bd->w[0] + bd->w[1] * bd->w[1] + bd->w[2] * bd->w[2]);
+        vmax = fmax(vmax, v + w * reach);
     }
     double H = hi > lo ? hi - lo : 0.0;
     return fmax(sqrt(2.0 * g * H), vmax);

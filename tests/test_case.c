@@ -605,6 +605,49 @@ static void test_cases_dir(const char *dir)
     }
 }
 
+/* The default c0 (10 U_ref) counts the moving bodies: a 20 m/s boulder into still, shallow water
+ * (free fall over 0.5 m: 3.1 m/s) must give c0 = 200 m/s, not 31 (README "Stability limits": a
+ * body faster than c0 outruns the water's pressure wave and crosses it). A spinning disc counts
+ * its rim: |w| (r_core + radius). Fixed bodies do not count. */
+static void test_default_c0_bodies(const char *tmpdir)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/c0_bodies.yaml", tmpdir);
+    FILE *fp = fopen(path, "w");
+    if (!fp) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(fp, "dimensions: 2\ntime: {end: 0.1}\n"
+                "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                "bodies:\n"
+                "  - {name: floor, shape: box, size: [4, 0.1], radius: 0.01, motion: fixed, material: rock,\n"
+                "     position: [0, -0.06]}\n"
+                "  - {name: boulder, shape: disc, radius: 0.2, material: rock, position: [-1, 1], velocity: [20, 0]}\n"
+                "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 30}\n"
+                "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n");
+    fclose(fp);
+    lahar_case c;
+    CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
+    CHECK(fabs(c.sph.c0 - 200.0) < 1e-9, "default c0 with a 20 m/s boulder: %g m/s (expected 200)", c.sph.c0);
+    lahar_case_free(&c);
+    fp = fopen(path, "w");
+    if (!fp) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(fp, "dimensions: 2\ntime: {end: 0.1}\n"
+                "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                "bodies:\n"
+                "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 60}\n"
+                "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n");
+    fclose(fp);
+    CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
+    /* a disc is a point core swept by its radius: rim speed 60 x 0.1 = 6 m/s > sqrt(2 g 0.5) */
+    CHECK(fabs(c.sph.c0 - 60.0) < 1e-9, "default c0 with a disc spinning at 60 rad/s: %g m/s (expected 60)", c.sph.c0);
+    lahar_case_free(&c);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 3) {
@@ -620,6 +663,7 @@ int main(int argc, char **argv)
     test_rock_grid();
     test_stl(argv[2]);
     test_loader_misc(argv[2]);
+    test_default_c0_bodies(argv[2]);
     test_cases_dir(argv[1]);
     printf("%d checks, %d failures\n", checks, failures);
     return failures ? 1 : 0;
