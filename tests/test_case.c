@@ -443,25 +443,33 @@ static void test_stl(const char *tmpdir)
     CHECK(lahar_shape_read_stl(&s, path, 0.01, err, sizeof err) != 0 && strstr(err, path), "missing STL named: %s", err);
 }
 
+/* Writes text to path; 0, or -1 (counted as a failure) when the file cannot be written. */
+static int write_text(const char *path, const char *text)
+{
+    FILE *fp = fopen(path, "w");
+    if (!fp || fputs(text, fp) < 0) {
+        CHECK(0, "cannot write %s", path);
+        if (fp)
+            fclose(fp);
+        return -1;
+    }
+    return fclose(fp) == 0 ? 0 : -1;
+}
+
 /* Loader paths not covered by cases/: STL body (path relative to the case, scale, placement),
  * prescribed body, defaults, 2D polygon/box with orientation. Runs after test_stl (cube.stl). */
 static void test_loader_misc(const char *tmpdir)
 {
     char path[1024];
     snprintf(path, sizeof path, "%s/misc3d.yaml", tmpdir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) {
-        CHECK(0, "cannot write %s", path);
+    if (write_text(path, "dimensions: 3\ntime: {end: 2.0}\n"
+                         "materials: {rock: {density: 1000, young: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                         "bodies:\n"
+                         "  - {name: terrain, shape: stl, file: cube.stl, scale: 2, motion: fixed, radius: 0.01,\n"
+                         "     material: rock, position: [10, 0, 0], orientation: {axis: [0, 0, 1], angle_deg: 90}}\n"
+                         "  - {name: gate, shape: box, size: [0.2, 0.2, 0.2], radius: 0.01, motion: prescribed,\n"
+                         "     material: rock, position: [0, 0, 5], velocity: [0, 0, 0.1]}\n") != 0)
         return;
-    }
-    fprintf(fp, "dimensions: 3\ntime: {end: 2.0}\n"
-                "materials: {rock: {density: 1000, young: 1e8, restitution: 0.5, friction: 0.5}}\n"
-                "bodies:\n"
-                "  - {name: terrain, shape: stl, file: cube.stl, scale: 2, motion: fixed, radius: 0.01,\n"
-                "     material: rock, position: [10, 0, 0], orientation: {axis: [0, 0, 1], angle_deg: 90}}\n"
-                "  - {name: gate, shape: box, size: [0.2, 0.2, 0.2], radius: 0.01, motion: prescribed,\n"
-                "     material: rock, position: [0, 0, 5], velocity: [0, 0, 0.1]}\n");
-    fclose(fp);
     lahar_case c;
     CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
     if (c.nbody == 2) {
@@ -489,19 +497,14 @@ static void test_loader_misc(const char *tmpdir)
     lahar_case_free(&c);
 
     snprintf(path, sizeof path, "%s/misc2d.yaml", tmpdir);
-    fp = fopen(path, "w");
-    if (!fp) {
-        CHECK(0, "cannot write %s", path);
+    if (write_text(path, "dimensions: 2\ntime: {end: 1.0}\n"
+                         "materials: {rock: {density: 2000, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
+                         "bodies:\n"
+                         "  - {name: tri, shape: polygon, radius: 0.01, material: rock, position: [1, 1],\n"
+                         "     vertices: [[0, 0], [0.3, 0], [0, 0.3], [0.05, 0.05]], angular_velocity: 2}\n"
+                         "  - {name: slab, shape: box, size: [0.4, 0.1], radius: 0.01, material: rock, position: [0, 0],\n"
+                         "     orientation: {angle_deg: 30}}\n") != 0)
         return;
-    }
-    fprintf(fp, "dimensions: 2\ntime: {end: 1.0}\n"
-                "materials: {rock: {density: 2000, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
-                "bodies:\n"
-                "  - {name: tri, shape: polygon, radius: 0.01, material: rock, position: [1, 1],\n"
-                "     vertices: [[0, 0], [0.3, 0], [0, 0.3], [0.05, 0.05]], angular_velocity: 2}\n"
-                "  - {name: slab, shape: box, size: [0.4, 0.1], radius: 0.01, material: rock, position: [0, 0],\n"
-                "     orientation: {angle_deg: 30}}\n");
-    fclose(fp);
     CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
     if (c.nbody == 2) {
         const lahar_body *t = &c.bodies[0], *s = &c.bodies[1];
@@ -613,35 +616,25 @@ static void test_default_c0_bodies(const char *tmpdir)
 {
     char path[1024];
     snprintf(path, sizeof path, "%s/c0_bodies.yaml", tmpdir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) {
-        CHECK(0, "cannot write %s", path);
+    if (write_text(path, "dimensions: 2\ntime: {end: 0.1}\n"
+                         "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                         "bodies:\n"
+                         "  - {name: floor, shape: box, size: [4, 0.1], radius: 0.01, motion: fixed, material: rock,\n"
+                         "     position: [0, -0.06]}\n"
+                         "  - {name: boulder, shape: disc, radius: 0.2, material: rock, position: [-1, 1], velocity: [20, 0]}\n"
+                         "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 30}\n"
+                         "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n") != 0)
         return;
-    }
-    fprintf(fp, "dimensions: 2\ntime: {end: 0.1}\n"
-                "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
-                "bodies:\n"
-                "  - {name: floor, shape: box, size: [4, 0.1], radius: 0.01, motion: fixed, material: rock,\n"
-                "     position: [0, -0.06]}\n"
-                "  - {name: boulder, shape: disc, radius: 0.2, material: rock, position: [-1, 1], velocity: [20, 0]}\n"
-                "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 30}\n"
-                "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n");
-    fclose(fp);
     lahar_case c;
     CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
     CHECK(fabs(c.sph.c0 - 200.0) < 1e-9, "default c0 with a 20 m/s boulder: %g m/s (expected 200)", c.sph.c0);
     lahar_case_free(&c);
-    fp = fopen(path, "w");
-    if (!fp) {
-        CHECK(0, "cannot write %s", path);
+    if (write_text(path, "dimensions: 2\ntime: {end: 0.1}\n"
+                         "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                         "bodies:\n"
+                         "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 60}\n"
+                         "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n") != 0)
         return;
-    }
-    fprintf(fp, "dimensions: 2\ntime: {end: 0.1}\n"
-                "materials: {rock: {density: 2650, model: linear, kn: 1e8, restitution: 0.5, friction: 0.5}}\n"
-                "bodies:\n"
-                "  - {name: wheel, shape: disc, radius: 0.1, material: rock, position: [1, 1], angular_velocity: 60}\n"
-                "sph:\n  dx: 0.05\n  blocks:\n    - {name: pool, box: {lo: [-1.5, 0], hi: [1.5, 0.5]}}\n");
-    fclose(fp);
     CHECK(lahar_case_load(path, &c) == 0, "load %s", path);
     /* a disc is a point core swept by its radius: rim speed 60 x 0.1 = 6 m/s > sqrt(2 g 0.5) */
     CHECK(fabs(c.sph.c0 - 60.0) < 1e-9, "default c0 with a disc spinning at 60 rad/s: %g m/s (expected 60)", c.sph.c0);
