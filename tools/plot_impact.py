@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Impact force of granular_impact_3d runs at several slopes (paper 000 section 5.3, Fig. 14-15).
 
-usage: plot_impact.py OUT.png RUN_DIR [RUN_DIR ...]
+usage: plot_impact.py OUT.png RUN_DIR [RUN_DIR ...] [--peaks "LABEL=SLOPE:N,SLOPE:N,..."]...
 
 Each RUN_DIR is the output of `lahar check` on cases/granular_impact_3d.yaml (any slope, any dx):
 the script reads only its check.json (reference granular_impact), so the force history it draws is
@@ -9,7 +9,10 @@ the check's own (the wall's force along the chute, 10 ms moving average; common/
 and prints a Markdown table: slope, dx, first impact, peak force and its time, the momentum flux
 estimate rho u^2 A, and the run's metrics. Left panel: F(t) per slope; right panel: peak force
 against the slope. Paper 000 Fig. 14-15 are images whose numbers are not in the paper's text
-(shared/papers/000), so no published curve is drawn."""
+(shared/papers/000), so no published curve is drawn. --peaks (repeatable) adds a series of peak
+forces from elsewhere to the right panel, e.g. the same case at another dx whose run directories
+are gone: --peaks "dx 25 mm=45:366,50:433,55:570,60:824,65:928"."""
+import argparse
 import json
 import os
 import sys
@@ -43,12 +46,28 @@ def load(run):
     return chk, info, curve
 
 
+def parse_peaks(text):
+    """'LABEL=S:F,S:F' -> (label, [slopes], [forces])."""
+    label, sep, pairs = text.rpartition("=")
+    try:
+        pts = sorted(tuple(float(v) for v in p.split(":")) for p in pairs.split(","))
+        if not sep or not label or any(len(p) != 2 for p in pts):
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected LABEL=SLOPE:N,SLOPE:N,... (got %r)" % text)
+    return label, [p[0] for p in pts], [p[1] for p in pts]
+
+
 def main(argv):
-    if len(argv) < 3:
-        print(__doc__, file=sys.stderr)
-        return 2
+    ap = argparse.ArgumentParser(prog="plot_impact.py", description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", help="the PNG to write")
+    ap.add_argument("runs", nargs="+", help="output directories of lahar check on granular_impact_3d")
+    ap.add_argument("--peaks", type=parse_peaks, action="append", default=[],
+                    help="LABEL=SLOPE:N,... a further series of peak forces for the right panel")
+    args = ap.parse_args(argv[1:])
     runs = []
-    for run in argv[2:]:
+    for run in args.runs:
         chk, info, curve = load(run)
         runs.append((info["slope_deg"], run, chk, info, curve))
     runs.sort(key=lambda r: r[0])
@@ -69,7 +88,11 @@ def main(argv):
     ax.legend()
     ax.grid(alpha=0.3)
     s = [r[0] for r in runs]
-    bx.plot(s, [r[3]["peak_force_N"] for r in runs], "o-", label="lahar peak (10 ms average)")
+    dxs = sorted({r[3].get("dx_m") for r in runs if isinstance(r[3].get("dx_m"), (int, float))})
+    bx.plot(s, [r[3]["peak_force_N"] for r in runs], "o-", label="lahar peak (10 ms average)" +
+            (", dx %g mm" % (1e3 * dxs[0]) if len(dxs) == 1 else ""))
+    for label, ps, fs in args.peaks:
+        bx.plot(ps, fs, "^-.", label=label)
     bx.plot(s, [r[3]["momentum_flux_max_N"] for r in runs], "s--", label="rho u^2 A of the arriving soil")
     bx.plot(s, [r[3]["weight_along_chute_N"] for r in runs], ":", label="M g sin(theta)")
     bx.set_xlabel("slope (deg)")
@@ -78,7 +101,7 @@ def main(argv):
     bx.legend()
     bx.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(argv[1], dpi=110)
+    fig.savefig(args.out, dpi=110)
     return 0
 
 
