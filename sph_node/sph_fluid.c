@@ -140,15 +140,22 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
     return prm->c0 * prm->c0 * (rho - prm->rho0); /* 000 eq. 3 */
 }
 
-/* Sums over the neighbours of particle i (gather). `kind`, `sps`, `soil` and `dim` are
- * compile-time constants at each call site of the switch in fluid_pass, so the kernel evaluation
- * inlines without a branch per pair and 2D reads no z components. Per pair: one square root and
- * one division (1/(r^2 + eta^2)); p_j/rho_j^2 and V_j = m_j/rho_j come precomputed (f->prho2,
- * f->vol, filled with the EOS), W'/r = dnorm/h f'(q)/q (kernel_dshape_over_q). With soil, soil
- * neighbours are skipped (sph_soil.h). Returns the neighbours summed over (work counter). */
-static inline __attribute__((always_inline)) int64_t fluid_particle(const sph_fluid *f, const kernel_kind kind,
-                                                                    const int sps, const int soil, const int dim,
-                                                                    int64_t i, double out[4])
+/* The pairs (i, j) of water particle i with the water particles j after it in the forward half
+ * stencil (SPH_HALF_NEIGHBOUR_CHUNKS_D), each evaluated once and added to both particles: the
+ * density rates to drho[] and the pair force F_ij = m_i m_j (dv_i/dt)_j to fx[], fy[], fz[]
+ * (+F_ij to i, -F_ij to j: the momentum terms are antisymmetric in i and j, sph_fluid.h).
+ * `kind`, `sps`, `soil` and `dim` are compile-time constants at each call site of the switch in
+ * fluid_pass, so the kernel evaluation inlines without a branch per pair and 2D reads no z
+ * components. Per pair: one square root and one division (1/(r^2 + eta^2)), a second only for
+ * approaching pairs with artificial viscosity; p_j/rho_j^2 and V_j = m_j/rho_j come precomputed
+ * (f->prho2, f->vol), W'/r = dnorm/h f'(q)/q (kernel_dshape_over_q). With soil, pairs with a soil
+ * particle are skipped (sph_soil.h). i's own sums are added to its entries after its pairs (they
+ * may already hold the terms of pairs met from particles before it). Returns the pairs evaluated. */
+static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid *f, const kernel_kind kind,
+                                                                 const int sps, const int soil, const int dim,
+                                                                 int64_t i, double *restrict drho,
+                                                                 double *restrict fx, double *restrict fy,
+                                                                 double *restrict fz)
 {
     const sph_particles *p = &f->p;
     const sph_cells *c = &f->cells;
@@ -160,9 +167,9 @@ static inline __attribute__((always_inline)) int64_t fluid_particle(const sph_fl
     const double eta2 = 0.01 * h * h;
     const double xi = p->x[i], yi = p->y[i], zi = dim == 2 ? 0.0 : p->z[i];
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = dim == 2 ? 0.0 : p->vz[i];
-    const double rhoi = p->rho[i], pri = pra[i];
-    /* Morris: m_j (mu_i + mu_j)/(rho_i rho_j) = V_j (mu_i + mu_j)/rho_i */
-    const double visci = (prm->mu + prm->mu) / rhoi;
+    const double rhoi = p->rho[i], pri = pra[i], mi = ma[i], voli = vola[i];
+    /* Morris: m_i m_j (mu_i + mu_j)/(rho_i rho_j) = 2 mu V_i V_j */
+    const double visci = 2.0 * prm->mu * voli;
     const double c0 = prm->c0, alpha = prm->alpha, ddelta = 2.0 * prm->delta * h * c0;
     /* Monaghan: Pi_ij = -alpha c0 h v_ij.x_ij/(r^2 + eta^2) / rho_ij, rho_ij = (rho_i + rho_j)/2 */
     const double av = 2.0 * alpha * c0 * h;
@@ -177,56 +184,58 @@ static inline __attribute__((always_inline)) int64_t fluid_particle(const sph_fl
     if (sps)
         for (int a = 0; a < 6; a++)
             ti[a] = tau[a][i] / (rhoi * rhoi);
-    double drho = 0.0, ax = 0.0, ay = 0.0, az = 0.0;
-    int64_t nnb = 0; /* neighbours summed over (work counter) */
+    double drhoi = 0.0, fxi = 0.0, fyi = 0.0, fzi = 0.0;
+    int64_t npair = 0;
     const int32_t *const ph = p->phase;
-    /* (an `omp simd` reduction over a chunk was measured slower with SSE2: 1.38 vs 1.19 s) */
-    SPH_NEIGHBOUR_CHUNKS_D(c, p, i, xi, yi, zi, s2, dim, {
+    SPH_HALF_NEIGHBOUR_CHUNKS_D(c, p, i, xi, yi, zi, s2, dim, {
         for (int k = 0; k < nb_n; k++) {
             const int64_t j = nb_j[k];
             if (soil && ph[j] != 0) /* soil neighbours: sph_soil.h (fluid-soil: paper 000 section 2.3) */
                 continue;
-            nnb++;
+            npair++;
             const double rx = nb_xi - nb_x[j], ry = nb_yi - nb_y[j], rz = dim == 2 ? 0.0 : nb_zi - nb_z[j];
             const double r2 = rx * rx + ry * ry + rz * rz;
             const double r = sqrt(r2);
             const double fij = fnorm * kernel_dshape_over_q(kind, r * inv_h); /* W'/r */
             const double vx = vxi - vxa[j], vy = vyi - vya[j], vz = dim == 2 ? 0.0 : vzi - vza[j];
-            const double rhoj = rhoa[j], volj = vola[j];
+            const double rhoj = rhoa[j], volj = vola[j], mj = ma[j];
             const double vdotr = vx * rx + vy * ry + vz * rz;
             const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
-            const double vf = volj * fij;
-            /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h) */
-            const double drho_dev = (rhoi - rhoj) - (hx * rx + hy * ry + hz * rz);
-            drho += vf * (rhoi * vdotr + ddelta * drho_dev * rsoft);
+            /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h); x_ji = -x_ij,
+             * v_ji.x_ji = v_ij.x_ij, and the diffusion term changes sign */
+            const double dev = ddelta * ((rhoi - rhoj) - (hx * rx + hy * ry + hz * rz)) * rsoft;
+            drhoi += volj * fij * (rhoi * vdotr + dev);
+            drho[j] += voli * fij * (rhoj * vdotr - dev);
             /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij > 0 when approaching
-             * (av = 0 without artificial viscosity) */
+             * (av = 0 without artificial viscosity): -m_i m_j (...) F_ij x_ij */
             const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
-            const double gp = -ma[j] * (pri + pra[j] - pav) * fij;
-            /* laminar viscosity, Morris 1997 */
-            const double gv = visci * vf * rsoft;
-            ax += gp * rx + gv * vx;
-            ay += gp * ry + gv * vy;
-            if (dim == 3)
-                az += gp * rz + gv * vz;
-            if (sps) { /* 003 eq. 10, third term: sum_j m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
-                const double irj2 = 1.0 / (rhoj * rhoj), mf = ma[j] * fij;
+            const double gp = -mi * mj * (pri + pra[j] - pav) * fij;
+            /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij */
+            const double gv = visci * volj * fij * rsoft;
+            double Fx = gp * rx + gv * vx, Fy = gp * ry + gv * vy, Fz = dim == 3 ? gp * rz + gv * vz : 0.0;
+            if (sps) { /* 003 eq. 10, third term: m_i m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
+                const double irj2 = 1.0 / (rhoj * rhoj), mf = mi * mj * fij;
                 const double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2,
                              txz = ti[2] + tau[2][j] * irj2;
                 const double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2,
                              tzz = ti[5] + tau[5][j] * irj2;
-                ax += mf * (txx * rx + txy * ry + txz * rz);
-                ay += mf * (txy * rx + tyy * ry + tyz * rz);
+                Fx += mf * (txx * rx + txy * ry + txz * rz);
+                Fy += mf * (txy * rx + tyy * ry + tyz * rz);
                 if (dim == 3)
-                    az += mf * (txz * rx + tyz * ry + tzz * rz);
+                    Fz += mf * (txz * rx + tyz * ry + tzz * rz);
             }
+            fxi += Fx, fyi += Fy;
+            fx[j] -= Fx, fy[j] -= Fy;
+            if (dim == 3)
+                fzi += Fz, fz[j] -= Fz;
         }
     });
-    out[0] = drho;
-    out[1] = ax + prm->body_force[0];
-    out[2] = ay + prm->body_force[1];
-    out[3] = az + prm->body_force[2];
-    return nnb;
+    drho[i] += drhoi;
+    fx[i] += fxi;
+    fy[i] += fyi;
+    if (dim == 3)
+        fz[i] += fzi;
+    return npair;
 }
 
 /* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, 003 eq. 11). */
@@ -279,44 +288,74 @@ static void fluid_sps_pass(sph_fluid *f)
     }
 }
 
+/* The water's particle-particle sums (sph_fluid.h) in symmetric form: each pair once
+ * (fluid_pairs), its terms added to both particles. Threads must not add to one particle at the
+ * same time, and the sums must come out bitwise the same for any number of threads: the particles
+ * are split into slabs of cell rows (sph_cells_slab_count); the pairs met from one slab touch it
+ * and the next one only, so the even slabs run in parallel, then the odd ones. Each slab runs its
+ * particles in order on one thread, so every particle receives its terms in an order fixed by the
+ * slabs alone. Then F/m + g (soil particles too: sph_soil_momentum overwrites theirs). */
 static void fluid_pass(sph_fluid *f)
 {
     sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
     const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
     const int soil = f->has_soil;
-    int64_t neighbours = 0;
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) reduction(+ : neighbours) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        double out[4];
-        if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
-            continue;
-        /* kind, sps, soil and dim constant per call site: the pair loop inlines without their branches */
-#define FLUID_PARTICLE_DIM(K, S, L)                                                                \
-    (d3 ? fluid_particle(f, K, S, L, 3, i, out) : fluid_particle(f, K, S, L, 2, i, out))
-        switch ((kind * 2 + sps) * 2 + soil) {
-        case KERNEL_QUINTIC * 4: neighbours += FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 0, 0); break;
-        case KERNEL_QUINTIC * 4 + 1: neighbours += FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 0, 1); break;
-        case KERNEL_QUINTIC * 4 + 2: neighbours += FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 1, 0); break;
-        case KERNEL_QUINTIC * 4 + 3: neighbours += FLUID_PARTICLE_DIM(KERNEL_QUINTIC, 1, 1); break;
-        case KERNEL_WENDLAND2 * 4: neighbours += FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 0, 0); break;
-        case KERNEL_WENDLAND2 * 4 + 1: neighbours += FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 0, 1); break;
-        case KERNEL_WENDLAND2 * 4 + 2: neighbours += FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 1, 0); break;
-        case KERNEL_WENDLAND2 * 4 + 3: neighbours += FLUID_PARTICLE_DIM(KERNEL_WENDLAND2, 1, 1); break;
-        case KERNEL_CUBIC * 4 + 1: neighbours += FLUID_PARTICLE_DIM(KERNEL_CUBIC, 0, 1); break;
-        case KERNEL_CUBIC * 4 + 2: neighbours += FLUID_PARTICLE_DIM(KERNEL_CUBIC, 1, 0); break;
-        case KERNEL_CUBIC * 4 + 3: neighbours += FLUID_PARTICLE_DIM(KERNEL_CUBIC, 1, 1); break;
-        default: neighbours += FLUID_PARTICLE_DIM(KERNEL_CUBIC, 0, 0); break;
+    double *const drho = p->drho, *const fx = p->ax, *const fy = p->ay, *const fz = p->az;
+    const int nslab = sph_cells_slab_count(c);
+    int64_t pairs = 0;
+#pragma omp parallel if (n >= SPH_OMP_MIN_HEAVY)
+    {
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < n; i++)
+            drho[i] = fx[i] = fy[i] = fz[i] = 0.0;
+        for (int parity = 0; parity < 2; parity++) {
+            /* slabs differ in cost (a water column's top, a tank's empty part): handed out one by
+             * one; which thread runs a slab does not change the order within it */
+#pragma omp for schedule(dynamic, 1) reduction(+ : pairs)
+            for (int s = parity; s < nslab; s += 2) {
+                int row0, row1;
+                sph_cells_slab_rows(c, nslab, s, &row0, &row1);
+                const int64_t i1 = sph_cells_row_start(c, row1);
+                for (int64_t i = sph_cells_row_start(c, row0); i < i1; i++) {
+                    if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
+                        continue;
+                    /* kind, sps, soil and dim constant per call site: the pair loop inlines without their branches */
+#define FLUID_PAIRS_DIM(K, S, L)                                                                   \
+    (d3 ? fluid_pairs(f, K, S, L, 3, i, drho, fx, fy, fz) : fluid_pairs(f, K, S, L, 2, i, drho, fx, fy, fz))
+                    switch ((kind * 2 + sps) * 2 + soil) {
+                    case KERNEL_QUINTIC * 4: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 0, 0); break;
+                    case KERNEL_QUINTIC * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 0, 1); break;
+                    case KERNEL_QUINTIC * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 1, 0); break;
+                    case KERNEL_QUINTIC * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 1, 1); break;
+                    case KERNEL_WENDLAND2 * 4: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 0, 0); break;
+                    case KERNEL_WENDLAND2 * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 0, 1); break;
+                    case KERNEL_WENDLAND2 * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 1, 0); break;
+                    case KERNEL_WENDLAND2 * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 1, 1); break;
+                    case KERNEL_CUBIC * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 0, 1); break;
+                    case KERNEL_CUBIC * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 1, 0); break;
+                    case KERNEL_CUBIC * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 1, 1); break;
+                    default: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 0, 0); break;
+                    }
+#undef FLUID_PAIRS_DIM
+                }
+            }
         }
-#undef FLUID_PARTICLE_DIM
-        p->drho[i] = out[0];
-        p->ax[i] = out[1];
-        p->ay[i] = out[2];
-        p->az[i] = out[3];
+        /* forces to accelerations, plus the body force; soil particles: left to the soil pass */
+        const double gx = f->prm.body_force[0], gy = f->prm.body_force[1], gz = f->prm.body_force[2];
+        const double *const m = p->m;
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < n; i++) {
+            const double im = 1.0 / m[i];
+            fx[i] = fx[i] * im + gx;
+            fy[i] = fy[i] * im + gy;
+            fz[i] = fz[i] * im + gz;
+        }
     }
     f->work_passes++;
-    f->work_neighbours_fluid += neighbours; /* integer sum: exact in any order */
+    f->work_neighbours_fluid += 2 * pairs; /* (i, j) and (j, i); integer sum: exact in any order */
 }
 
 /* Particle shifting (Lind et al. 2012, J. Comput. Phys. 231:1499, eq. 17-18 with D = A h^2):

@@ -36,8 +36,14 @@
  * Step proposal (003 eq. 20 split in its three parts, plus the viscous limit):
  *   dt = min(C_cfl h/(c0 + |v|max), C_f sqrt(h/|a|max), C_v h^2/(nu + nu_t,max)),
  *   nu_t,max the largest SPS eddy viscosity (0 without SPS).
- * Every loop over particles is an OpenMP loop in gather form (each particle sums over its own
- * neighbours in cell order): no races, and bitwise the same result for any number of threads. */
+ * The water's particle-particle sums are symmetric: each pair (i, j) is evaluated once, from the
+ * particle that comes first in the forward half of the cell stencil, and its terms are added to
+ * both (the momentum terms as the pair force m_i m_j (...) with +F to i and -F to j, so momentum is
+ * conserved to round-off; the continuity and delta-SPH terms each with their own V and rho). The
+ * threads take slabs of cell rows, a parity at a time, so no two add to one particle at once, and
+ * each particle receives its terms in an order fixed by the slabs: bitwise the same result for any
+ * number of threads (sph_fluid.c fluid_pass). The other loops over particles (SPS, Shepard,
+ * shifting, soil) gather: each particle sums over its own neighbours in cell order. */
 #ifndef LAHAR_SPH_FLUID_H
 #define LAHAR_SPH_FLUID_H
 #include <stdint.h>
@@ -103,9 +109,9 @@ typedef struct {
     sph_soil soil;
     /* Work counters (cumulative since init; read by the SPH node for its STATUS work fields):
      * particle-particle passes, and the neighbours (i, j), j != i, within the kernel support that
-     * the water pass summed over, counted once per particle i (each pair twice in gather form).
-     * The count is a register increment in the pair loop summed by the pass's reduction: integer,
-     * so the same for any thread count. The soil passes count theirs the same way. */
+     * the water pass summed over: ordered pairs, so each pair evaluated counts twice, (i, j) and
+     * (j, i), as in the soil passes, which gather. The count is a register increment in the pair
+     * loop summed by the pass's reduction: integer, so the same for any thread count. */
     int64_t work_passes;
     int64_t work_neighbours_fluid;
     int64_t work_neighbours_soil;       /* soil pass: soil neighbours of soil particles */

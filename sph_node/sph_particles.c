@@ -311,3 +311,21 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
             cell_of[i] = k;
     return 0;
 }
+
+int sph_cells_slab_count(const sph_cells *c)
+{
+    const int axis = c->dim == 3 ? 2 : 1;
+    int nslab = c->nc[axis] / c->reach;
+    if (nslab < 1)
+        nslab = 1;
+    if (c->periodic[axis] && nslab > 1 && nslab % 2 == 1)
+        nslab--;
+    return nslab;
+}
+
+void sph_cells_slab_rows(const sph_cells *c, int nslab, int s, int *row0, int *row1)
+{
+    const int rows = c->nc[c->dim == 3 ? 2 : 1];
+    *row0 = s * c->reach;
+    *row1 = s == nslab - 1 ? rows : (s + 1) * c->reach;
+}

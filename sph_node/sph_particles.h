@@ -91,6 +91,21 @@ void sph_cells_free(sph_cells *c);
  * order (stable: particles of a cell keep their relative order). Returns 0, or -1 when the cell
  * table cannot grow (out of memory). */
 int sph_cells_sort(sph_cells *c, sph_particles *p);
+/* Slabs for pair loops that add each pair to both particles (sph_fluid.c): runs of `reach` cell
+ * rows along the slowest axis (y in 2D, z in 3D), each one contiguous range of the sorted arrays.
+ * The pairs of the forward half stencil met from slab s touch only slab s and the first reach rows
+ * after it, so slabs of one parity can run at the same time. On a periodic slowest axis the rows
+ * after the last slab are the first slab's, so the count is made even there (the last slab takes
+ * the rows left over). Slab s covers rows [*row0, *row1) of the slowest axis. */
+int sph_cells_slab_count(const sph_cells *c);
+void sph_cells_slab_rows(const sph_cells *c, int nslab, int s, int *row0, int *row1);
+/* First particle of row `row` of the slowest axis (row = the row count: n). */
+static inline int64_t sph_cells_row_start(const sph_cells *c, int row)
+{
+    const int64_t row_len = c->dim == 3 ? (int64_t)c->nc[0] * c->nc[1] : c->nc[0];
+    return c->start[row * row_len];
+}
+
 /* Cell coordinate of a position along axis a (clamped into the grid). */
 static inline int sph_cells_coord(const sph_cells *c, int a, double x)
 {
@@ -154,6 +169,18 @@ static inline double sph_cell_gap2_(double gap, double size)
  * the periodic image already in nb_xi, nb_yi, nb_zi (x_i minus the shift of the run); with
  * DIM = 2 the z parts are 0 and nb_z is not to be read. */
 #define SPH_NEIGHBOUR_CHUNKS_D(C, P, I, XI, YI, ZI, S2, DIM, ...)                                   \
+    SPH_NEIGHBOUR_CHUNKS_(C, P, I, XI, YI, ZI, S2, DIM, 0, __VA_ARGS__)
+
+/* The same walk over the forward half of the stencil only, for pair sums that add each pair to
+ * both particles (sph_fluid.c): the rows after i's along the slowest axes (dz > 0, or dz = 0 and
+ * dy > 0; all their cells along x) and, in i's own row, the particles after i in the sorted order
+ * up to the cell cx + reach. Each unordered pair within the support is met exactly once, from the
+ * particle that comes first (periodic axes hold >= 2 reach + 1 cells, so an offset between two
+ * cells is never both forward and backward). */
+#define SPH_HALF_NEIGHBOUR_CHUNKS_D(C, P, I, XI, YI, ZI, S2, DIM, ...)                              \
+    SPH_NEIGHBOUR_CHUNKS_(C, P, I, XI, YI, ZI, S2, DIM, 1, __VA_ARGS__)
+
+#define SPH_NEIGHBOUR_CHUNKS_(C, P, I, XI, YI, ZI, S2, DIM, HALF, ...)                             \
     do {                                                                                           \
         const sph_cells *nc_c_ = (C);                                                              \
         const double *const nc_px_ = (P)->x, *const nc_py_ = (P)->y, *const nc_pz_ = (P)->z;       \
@@ -166,7 +193,7 @@ static inline double sph_cell_gap2_(double gap, double size)
                   nc_cz_ = (int)(nc_cell_ / ((int64_t)nc_n0_ * nc_n1_));                           \
         const int nc_re_ = nc_c_->reach;                                                           \
         const int nc_zr_ = ((DIM) ? (DIM) : nc_c_->dim) == 3 ? nc_re_ : 0;                         \
-        for (int nc_dz_ = -nc_zr_; nc_dz_ <= nc_zr_; nc_dz_++) {                                   \
+        for (int nc_dz_ = (HALF) ? 0 : -nc_zr_; nc_dz_ <= nc_zr_; nc_dz_++) {                     \
             int nc_jz_ = nc_cz_ + nc_dz_;                                                          \
             /* rows of cells wholly beyond the support are skipped (SPH_CELL_GAP2) */              \
             const double nc_gz2_ = SPH_CELL_GAP2(nc_c_, 2, nc_jz_, nc_dz_, nc_zi_);                 \
@@ -179,7 +206,7 @@ static inline double sph_cell_gap2_(double gap, double size)
                 nc_sz_ = (nc_jz_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[2] - nc_c_->lo[2]);                \
                 nc_jz_ += nc_jz_ < 0 ? nc_n2_ : -nc_n2_;                                           \
             }                                                                                      \
-            for (int nc_dy_ = -nc_re_; nc_dy_ <= nc_re_; nc_dy_++) {                               \
+            for (int nc_dy_ = (HALF) && nc_dz_ == 0 ? 0 : -nc_re_; nc_dy_ <= nc_re_; nc_dy_++) {   \
                 int nc_jy_ = nc_cy_ + nc_dy_;                                                      \
                 /* 3D only: in 2D a row is (nearly) never beyond the support, and the test costs */ \
                 const double nc_gyz2_ = nc_zr_ > 0 ? nc_gz2_ + SPH_CELL_GAP2(nc_c_, 1, nc_jy_, nc_dy_, nc_yi_) : 0.0; \
@@ -197,7 +224,9 @@ static inline double sph_cell_gap2_(double gap, double size)
                 double nc_ss_[2 * SPH_CELLS_PER_SUPPORT + 1];                                      \
                 int nc_nseg_ = 0;                                                                  \
                 /* along x, the cells within the support left by the row's gap */                \
-                int nc_xa_ = nc_cx_ - nc_re_, nc_xb_ = nc_cx_ + nc_re_;                            \
+                /* half stencil, own row: from i's own cell on, and there from i + 1 */           \
+                const int nc_own_ = (HALF) && nc_dz_ == 0 && nc_dy_ == 0;                          \
+                int nc_xa_ = nc_own_ ? nc_cx_ : nc_cx_ - nc_re_, nc_xb_ = nc_cx_ + nc_re_;         \
                 if (nc_zr_ > 0) { /* 3D (in 2D the corner cells saved do not pay for the tests) */ \
                     while (nc_xa_ < nc_cx_ && nc_gyz2_ + SPH_CELL_GAP2(nc_c_, 0, nc_xa_, -1, nc_xi_) >= nc_s2_) \
                         nc_xa_++;                                                                  \
@@ -207,7 +236,7 @@ static inline double sph_cell_gap2_(double gap, double size)
                 if (!nc_c_->periodic[0] || (nc_xa_ >= 0 && nc_xb_ < nc_n0_)) {                     \
                     const int nc_a_ = nc_xa_ > 0 ? nc_xa_ : 0,                                     \
                               nc_b_ = nc_xb_ < nc_n0_ ? nc_xb_ : nc_n0_ - 1;                       \
-                    nc_sb_[0] = nc_start_[nc_row_ + nc_a_];                                        \
+                    nc_sb_[0] = nc_own_ ? nc_i_ + 1 : nc_start_[nc_row_ + nc_a_];                  \
                     nc_se_[0] = nc_start_[nc_row_ + nc_b_ + 1];                                    \
                     nc_ss_[0] = 0.0;                                                               \
                     nc_nseg_ = 1;                                                                  \
@@ -219,7 +248,8 @@ static inline double sph_cell_gap2_(double gap, double size)
                             nc_sx_ = (nc_jx_ < 0 ? -1.0 : 1.0) * (nc_c_->hi[0] - nc_c_->lo[0]);    \
                             nc_jx_ += nc_jx_ < 0 ? nc_n0_ : -nc_n0_;                               \
                         }                                                                          \
-                        nc_sb_[nc_nseg_] = nc_start_[nc_row_ + nc_jx_];                            \
+                        nc_sb_[nc_nseg_] = nc_own_ && nc_jx0_ == nc_cx_ ? nc_i_ + 1                \
+                                                                        : nc_start_[nc_row_ + nc_jx_]; \
                         nc_se_[nc_nseg_] = nc_start_[nc_row_ + nc_jx_ + 1];                        \
                         nc_ss_[nc_nseg_++] = nc_sx_;                                               \
                     }                                                                              \

@@ -3,7 +3,10 @@
  *     positions are wrapped into the box;
  *  2. the cell-list rates (continuity + delta-SPH, pressure, Morris viscosity, Monaghan AV, Tait)
  *     against a brute-force O(n^2) evaluation with minimum-image periodicity, relative 1e-12,
- *     in 2D (periodic x and y) and 3D (periodic x only), for every kernel;
+ *     in 2D (periodic x and y) and 3D (periodic x only), for every kernel, and on 2 threads with
+ *     every axis periodic (2D 3025, 3D 2744 particles: the symmetric pass's slabs in parallel);
+ *     the water pass's neighbour count equals the brute-force count; the slabs of that pass never
+ *     let two threads write one row;
  *  3. delta-SPH diffuses: for rho = rho0 (1 + A sin(k x)) at rest on a lattice, drho/dt equals
  *     delta h c0 lap(rho) = -delta h c0 k^2 (rho - rho0) within 2 % (Brookshaw's Laplacian,
  *     Molteni & Colagrossi 2009), i.e. a crest decays;
@@ -61,8 +64,9 @@ static void check_sort(const sph_fluid *f)
 }
 
 /* Brute-force rates of particle i (same formulas as sph_fluid.h, minimum image). */
-static void brute_rates(const sph_fluid *f, int64_t i, double out[4])
+static int64_t brute_rates(const sph_fluid *f, int64_t i, double out[4])
 {
+    int64_t nb = 0;
     const sph_particles *p = &f->p;
     const sph_params *prm = &f->prm;
     const kernel *k = &f->k;
@@ -80,6 +84,7 @@ static void brute_rates(const sph_fluid *f, int64_t i, double out[4])
         double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         if (r2 >= k->support * k->support)
             continue;
+        nb++;
         double rr = sqrt(r2), F = kernel_dwdr(k, rr) / rr;
         double v[3] = {p->vx[i] - p->vx[j], p->vy[i] - p->vy[j], p->vz[i] - p->vz[j]};
         double vr = v[0] * r[0] + v[1] * r[1] + v[2] * r[2];
@@ -101,10 +106,21 @@ static void brute_rates(const sph_fluid *f, int64_t i, double out[4])
     out[0] = drho;
     for (int d = 0; d < 3; d++)
         out[1 + d] = a[d] + prm->body_force[d];
+    return nb;
 }
 
-static void check_rates_brute(int dim, const char *kern, sph_eos eos)
+/* Rates of a disordered, moving, noisy lattice of side[] particles against brute_rates, and the
+ * water pass's neighbour count against the brute-force count of pairs within the support. big:
+ * every axis periodic and 2 threads with n above SPH_OMP_MIN_HEAVY, so that the symmetric pass runs
+ * its slabs in parallel (a race would show here) and, with an odd number of slabs along the
+ * periodic slowest axis, merges the last two (sph_fluid.c fluid_pass). */
+static void check_rates_brute(int dim, const char *kern, sph_eos eos, int big)
 {
+    /* small: 2D 12 x 12 periodic x and y, 3D 12 x 6 x 6 periodic x; big: 2D 55 x 55 (42 cell rows
+     * of the cubic kernel, 21 slabs), 3D 14 x 14 x 14 (10 rows, 5 slabs) */
+    const int side[3] = {big ? (dim == 2 ? 55 : 14) : 12, big ? (dim == 2 ? 55 : 14) : dim == 2 ? 12 : 6,
+                         dim == 2 ? 1 : big ? 14 : 6};
+    omp_set_num_threads(big ? 2 : 1);
     sph_params prm = {0};
     prm.dim = dim;
     prm.kernel = kern;
@@ -117,18 +133,19 @@ static void check_rates_brute(int dim, const char *kern, sph_eos eos)
     prm.delta = 0.1;
     prm.body_force[1] = -9.81;
     prm.periodic[0] = 1;
-    prm.periodic[1] = dim == 2;
-    prm.hi[0] = 0.12;
-    prm.hi[1] = 0.12;
+    prm.periodic[1] = dim == 2 || big;
+    prm.periodic[2] = big;
+    for (int a = 0; a < 3; a++)
+        prm.hi[a] = side[a] * prm.dx;
     sph_fluid f;
     char err[256];
-    int64_t cap = dim == 2 ? 144 : 12 * 6 * 6;
+    int64_t cap = (int64_t)side[0] * side[1] * side[2];
     if (sph_fluid_init(&f, &prm, cap, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
         failures++;
         return;
     }
-    double lo[3] = {0, 0, 0}, hi[3] = {0.12, dim == 2 ? 0.12 : 0.06, 0.06}, v0[3] = {0, 0, 0};
+    double lo[3] = {0, 0, 0}, hi[3] = {prm.hi[0], prm.hi[1], prm.hi[2]}, v0[3] = {0, 0, 0};
     sph_particles_add_box(&f.p, dim, prm.dx, prm.rho0, lo, hi, v0);
     sph_particles *p = &f.p;
     for (int64_t i = 0; i < p->n; i++) { /* disorder, motion, density noise; some cross the period */
@@ -145,9 +162,10 @@ static void check_rates_brute(int dim, const char *kern, sph_eos eos)
         failures++;
     check_sort(&f);
     double worst = 0.0, scale_a = 0.0, scale_d = 0.0;
+    int64_t pairs = 0; /* ordered pairs (i, j) within the support, minimum image */
     for (int64_t i = 0; i < p->n; i++) {
         double b[4];
-        brute_rates(&f, i, b);
+        pairs += brute_rates(&f, i, b);
         scale_d = fmax(scale_d, fabs(b[0]));
         scale_a = fmax(scale_a, sqrt(b[1] * b[1] + b[2] * b[2] + b[3] * b[3]));
     }
@@ -159,10 +177,61 @@ static void check_rates_brute(int dim, const char *kern, sph_eos eos)
         worst = fmax(worst, fabs(b[2] - p->ay[i]) / scale_a);
         worst = fmax(worst, fabs(b[3] - p->az[i]) / scale_a);
     }
-    printf("rates vs brute force, %dD %-9s %s: %lld particles, max relative difference %.2e\n", dim, kern,
-           eos == SPH_EOS_TAIT ? "Tait  " : "linear", (long long)p->n, worst);
+    printf("rates vs brute force, %dD %-9s %s: %lld particles%s, max relative difference %.2e, %lld pairs\n", dim,
+           kern, eos == SPH_EOS_TAIT ? "Tait  " : "linear", (long long)p->n, big ? " (2 threads)" : "", worst,
+           (long long)pairs);
     CHECK(worst < 1e-12, "%dD %s: cell-list rates differ from brute force by %.2e", dim, kern, worst);
+    CHECK(f.work_neighbours_fluid == pairs, "%dD %s: the water pass counted %lld neighbours, brute force %lld", dim,
+          kern, (long long)f.work_neighbours_fluid, (long long)pairs);
     sph_fluid_free(&f);
+}
+
+/* The slabs of the symmetric pass (sph_cells_slab_count): for every row count and periodicity they
+ * cover the rows of the slowest axis once, in order, and two slabs of one parity never write the
+ * same row (a slab writes its rows and the reach rows after it, wrapped on a periodic axis), so
+ * the slabs of a parity can run at the same time without a race. */
+static void check_slabs(void)
+{
+    int bad = 0, cases = 0;
+    for (int dim = 2; dim <= 3; dim++)
+        for (int periodic = 0; periodic < 2; periodic++)
+            for (int rows = 1; rows <= 41; rows++) {
+                if (periodic && rows < 2 * SPH_CELLS_PER_SUPPORT + 1) /* sph_cells_init refuses them */
+                    continue;
+                sph_cells c;
+                memset(&c, 0, sizeof c);
+                c.dim = dim;
+                c.reach = SPH_CELLS_PER_SUPPORT;
+                c.nc[0] = c.nc[1] = c.nc[2] = 1;
+                c.nc[dim - 1] = rows;
+                c.periodic[dim - 1] = periodic;
+                const int nslab = sph_cells_slab_count(&c);
+                int writer[64][2]; /* per row: the slab of each parity that writes it, or -1 */
+                for (int r = 0; r < rows; r++)
+                    writer[r][0] = writer[r][1] = -1;
+                int next = 0;
+                for (int s = 0; s < nslab; s++) {
+                    int r0, r1;
+                    sph_cells_slab_rows(&c, nslab, s, &r0, &r1);
+                    bad += r0 != next || r1 <= r0;
+                    next = r1;
+                    for (int r = r0; r < r1 + c.reach; r++) {
+                        int row = r;
+                        if (row >= rows) {
+                            if (!periodic)
+                                break;
+                            row -= rows;
+                        }
+                        if (writer[row][s % 2] != -1 && writer[row][s % 2] != s)
+                            bad++;
+                        writer[row][s % 2] = s;
+                    }
+                }
+                bad += next != rows;
+                cases++;
+            }
+    printf("slabs of the symmetric pass: %d row counts and periodicities, %d overlaps or gaps\n", cases, bad);
+    CHECK(bad == 0, "slabs overlap within a parity or do not cover the rows (%d)", bad);
 }
 
 static void check_delta_sph(void)
@@ -448,9 +517,12 @@ int main(void)
 {
     const char *kernels[] = {"cubic", "quintic", "wendland2"};
     for (int k = 0; k < 3; k++) {
-        check_rates_brute(2, kernels[k], SPH_EOS_LINEAR);
-        check_rates_brute(3, kernels[k], k == 0 ? SPH_EOS_TAIT : SPH_EOS_LINEAR);
+        check_rates_brute(2, kernels[k], SPH_EOS_LINEAR, 0);
+        check_rates_brute(3, kernels[k], k == 0 ? SPH_EOS_TAIT : SPH_EOS_LINEAR, 0);
     }
+    check_rates_brute(2, "cubic", SPH_EOS_LINEAR, 1);
+    check_rates_brute(3, "cubic", SPH_EOS_LINEAR, 1);
+    check_slabs();
     check_delta_sph();
     check_eos();
     check_shepard();
