@@ -288,13 +288,35 @@ static void fluid_sps_pass(sph_fluid *f)
     }
 }
 
+/* The pairs of the water particles of block k (sph_cells_blocks), particle by particle in the
+ * sorted order; soil particles are left to sph_soil_momentum. Returns the pairs evaluated. */
+static inline __attribute__((always_inline)) int64_t fluid_block(const sph_fluid *f, const kernel_kind kind,
+                                                                 const int sps, const int soil, const int dim,
+                                                                 const sph_blocks *blk, int k, double *restrict drho,
+                                                                 double *restrict fx, double *restrict fy,
+                                                                 double *restrict fz)
+{
+    const sph_cells *c = &f->cells;
+    const int32_t *const phase = f->p.phase;
+    int a0, a1, b0, b1;
+    sph_cells_block(blk, k, &a0, &a1, &b0, &b1);
+    int64_t pairs = 0;
+    for (int a = a0; a < a1; a++) {
+        const int64_t i1 = sph_cells_run_start(c, blk, a, b1);
+        for (int64_t i = sph_cells_run_start(c, blk, a, b0); i < i1; i++)
+            if (!soil || phase[i] == 0)
+                pairs += fluid_pairs(f, kind, sps, soil, dim, i, drho, fx, fy, fz);
+    }
+    return pairs;
+}
+
 /* The water's particle-particle sums (sph_fluid.h) in symmetric form: each pair once
  * (fluid_pairs), its terms added to both particles. Threads must not add to one particle at the
  * same time, and the sums must come out bitwise the same for any number of threads: the particles
- * are split into slabs of cell rows (sph_cells_slab_count); the pairs met from one slab touch it
- * and the next one only, so the even slabs run in parallel, then the odd ones. Each slab runs its
+ * are split into blocks of cell rows (sph_cells_blocks) in four colours; the blocks of one colour
+ * share no particle, so they run in parallel, one colour after the other. Each block runs its
  * particles in order on one thread, so every particle receives its terms in an order fixed by the
- * slabs alone. Then F/m + g (soil particles too: sph_soil_momentum overwrites theirs). */
+ * blocks alone. Then F/m + g (soil particles too: sph_soil_momentum overwrites theirs). */
 static void fluid_pass(sph_fluid *f)
 {
     sph_particles *p = &f->p;
@@ -304,46 +326,44 @@ static void fluid_pass(sph_fluid *f)
     const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
     const int soil = f->has_soil;
     double *const drho = p->drho, *const fx = p->ax, *const fy = p->ay, *const fz = p->az;
-    const int nslab = sph_cells_slab_count(c);
+    sph_blocks blk;
+    sph_cells_blocks(c, &blk);
     int64_t pairs = 0;
 #pragma omp parallel if (n >= SPH_OMP_MIN_HEAVY)
     {
 #pragma omp for schedule(static)
         for (int64_t i = 0; i < n; i++)
             drho[i] = fx[i] = fy[i] = fz[i] = 0.0;
-        for (int parity = 0; parity < 2; parity++) {
-            /* slabs differ in cost (a water column's top, a tank's empty part): handed out one by
-             * one; which thread runs a slab does not change the order within it */
+        for (int colour = 0; colour < SPH_BLOCK_COLOURS; colour++) {
+            /* the blocks of this colour: every second run along A and B from (pa, pb) */
+            const int pa = colour >> 1, pb = colour & 1;
+            const int nka = (blk.na - pa + 1) / 2, nkb = (blk.nb - pb + 1) / 2;
+            /* blocks differ in cost (a water column's top, a tank's empty part): handed out one by
+             * one; which thread runs a block does not change the order within it */
 #pragma omp for schedule(dynamic, 1) reduction(+ : pairs)
-            for (int s = parity; s < nslab; s += 2) {
-                int row0, row1;
-                sph_cells_slab_rows(c, nslab, s, &row0, &row1);
-                const int64_t i1 = sph_cells_row_start(c, row1);
-                for (int64_t i = sph_cells_row_start(c, row0); i < i1; i++) {
-                    if (soil && p->phase[i] != 0) /* soil particles: sph_soil_momentum */
-                        continue;
-                    /* kind, sps, soil and dim constant per call site: the pair loop inlines without their branches */
-#define FLUID_PAIRS_DIM(K, S, L)                                                                   \
-    (d3 ? fluid_pairs(f, K, S, L, 3, i, drho, fx, fy, fz) : fluid_pairs(f, K, S, L, 2, i, drho, fx, fy, fz))
-                    switch ((kind * 2 + sps) * 2 + soil) {
-                    case KERNEL_QUINTIC * 4: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 0, 0); break;
-                    case KERNEL_QUINTIC * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 0, 1); break;
-                    case KERNEL_QUINTIC * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 1, 0); break;
-                    case KERNEL_QUINTIC * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_QUINTIC, 1, 1); break;
-                    case KERNEL_WENDLAND2 * 4: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 0, 0); break;
-                    case KERNEL_WENDLAND2 * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 0, 1); break;
-                    case KERNEL_WENDLAND2 * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 1, 0); break;
-                    case KERNEL_WENDLAND2 * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_WENDLAND2, 1, 1); break;
-                    case KERNEL_CUBIC * 4 + 1: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 0, 1); break;
-                    case KERNEL_CUBIC * 4 + 2: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 1, 0); break;
-                    case KERNEL_CUBIC * 4 + 3: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 1, 1); break;
-                    default: pairs += FLUID_PAIRS_DIM(KERNEL_CUBIC, 0, 0); break;
-                    }
-#undef FLUID_PAIRS_DIM
+            for (int t = 0; t < nka * nkb; t++) {
+                const int k = (pa + 2 * (t / nkb)) * blk.nb + pb + 2 * (t % nkb);
+                /* kind, sps, soil and dim constant per call site: the pair loop inlines without their branches */
+#define FLUID_BLOCK_DIM(K, S, L)                                                                   \
+    (d3 ? fluid_block(f, K, S, L, 3, &blk, k, drho, fx, fy, fz) : fluid_block(f, K, S, L, 2, &blk, k, drho, fx, fy, fz))
+                switch ((kind * 2 + sps) * 2 + soil) {
+                case KERNEL_QUINTIC * 4: pairs += FLUID_BLOCK_DIM(KERNEL_QUINTIC, 0, 0); break;
+                case KERNEL_QUINTIC * 4 + 1: pairs += FLUID_BLOCK_DIM(KERNEL_QUINTIC, 0, 1); break;
+                case KERNEL_QUINTIC * 4 + 2: pairs += FLUID_BLOCK_DIM(KERNEL_QUINTIC, 1, 0); break;
+                case KERNEL_QUINTIC * 4 + 3: pairs += FLUID_BLOCK_DIM(KERNEL_QUINTIC, 1, 1); break;
+                case KERNEL_WENDLAND2 * 4: pairs += FLUID_BLOCK_DIM(KERNEL_WENDLAND2, 0, 0); break;
+                case KERNEL_WENDLAND2 * 4 + 1: pairs += FLUID_BLOCK_DIM(KERNEL_WENDLAND2, 0, 1); break;
+                case KERNEL_WENDLAND2 * 4 + 2: pairs += FLUID_BLOCK_DIM(KERNEL_WENDLAND2, 1, 0); break;
+                case KERNEL_WENDLAND2 * 4 + 3: pairs += FLUID_BLOCK_DIM(KERNEL_WENDLAND2, 1, 1); break;
+                case KERNEL_CUBIC * 4 + 1: pairs += FLUID_BLOCK_DIM(KERNEL_CUBIC, 0, 1); break;
+                case KERNEL_CUBIC * 4 + 2: pairs += FLUID_BLOCK_DIM(KERNEL_CUBIC, 1, 0); break;
+                case KERNEL_CUBIC * 4 + 3: pairs += FLUID_BLOCK_DIM(KERNEL_CUBIC, 1, 1); break;
+                default: pairs += FLUID_BLOCK_DIM(KERNEL_CUBIC, 0, 0); break;
                 }
+#undef FLUID_BLOCK_DIM
             }
         }
-        /* forces to accelerations, plus the body force; soil particles: left to the soil pass */
+        /* forces to accelerations, plus the body force */
         const double gx = f->prm.body_force[0], gy = f->prm.body_force[1], gz = f->prm.body_force[2];
         const double *const m = p->m;
 #pragma omp for schedule(static)

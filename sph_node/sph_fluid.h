@@ -40,9 +40,9 @@
  * particle that comes first in the forward half of the cell stencil, and its terms are added to
  * both (the momentum terms as the pair force m_i m_j (...) with +F to i and -F to j, so momentum is
  * conserved to round-off; the continuity and delta-SPH terms each with their own V and rho). The
- * threads take slabs of cell rows, a parity at a time, so no two add to one particle at once, and
- * each particle receives its terms in an order fixed by the slabs: bitwise the same result for any
- * number of threads (sph_fluid.c fluid_pass). The other loops over particles (SPS, Shepard,
+ * threads take blocks of cell rows, a colour at a time (sph_cells_blocks), so no two add to one
+ * particle at once, and each particle receives its terms in an order fixed by the blocks: bitwise
+ * the same result for any number of threads (sph_fluid.c fluid_pass). The other loops over particles (SPS, Shepard,
  * shifting, soil) gather: each particle sums over its own neighbours in cell order. */
 #ifndef LAHAR_SPH_FLUID_H
 #define LAHAR_SPH_FLUID_H

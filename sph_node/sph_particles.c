@@ -312,20 +312,34 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     return 0;
 }
 
-int sph_cells_slab_count(const sph_cells *c)
+/* runs of w rows out of `rows`: at least 1, even on a periodic axis */
+static int block_runs(int rows, int w, int periodic)
 {
-    const int axis = c->dim == 3 ? 2 : 1;
-    int nslab = c->nc[axis] / c->reach;
-    if (nslab < 1)
-        nslab = 1;
-    if (c->periodic[axis] && nslab > 1 && nslab % 2 == 1)
-        nslab--;
-    return nslab;
+    int n = rows / w;
+    if (n < 1)
+        n = 1;
+    if (periodic && n > 1 && n % 2 == 1)
+        n--;
+    return n;
 }
 
-void sph_cells_slab_rows(const sph_cells *c, int nslab, int s, int *row0, int *row1)
+void sph_cells_blocks(const sph_cells *c, sph_blocks *b)
 {
-    const int rows = c->nc[c->dim == 3 ? 2 : 1];
-    *row0 = s * c->reach;
-    *row1 = s == nslab - 1 ? rows : (s + 1) * c->reach;
+    const int d3 = c->dim == 3, A = d3 ? 2 : 1;
+    b->rows_a = c->nc[A];
+    b->rows_b = d3 ? c->nc[1] : 1;
+    b->wa = c->reach;
+    b->wb = 2 * c->reach;
+    b->na = block_runs(b->rows_a, b->wa, c->periodic[A]);
+    b->nb = d3 ? block_runs(b->rows_b, b->wb, c->periodic[1]) : 1;
+}
+
+int sph_cells_block(const sph_blocks *b, int k, int *a0, int *a1, int *b0, int *b1)
+{
+    const int ka = k / b->nb, kb = k % b->nb;
+    *a0 = ka * b->wa;
+    *a1 = ka == b->na - 1 ? b->rows_a : (ka + 1) * b->wa;
+    *b0 = kb * b->wb;
+    *b1 = kb == b->nb - 1 ? b->rows_b : (kb + 1) * b->wb;
+    return (ka % 2) * 2 + kb % 2;
 }

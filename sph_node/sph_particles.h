@@ -91,19 +91,30 @@ void sph_cells_free(sph_cells *c);
  * order (stable: particles of a cell keep their relative order). Returns 0, or -1 when the cell
  * table cannot grow (out of memory). */
 int sph_cells_sort(sph_cells *c, sph_particles *p);
-/* Slabs for pair loops that add each pair to both particles (sph_fluid.c): runs of `reach` cell
- * rows along the slowest axis (y in 2D, z in 3D), each one contiguous range of the sorted arrays.
- * The pairs of the forward half stencil met from slab s touch only slab s and the first reach rows
- * after it, so slabs of one parity can run at the same time. On a periodic slowest axis the rows
- * after the last slab are the first slab's, so the count is made even there (the last slab takes
- * the rows left over). Slab s covers rows [*row0, *row1) of the slowest axis. */
-int sph_cells_slab_count(const sph_cells *c);
-void sph_cells_slab_rows(const sph_cells *c, int nslab, int s, int *row0, int *row1);
-/* First particle of row `row` of the slowest axis (row = the row count: n). */
-static inline int64_t sph_cells_row_start(const sph_cells *c, int row)
+/* Blocks for pair loops that add each pair to both particles (sph_fluid.c). The cell rows along
+ * the slowest axis A (y in 2D, z in 3D) are cut into runs of `reach` rows, and in 3D the rows
+ * along the middle axis B (y) into runs of 2 reach; a block is one run of each (2D: one run of A,
+ * all of B) and, in the sorted order, one contiguous range of particles per A row. The pairs of
+ * the forward half stencil met from a block touch only the cells in its A rows and the reach rows
+ * after them, and in its B rows widened by reach on both sides. So two blocks whose A runs differ
+ * in parity, or whose A runs agree and B runs differ in parity, may share particles; blocks of one
+ * colour (A parity, B parity) never do and can run at the same time. On a periodic axis the run
+ * after the last is the first, so the count of runs is made even there (the last run takes the
+ * rows left over). The blocks depend on the grid only, never on the number of threads. */
+typedef struct {
+    int na, nb;         /* runs along A and along B (1 in 2D); block k = (k / nb, k % nb) */
+    int rows_a, rows_b; /* cell rows along A and B (1 in 2D) */
+    int wa, wb;         /* rows per run along A (reach) and B (2 reach) */
+} sph_blocks;
+#define SPH_BLOCK_COLOURS 4
+void sph_cells_blocks(const sph_cells *c, sph_blocks *b);
+/* Block k's rows [*a0, *a1) along A and [*b0, *b1) along B, and its colour (0 .. 3). */
+int sph_cells_block(const sph_blocks *b, int k, int *a0, int *a1, int *b0, int *b1);
+/* First particle of cells (A row a, B row b, x = 0): [run(a, b0), run(a, b1)) are the block's
+ * particles in row a (b1 = rows_b gives the start of row a + 1). */
+static inline int64_t sph_cells_run_start(const sph_cells *c, const sph_blocks *b, int a, int brow)
 {
-    const int64_t row_len = c->dim == 3 ? (int64_t)c->nc[0] * c->nc[1] : c->nc[0];
-    return c->start[row * row_len];
+    return c->start[((int64_t)a * b->rows_b + brow) * c->nc[0]];
 }
 
 /* Cell coordinate of a position along axis a (clamped into the grid). */

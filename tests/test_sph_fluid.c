@@ -4,9 +4,9 @@
  *  2. the cell-list rates (continuity + delta-SPH, pressure, Morris viscosity, Monaghan AV, Tait)
  *     against a brute-force O(n^2) evaluation with minimum-image periodicity, relative 1e-12,
  *     in 2D (periodic x and y) and 3D (periodic x only), for every kernel, and on 2 threads with
- *     every axis periodic (2D 3025, 3D 2744 particles: the symmetric pass's slabs in parallel);
- *     the water pass's neighbour count equals the brute-force count; the slabs of that pass never
- *     let two threads write one row;
+ *     every axis periodic (2D 3025, 3D 2744 particles: the symmetric pass's blocks in parallel);
+ *     the water pass's neighbour count equals the brute-force count; the blocks of that pass never
+ *     let two threads write one cell;
  *  3. delta-SPH diffuses: for rho = rho0 (1 + A sin(k x)) at rest on a lattice, drho/dt equals
  *     delta h c0 lap(rho) = -delta h c0 k^2 (rho - rho0) within 2 % (Brookshaw's Laplacian,
  *     Molteni & Colagrossi 2009), i.e. a crest decays;
@@ -112,12 +112,13 @@ static int64_t brute_rates(const sph_fluid *f, int64_t i, double out[4])
 /* Rates of a disordered, moving, noisy lattice of side[] particles against brute_rates, and the
  * water pass's neighbour count against the brute-force count of pairs within the support. big:
  * every axis periodic and 2 threads with n above SPH_OMP_MIN_HEAVY, so that the symmetric pass runs
- * its slabs in parallel (a race would show here) and, with an odd number of slabs along the
- * periodic slowest axis, merges the last two (sph_fluid.c fluid_pass). */
+ * its blocks in parallel and, with an odd number of runs along a periodic axis, merges the last
+ * two (sph_cells_blocks). */
 static void check_rates_brute(int dim, const char *kern, sph_eos eos, int big)
 {
     /* small: 2D 12 x 12 periodic x and y, 3D 12 x 6 x 6 periodic x; big: 2D 55 x 55 (42 cell rows
-     * of the cubic kernel, 21 slabs), 3D 14 x 14 x 14 (10 rows, 5 slabs) */
+     * of the cubic kernel, 21 runs of 2), 3D 14 x 14 x 14 (10 rows: 5 runs of 2 along z, 2 of 4
+     * along y) */
     const int side[3] = {big ? (dim == 2 ? 55 : 14) : 12, big ? (dim == 2 ? 55 : 14) : dim == 2 ? 12 : 6,
                          dim == 2 ? 1 : big ? 14 : 6};
     omp_set_num_threads(big ? 2 : 1);
@@ -186,52 +187,76 @@ static void check_rates_brute(int dim, const char *kern, sph_eos eos, int big)
     sph_fluid_free(&f);
 }
 
-/* The slabs of the symmetric pass (sph_cells_slab_count): for every row count and periodicity they
- * cover the rows of the slowest axis once, in order, and two slabs of one parity never write the
- * same row (a slab writes its rows and the reach rows after it, wrapped on a periodic axis), so
- * the slabs of a parity can run at the same time without a race. */
-static void check_slabs(void)
+/* The blocks of the symmetric pass (sph_cells_blocks): for every row count and periodicity they
+ * tile the grid of A and B rows once, and two blocks of one colour never write the same cell
+ * (a block writes its A rows and the reach rows after them, its B rows and reach rows on either
+ * side; wrapped on a periodic axis, cut off on another), so the blocks of a colour can run at the
+ * same time without a race. */
+static void check_blocks(void)
 {
+    enum { MAXA = 41, MAXB = 21 };
+    static int writer[MAXA][MAXB][SPH_BLOCK_COLOURS]; /* block of each colour writing the cell, or -1 */
+    static int owner[MAXA][MAXB];
     int bad = 0, cases = 0;
     for (int dim = 2; dim <= 3; dim++)
-        for (int periodic = 0; periodic < 2; periodic++)
-            for (int rows = 1; rows <= 41; rows++) {
-                if (periodic && rows < 2 * SPH_CELLS_PER_SUPPORT + 1) /* sph_cells_init refuses them */
-                    continue;
-                sph_cells c;
-                memset(&c, 0, sizeof c);
-                c.dim = dim;
-                c.reach = SPH_CELLS_PER_SUPPORT;
-                c.nc[0] = c.nc[1] = c.nc[2] = 1;
-                c.nc[dim - 1] = rows;
-                c.periodic[dim - 1] = periodic;
-                const int nslab = sph_cells_slab_count(&c);
-                int writer[64][2]; /* per row: the slab of each parity that writes it, or -1 */
-                for (int r = 0; r < rows; r++)
-                    writer[r][0] = writer[r][1] = -1;
-                int next = 0;
-                for (int s = 0; s < nslab; s++) {
-                    int r0, r1;
-                    sph_cells_slab_rows(&c, nslab, s, &r0, &r1);
-                    bad += r0 != next || r1 <= r0;
-                    next = r1;
-                    for (int r = r0; r < r1 + c.reach; r++) {
-                        int row = r;
-                        if (row >= rows) {
-                            if (!periodic)
-                                break;
-                            row -= rows;
+        for (int per = 0; per < 4; per++)
+            for (int ra = 1; ra <= MAXA; ra++)
+                for (int rb = 1; rb <= (dim == 3 ? MAXB : 1); rb++) {
+                    const int pa = per & 1, pb = dim == 3 && (per & 2);
+                    if (dim == 2 && (per & 2))
+                        continue;
+                    /* sph_cells_init refuses periodic axes of fewer than 2 reach + 1 cells */
+                    if ((pa && ra < 2 * SPH_CELLS_PER_SUPPORT + 1) || (pb && rb < 2 * SPH_CELLS_PER_SUPPORT + 1))
+                        continue;
+                    sph_cells c;
+                    memset(&c, 0, sizeof c);
+                    c.dim = dim;
+                    c.reach = SPH_CELLS_PER_SUPPORT;
+                    c.nc[0] = c.nc[1] = c.nc[2] = 1;
+                    c.nc[dim - 1] = ra;
+                    if (dim == 3)
+                        c.nc[1] = rb;
+                    c.periodic[dim - 1] = pa;
+                    c.periodic[1] = c.periodic[1] || pb;
+                    sph_blocks blk;
+                    sph_cells_blocks(&c, &blk);
+                    for (int x = 0; x < ra; x++)
+                        for (int y = 0; y < rb; y++) {
+                            owner[x][y] = -1;
+                            for (int q = 0; q < SPH_BLOCK_COLOURS; q++)
+                                writer[x][y][q] = -1;
                         }
-                        if (writer[row][s % 2] != -1 && writer[row][s % 2] != s)
-                            bad++;
-                        writer[row][s % 2] = s;
+                    const int R = c.reach;
+                    for (int k = 0; k < blk.na * blk.nb; k++) {
+                        int a0, a1, b0, b1;
+                        const int col = sph_cells_block(&blk, k, &a0, &a1, &b0, &b1);
+                        for (int x = a0; x < a1; x++)
+                            for (int y = b0; y < b1; y++) {
+                                bad += x >= ra || y >= rb || owner[x][y] != -1;
+                                if (x < ra && y < rb)
+                                    owner[x][y] = k;
+                            }
+                        for (int x = a0; x < a1 + R; x++)
+                            for (int y = b0 - R; y < b1 + R; y++) {
+                                int wx = x, wy = y;
+                                if (wx >= ra && !pa)
+                                    continue;
+                                if ((wy < 0 || wy >= rb) && !pb)
+                                    continue;
+                                wx %= ra;
+                                wy = (wy + rb) % rb;
+                                if (writer[wx][wy][col] != -1 && writer[wx][wy][col] != k)
+                                    bad++;
+                                writer[wx][wy][col] = k;
+                            }
                     }
+                    for (int x = 0; x < ra; x++)
+                        for (int y = 0; y < rb; y++)
+                            bad += owner[x][y] == -1;
+                    cases++;
                 }
-                bad += next != rows;
-                cases++;
-            }
-    printf("slabs of the symmetric pass: %d row counts and periodicities, %d overlaps or gaps\n", cases, bad);
-    CHECK(bad == 0, "slabs overlap within a parity or do not cover the rows (%d)", bad);
+    printf("blocks of the symmetric pass: %d grids and periodicities, %d overlaps or gaps\n", cases, bad);
+    CHECK(bad == 0, "blocks overlap within a colour or do not tile the grid (%d)", bad);
 }
 
 static void check_delta_sph(void)
@@ -522,7 +547,7 @@ int main(void)
     }
     check_rates_brute(2, "cubic", SPH_EOS_LINEAR, 1);
     check_rates_brute(3, "cubic", SPH_EOS_LINEAR, 1);
-    check_slabs();
+    check_blocks();
     check_delta_sph();
     check_eos();
     check_shepard();
