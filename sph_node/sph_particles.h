@@ -11,9 +11,13 @@
 
 /* OpenMP loops over particles run in parallel only above these counts: below them a step costs
  * more in barriers than in work (measured: 25 ms per step for 250 particles on a loaded 2-core
- * machine). Heavy = neighbour or body sums per particle, light = a few flops per particle. */
+ * machine). Heavy = neighbour or body sums per particle, light = a few flops per particle. The
+ * light bound was 32768 until the water pass became symmetric: then at 24,844 particles (the
+ * boulder pool of `lahar bench`) the serial light loops (integration, sort, EOS) left the second
+ * thread spinning in libgomp for 15.7 % of the node's samples (perf); at 4096, 6.7 %. Their
+ * reductions are max or integer sums: the same bits for any thread count. */
 #define SPH_OMP_MIN_HEAVY 2048
-#define SPH_OMP_MIN_LIGHT 32768
+#define SPH_OMP_MIN_LIGHT 4096
 /* Heavy loops hand out particles in chunks of this many, dynamically: the cost per particle
  * varies with position (full neighbourhoods at the bottom of a column, few at its surface, body
  * sums only near walls; sorted by cell, a static split gives one thread the floor and the other
