@@ -100,6 +100,9 @@ s = json.load(open(out + "/summary.json"))
 steps = s["steps"]
 assert s["status"] == "finished" and s["sim_time"] == 0.2, (s["status"], s["sim_time"])
 assert set(s["nodes"]) == {"dem", "sph"}, s["nodes"].keys()
+# the wall time split: start-up + steps + end = the whole run, each part positive
+parts = (s["setup_s"], s["stepping_s"], s["finish_s"])
+assert min(parts) > 0 and abs(sum(parts) - s["wall_time_s"]) < 1e-3, (parts, s["wall_time_s"])
 for ch in ("LAHAR_LOADS", "LAHAR_BODY_STATE", "LAHAR_STEP"):
     assert s["channels"][ch]["messages"] == steps, (ch, s["channels"][ch]["messages"], steps)
 with h5py.File(out + "/particles.h5", "r") as f:

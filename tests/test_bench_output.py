@@ -112,6 +112,9 @@ def main(out, sections, cases):
         for r in rows:
             check(all(num(r[k]) >= 0 for k in ("sph_compute_ms_per_step", "sph_wait_ms_per_step",
                                               "dem_wait_ms_per_step")), f"overhead/{r['size']}/{r['mode']}: per-step times >= 0")
+            # the steps' wall time is the run's minus its start-up and end: positive, and less
+            check(0 < num(r["stepping_s"]) < num(r["wall_s"]) and 0 < num(r["setup_s"]) < num(r["wall_s"]),
+                  f"overhead/{r['size']}/{r['mode']}: 0 < stepping_s, setup_s < wall_s")
     print(f"{len(failures)} failures")
     return 1 if failures else 0
 
