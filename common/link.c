@@ -119,6 +119,8 @@ struct lahar_link {
     pthread_t hb_thread;
     int hb_running;
     _Atomic int hb_stop;
+    pthread_mutex_t hb_lock; /* with hb_wake: the thread sleeps a whole period, woken at once by stop */
+    pthread_cond_t hb_wake;
     double hb_period;
     _Atomic int64_t completed_step;
     int64_t hb_seq;
@@ -599,12 +601,18 @@ static void *link_heartbeat_main(void *arg)
             link_publish_frames(l, LAHAR_FRAME_T_MSG_HEARTBEAT, hb.step, seq, buf, n, NULL, 0, 0);
             pthread_mutex_unlock(&l->send_lock);
         }
-        /* sleep in short slices so that stopping is quick */
-        double until = lahar_now() + l->hb_period;
-        while (!atomic_load(&l->hb_stop) && lahar_now() < until) {
-            struct timespec ts = {0, 10 * 1000 * 1000};
-            nanosleep(&ts, NULL);
-        }
+        /* one wake-up per period (a node's OpenMP threads lose a slice to every wake-up of
+         * another thread on the machine); lahar_link_heartbeat_stop signals hb_wake */
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        long long ns = (long long)until.tv_nsec + (long long)(l->hb_period * 1e9);
+        until.tv_sec += (time_t)(ns / 1000000000LL);
+        until.tv_nsec = (long)(ns % 1000000000LL);
+        pthread_mutex_lock(&l->hb_lock);
+        while (!atomic_load(&l->hb_stop))
+            if (pthread_cond_timedwait(&l->hb_wake, &l->hb_lock, &until) != 0)
+                break; /* timed out: the next beat */
+        pthread_mutex_unlock(&l->hb_lock);
     }
     return NULL;
 }
@@ -615,8 +623,17 @@ int lahar_link_heartbeat_start(lahar_link *l, double period_s)
         return 0;
     l->hb_period = period_s;
     atomic_store(&l->hb_stop, 0);
-    if (pthread_create(&l->hb_thread, NULL, link_heartbeat_main, l) != 0)
+    if (pthread_mutex_init(&l->hb_lock, NULL) != 0)
         return -1;
+    if (pthread_cond_init(&l->hb_wake, NULL) != 0) {
+        pthread_mutex_destroy(&l->hb_lock);
+        return -1;
+    }
+    if (pthread_create(&l->hb_thread, NULL, link_heartbeat_main, l) != 0) {
+        pthread_cond_destroy(&l->hb_wake);
+        pthread_mutex_destroy(&l->hb_lock);
+        return -1;
+    }
     l->hb_running = 1;
     return 0;
 }
@@ -625,8 +642,13 @@ void lahar_link_heartbeat_stop(lahar_link *l)
 {
     if (!l->hb_running)
         return;
+    pthread_mutex_lock(&l->hb_lock);
     atomic_store(&l->hb_stop, 1);
+    pthread_cond_signal(&l->hb_wake);
+    pthread_mutex_unlock(&l->hb_lock);
     pthread_join(l->hb_thread, NULL);
+    pthread_cond_destroy(&l->hb_wake);
+    pthread_mutex_destroy(&l->hb_lock);
     l->hb_running = 0;
 }
 
