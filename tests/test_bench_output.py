@@ -98,6 +98,9 @@ def main(out, sections, cases):
         check(num(forced["dem_substeps"]) == num(forced["steps"]),
               "subcycle: with dt_max = the DEM's stable dt there is one DEM substep per step")
         check(num(forced["steps"]) > num(sub["steps"]), "subcycle: the forced run takes more coordinator steps")
+        # the boulders' end positions were read from both runs' bodies.h5 (a number, and the boulders moved)
+        check(math.isfinite(num(sub["body_position_diff_mm"])) and num(sub["body_moved_mm"]) > 0,
+              "subcycle: the boulders' positions of both runs compared")
     if "overhead" in sections:
         _, rows = rows_of(os.path.join(out, "overhead.csv"))
         for size in ("large", "floor"):
