@@ -1258,7 +1258,7 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
 }
 
 int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
-                                          int (*keep)(const double x[3], void *ctx), void *ctx, int64_t most,
+                                          int (*keep)(double x[3], void *ctx), void *ctx, int64_t most,
                                           double (*out)[3], int64_t cap)
 {
     int64_t n[3];

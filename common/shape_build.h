@@ -102,9 +102,10 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
  * many lie inside (which may exceed cap). */
 int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap);
 /* As lahar_particle_block_lattice, keeping only the points for which keep(x, ctx) is non-zero
- * (keep may be NULL) and stopping after `most` points (-1: no limit). */
+ * (keep may be NULL; it may move the point it keeps: the moved x is written) and stopping after
+ * `most` points (-1: no limit). */
 int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
-                                          int (*keep)(const double x[3], void *ctx), void *ctx, int64_t most,
+                                          int (*keep)(double x[3], void *ctx), void *ctx, int64_t most,
                                           double (*out)[3], int64_t cap);
 
 /* lo/hi of a polygon or mesh block from its vertices (z = 0 .. 0 in 2D). */
