@@ -15,7 +15,10 @@
  * particle id: largest position difference in dx, relative L2 difference of the velocities), which
  * is how an optimisation of the solver shows it changed nothing but round-off.
  *
- *   bench_sph [--steps2d n] [--steps3d n] [--threads 1,2] [--save-ref FILE] [--ref FILE] [2d] [3d]
+ *   bench_sph [--steps2d n] [--steps3d n] [--threads 1,2] [--repeat n] [--save-ref FILE] [--ref FILE] [2d] [3d]
+ *
+ * --repeat n runs n rounds of the thread counts, alternating, and ends each case with the median
+ * particle-steps per second per thread count and the median of the rounds' speed-ups.
  *
  * Profiling only the timed part:
  *   valgrind --tool=callgrind --collect-atstart=no --toggle-collect='bench_measure*' bench_sph ...
@@ -229,7 +232,45 @@ static void reference(const bench_case *c, const sph_fluid *f, const int64_t *or
     }
 }
 
-static void run_case(bench_case *c, int steps, const int *thr, int nthr, const char *save, const char *cmp)
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+#define BENCH_MAX_REPEAT 32
+
+static void run_round(bench_case *c, int steps, const int *thr, int nthr, const char *save, const char *cmp, int last,
+                      double rate[][BENCH_MAX_REPEAT], double ratio[][BENCH_MAX_REPEAT], int round);
+
+/* One row per round and thread count; with repeat > 1 the thread counts alternate round by round
+ * (1, 2, 1, 2, ...: on a VM whose speed drifts, each speed-up compares runs a few seconds apart)
+ * and a last line gives the medians. */
+static void run_case(bench_case *c, int steps, const int *thr, int nthr, int repeat, const char *save,
+                     const char *cmp)
+{
+    double rate[8][BENCH_MAX_REPEAT], ratio[8][BENCH_MAX_REPEAT];
+    for (int r = 0; r < repeat; r++)
+        run_round(c, steps, thr, nthr, save, cmp, r == repeat - 1, rate, ratio, r);
+    if (repeat < 2)
+        return;
+    printf("# %s, median of %d rounds:", c->name, repeat);
+    for (int t = 0; t < nthr; t++) {
+        printf(" %d thread%s %.3g particle-steps/s", thr[t], thr[t] == 1 ? "" : "s", median(rate[t], repeat));
+        if (thr[t] != 1 && ratio[t][0] > 0.0)
+            printf(" (speed-up %.2f)", median(ratio[t], repeat));
+        printf(t == nthr - 1 ? "\n" : ";");
+    }
+}
+
+static void run_round(bench_case *c, int steps, const int *thr, int nthr, const char *save, const char *cmp, int last,
+                      double rate[][BENCH_MAX_REPEAT], double ratio[][BENCH_MAX_REPEAT], int round)
 {
     double t1 = 0.0;
     for (int t = 0; t < nthr; t++) {
@@ -258,11 +299,13 @@ static void run_case(bench_case *c, int steps, const int *thr, int nthr, const c
         char speedup[32] = "-";
         if (t1 > 0.0)
             snprintf(speedup, sizeof speedup, "%.2f", t1 / wall_s);
+        rate[t][round] = (double)f.p.n * steps / wall_s;
+        ratio[t][round] = t1 > 0.0 ? t1 / wall_s : 0.0;
         printf("| %s | %lld | %d | %.3f | %.3f | %.3g | %d | %s | %.0f | %.4g | %.3g | %016llx |\n", c->name,
                (long long)f.p.n, steps, wall_s, cpu_s, (double)f.p.n * steps / wall_s, thr[t], speedup,
                (double)bytes / (double)f.p.n, f.t, rhomax, digest(&f, order));
         fflush(stdout);
-        if (t == nthr - 1)
+        if (t == nthr - 1 && last)
             reference(c, &f, order, save, cmp, steps);
         free(order);
         sph_fluid_free(&f);
@@ -271,7 +314,7 @@ static void run_case(bench_case *c, int steps, const int *thr, int nthr, const c
 
 int main(int argc, char **argv)
 {
-    int steps2 = 100, steps3 = 40, thr[8] = {1, 2}, nthr = 2, want2 = 0, want3 = 0;
+    int steps2 = 100, steps3 = 40, thr[8] = {1, 2}, nthr = 2, want2 = 0, want3 = 0, repeat = 1;
     const char *save = NULL, *cmp = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--steps2d") && i + 1 < argc)
@@ -282,6 +325,13 @@ int main(int argc, char **argv)
             save = argv[++i];
         else if (!strcmp(argv[i], "--ref") && i + 1 < argc)
             cmp = argv[++i];
+        else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) {
+            repeat = atoi(argv[++i]);
+            if (repeat < 1 || repeat > BENCH_MAX_REPEAT) {
+                fprintf(stderr, "bench_sph: --repeat takes 1 .. %d rounds (got %s)\n", BENCH_MAX_REPEAT, argv[i]);
+                return 2;
+            }
+        }
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             nthr = 0;
             for (char *s = strtok(argv[++i], ","); s && nthr < 8; s = strtok(NULL, ","))
@@ -291,8 +341,8 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "3d"))
             want3 = 1;
         else {
-            fprintf(stderr, "usage: bench_sph [--steps2d n] [--steps3d n] [--threads 1,2] [--save-ref FILE] "
-                            "[--ref FILE] [2d] [3d]\n");
+            fprintf(stderr, "usage: bench_sph [--steps2d n] [--steps3d n] [--threads 1,2] [--repeat n] "
+                            "[--save-ref FILE] [--ref FILE] [2d] [3d]\n");
             return 2;
         }
     }
@@ -304,7 +354,7 @@ int main(int argc, char **argv)
         bench_case c = {.name = "dam_break_2d_80k", .dim = 2, .dx = 0.002, .c0 = 40.0, .col = {0.4, 0.8, 0.0},
                         .tank = {1.6, 1.0, 0.0}};
         case_walls(&c);
-        run_case(&c, steps2, thr, nthr, save, cmp);
+        run_case(&c, steps2, thr, nthr, repeat, save, cmp);
         for (int b = 0; b < c.nbody; b++)
             lahar_shape_free(&c.walls[b].shape);
     }
@@ -312,7 +362,7 @@ int main(int argc, char **argv)
         bench_case c = {.name = "dam_break_3d_100k", .dim = 3, .dx = 0.01, .c0 = 30.0, .col = {0.5, 0.4, 0.5},
                         .tank = {1.6, 0.4, 0.8}};
         case_walls(&c);
-        run_case(&c, steps3, thr, nthr, save, cmp);
+        run_case(&c, steps3, thr, nthr, repeat, save, cmp);
         for (int b = 0; b < c.nbody; b++)
             lahar_shape_free(&c.walls[b].shape);
     }
