@@ -15,3 +15,9 @@ add_test(NAME bench_quick
           ${LAHAR_TEST_DIR}/test_bench_output.py)
 set_tests_properties(bench_quick PROPERTIES LABELS "slow;netns;bench" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_BENCH_PYTHON}")
+
+# The converged solution the bench measures an experiment case's error against (Richardson
+# extrapolation, or the finest run when the sweep does not converge monotonically), on synthetic
+# sweeps with a known limit and order.
+add_test(NAME bench_converged_reference COMMAND ${LAHAR_BENCH_PYTHON} ${LAHAR_TEST_DIR}/test_bench_converged.py)
+set_tests_properties(bench_converged_reference PROPERTIES LABELS "fast;bench" TIMEOUT 60)

@@ -67,8 +67,20 @@ def check_case(out, name):
         vals = {k: v["value"] for k, v in chk["metrics"].items()}
         vals.update({k: v for k, v in chk["info"].items() if isinstance(v, (int, float))})
         want = max(vals[k] for k in bench.BENCH[name]["error"])
-        check(math.isclose(num(r["error"]), want, rel_tol=1e-5) and 0.0 <= want < 10.0,
-              f"{lab}: error {r['error']} = max of check.json {bench.BENCH[name]['error']} ({want:.6g})")
+        if bench.BENCH[name].get("converged"):
+            # an experiment's case: the check's deviation from it is exp_deviation, and the error is
+            # against the converged solution the error_reference names
+            check(math.isclose(num(r["exp_deviation"]), want, rel_tol=1e-5) and 0.0 <= want < 10.0,
+                  f"{lab}: exp_deviation {r['exp_deviation']} = max of check.json {bench.BENCH[name]['error']} ({want:.6g})")
+            check(r["error_reference"].startswith(("Richardson", "finest run")),
+                  f"{lab}: error_reference names the converged solution ({r['error_reference']})")
+            is_ref = r["family"] == "base" and r["error_reference"].startswith(f"finest run dx {num(r['dx']):.4g} ")
+            check(math.isnan(num(r["error"])) if is_ref else 0.0 < num(r["error"]) < 10.0,
+                  f"{lab}: error against the converged solution {r['error']}"
+                  + (" (nan: this run is the reference)" if is_ref else " is a number"))
+        else:
+            check(math.isclose(num(r["error"]), want, rel_tol=1e-5) and 0.0 <= want < 10.0,
+                  f"{lab}: error {r['error']} = max of check.json {bench.BENCH[name]['error']} ({want:.6g})")
         # a soil setting reached the case's own soil material (bench.SOIL_SETTINGS, `{soil}`)
         if r["family"] == "soil_av":
             case = case_override.load_case(os.path.join(out, "runs", name, r["label"] + ".yaml"))
