@@ -37,6 +37,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 import time
 
 TOOLS = os.path.dirname(os.path.abspath(__file__))
@@ -326,7 +327,9 @@ def converged_errors(rows, spec, rundir):
     window ends when the first base run's y stops rising (the front reaches the wall)."""
     import numpy as np
     ser = {r["label"]: read_series(os.path.join(rundir, r["label"]), spec["converged"]) for r in rows}
-    base = {r["dx"]: ser[r["label"]] for r in rows if r["family"] == "base" and ser[r["label"]] is not None}
+    def exact_dx(r):  # the planned dx (a resumed row's dx was rounded to 6 digits in the CSV)
+        return min(spec["dx"], key=lambda d: abs(d - r["dx"]))
+    base = {exact_dx(r): ser[r["label"]] for r in rows if r["family"] == "base" and ser[r["label"]] is not None}
     for r in rows:
         r["exp_deviation"] = check_error(os.path.join(rundir, r["label"]), spec["error"])[0]
         r["error"], r["error_reference"] = float("nan"), ""
@@ -347,7 +350,7 @@ def converged_errors(rows, spec, rundir):
     for r in rows:
         s = ser[r["label"]]
         r["error_reference"] = desc + f", t <= {t[-1]:.3g} s"
-        if s is None or span <= 0 or (r["family"] == "base" and r["dx"] == ref_dx):
+        if s is None or span <= 0 or (r["family"] == "base" and exact_dx(r) == ref_dx):
             continue  # the reference run itself has no error of its own
         r["error"] = float(np.max(np.abs(np.interp(t, s[0], s[1]) - ystar))) / span
     return desc
@@ -516,10 +519,11 @@ def plot_pareto(path, name, spec, rows, cost="wall_s"):
         title += f" ({len(failed)} runs failed: " + ", ".join(r["label"] for r in failed[:3]) + \
                  (" ..." if len(failed) > 3 else "") + ")"
     ax.set_title(title, fontsize=9)
-    fig.text(0.01, 0.01, "error: " + spec["error_note"], fontsize=6.5)
+    note = textwrap.wrap("error: " + spec["error_note"], 160)
+    fig.text(0.01, 0.01, "\n".join(note), fontsize=6.5)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="best", title="numbers: particles", title_fontsize=7)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.tight_layout(rect=(0, 0.03 * len(note), 1, 1))
     fig.savefig(path)
     plt.close(fig)
 
