@@ -562,6 +562,8 @@ static void read_dem(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     rmap_check_keys(&m, keys);
     rmap_name(&m, "engine", 0, "spheropoly", c->dem_engine);
+    yaml_node_t *engine_node = rmap_get(&m, "engine");
+    c->dem_engine_line = engine_node ? (int)engine_node->start_mark.line + 1 : 0;
     c->dem_dt_safety = rmap_num(&m, "dt_safety", 0, 0.02, "0.02");
     if (!r->failed && !(c->dem_dt_safety > 0 && c->dem_dt_safety <= 1)) {
         rmap_fail(&m, "dt_safety", "must be in (0, 1] (got %g); it is the fraction of the contact period used as "

@@ -169,6 +169,7 @@ typedef struct {
 
     /* DEM engine options */
     char dem_engine[LAHAR_NAME_MAX]; /* "spheropoly" by default */
+    int dem_engine_line;             /* line of `dem.engine` in the case file (0: not given), for messages */
     double dem_dt_safety;  /* fraction of the contact period used as the DEM step, default 0.02 */
 
     lahar_check check;

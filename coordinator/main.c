@@ -11,6 +11,7 @@
 #include "case.h"
 #include "check.h"
 #include "coordinator.h"
+#include "dem_engine.h"
 #include "netns.h"
 
 static void usage(FILE *f)
@@ -80,6 +81,46 @@ static int bench_exec(int argc, char **argv)
     return 2;
 }
 
+/* A whole number in [lo, hi] for option `opt`, or exit 2 naming the option and what it takes. */
+static int parse_int_option(const char *cmd, const char *opt, const char *s, long lo, long hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || end == s || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "lahar %s: %s takes a whole number from %ld to %ld (got '%s')\n", cmd, opt, lo, hi, s);
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+/* A number in (lo, hi] of seconds for option `opt`, or exit 2. */
+static int parse_seconds_option(const char *cmd, const char *opt, const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end != '\0' || !(v > lo && v <= hi)) {
+        fprintf(stderr, "lahar %s: %s takes a number of seconds above %g and at most %g (got '%s')\n", cmd, opt, lo,
+                hi, s);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* The DEM engine the case names must exist in this build (dem_node/dem_engine_registry.c): said at
+ * validation, with the case's file and line, not when the DEM node starts. */
+static int check_dem_engine(const lahar_case *cs)
+{
+    if (lahar_dem_engine_find(cs->dem_engine))
+        return 0;
+    fprintf(stderr, "%s:%d: dem.engine: unknown DEM engine '%s'; engines in this build: %s\n", cs->path,
+            cs->dem_engine_line, cs->dem_engine, lahar_dem_engine_names());
+    return -1;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -117,11 +158,17 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
         switch (c) {
         case 'o': o.outdir = optarg; break;
-        case 't': o.threads = atoi(optarg); break;
+        case 't':
+            if (parse_int_option(cmd, "--threads", optarg, 1, 1024, &o.threads) != 0)
+                return 2;
+            break;
         case 'i': o.in_process = 1; break;
         case 'n': o.no_spawn = 1; break;
         case 'u': o.lcm_url = optarg; break;
-        case 'w': o.join_wait_s = atof(optarg); break;
+        case 'w':
+            if (parse_seconds_option(cmd, "--wait", optarg, 0.0, 86400.0, &o.join_wait_s) != 0)
+                return 2;
+            break;
         case 'q': o.quiet = 1; break;
         case 'e': evaluate_only = 1; break;
         case 'h': usage(stdout); return 0;
@@ -149,6 +196,10 @@ int main(int argc, char **argv)
     lahar_case cs;
     if (lahar_case_load(case_path, &cs) != 0)
         return LAHAR_EXIT_BAD_INPUT;
+    if (check_dem_engine(&cs) != 0) {
+        lahar_case_free(&cs);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
     int status = 0;
     if (is_validate) {
         printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,

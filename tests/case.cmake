@@ -20,3 +20,9 @@ target_link_libraries(test_case_blocks PRIVATE lahar_common)
 # bodies cut out of the lattice against an independent inside test
 add_test(NAME case_blocks COMMAND test_case_blocks ${CMAKE_CURRENT_BINARY_DIR})
 set_tests_properties(case_blocks PROPERTIES LABELS fast)
+
+# the command line: bad option values and an unknown DEM engine exit 2 with a message naming the
+# option, or the case's file, line and key
+add_test(NAME cli_bad_args COMMAND sh ${LAHAR_TEST_DIR}/cli_bad_args.sh $<TARGET_FILE:lahar>
+         ${LAHAR_TEST_DIR}/bad_args ${CMAKE_CURRENT_BINARY_DIR}/cli_bad_args)
+set_tests_properties(cli_bad_args PROPERTIES LABELS fast)

@@ -1,0 +1,33 @@
+#!/bin/sh
+# The coordinator's command line refuses bad arguments with exit status 2 and a message naming the
+# option or the case file, line and key (coordinator/main.c), before anything runs.
+# usage: cli_bad_args.sh LAHAR FIXTURES_DIR WORK_DIR
+lahar=$1 fixtures=$2 work=$3
+fail=0
+rm -rf "$work" && mkdir -p "$work"
+good=$fixtures/../../cases/dem_bounce_3d.yaml
+expect() { # expect STATUS PATTERN -- ARGS...
+    want=$1 pattern=$2
+    shift 3
+    "$lahar" "$@" >"$work/out" 2>"$work/err"
+    got=$?
+    if [ "$got" -ne "$want" ] || { [ -n "$pattern" ] && ! grep -q -E -e "$pattern" "$work/err"; }; then
+        echo "FAIL lahar $*: exit $got (want $want), stderr:"; sed 's/^/    /' "$work/err"
+        echo "     (wanted a line matching: $pattern)"
+        fail=$((fail + 1))
+    else
+        echo "ok   lahar $*: exit $got, $(head -n 1 "$work/err")"
+    fi
+}
+expect 2 "unknown_engine.yaml:5: dem.engine: unknown DEM engine 'nosuch'; engines in this build: spheropoly" -- \
+    validate "$fixtures/unknown_engine.yaml"
+expect 2 "unknown_engine.yaml:5: dem.engine" -- run "$fixtures/unknown_engine.yaml" -o "$work/run" --in-process
+expect 2 "--threads takes a whole number from 1 to 1024 \(got 'abc'\)" -- run "$good" -o "$work/run" --threads abc
+expect 2 "--threads takes a whole number" -- run "$good" -o "$work/run" --threads 0
+expect 2 "--threads takes a whole number" -- check "$good" -o "$work/run" --threads 2x
+expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait soon
+expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait 0
+[ ! -e "$work/run" ] || { echo "FAIL an output directory was created for a refused command"; fail=$((fail + 1)); }
+expect 0 "" -- validate "$good"
+echo "$((9 - fail)) passed, $fail failed"
+[ "$fail" -eq 0 ]
