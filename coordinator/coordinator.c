@@ -3,6 +3,7 @@
 #include "coordinator.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <libgen.h>
 #include <limits.h>
 #include <math.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/file.h>
 #include <sys/random.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -761,6 +763,50 @@ static int coord_mkdir_p(const char *path)
     return (mkdir(tmp, 0777) != 0 && errno != EEXIST) ? -1 : 0;
 }
 
+/* OUT/.lahar.lock, held (flock) for the whole run: a second run into the same directory is refused
+ * with the holder's pid, host, start time and case (the file's text), instead of two runs writing
+ * one set of HDF5 files. The lock goes with the process (also when it is killed); the file stays.
+ * Returns the descriptor, or -1 after saying why (and exit status 2 is the caller's). */
+static int coord_lock_outdir(const char *outdir, const char *case_path)
+{
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/.lahar.lock", outdir);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        fprintf(stderr, "lahar: cannot write in the output directory %s: %s; choose another -o or make it "
+                        "writable\n", outdir, strerror(errno));
+        return -1;
+    }
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        char text[512] = "", holder[768] = "";
+        ssize_t n = pread(fd, text, sizeof text - 1, 0);
+        text[n > 0 ? n : 0] = '\0';
+        size_t h = 0; /* the file's lines joined by ", " */
+        for (char *line = strtok(text, "\n"); line && h < sizeof holder; line = strtok(NULL, "\n"))
+            h += (size_t)snprintf(holder + h, sizeof holder - h, "%s%s", h ? ", " : "", line);
+        fprintf(stderr, "lahar: %s is in use by another lahar run (%s); wait for it to end, stop it, or choose "
+                        "another -o\n", outdir, holder[0] ? holder : "no details");
+        close(fd);
+        return -1;
+    }
+    char host[256] = "?", when[64] = "?";
+    gethostname(host, sizeof host - 1);
+    time_t now = time(NULL);
+    struct tm tm;
+    if (gmtime_r(&now, &tm))
+        strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &tm);
+    char text[PATH_MAX + 640];
+    int len = snprintf(text, sizeof text, "pid %ld\nhost %s\nstarted %s\ncase %s\n", (long)getpid(), host, when,
+                       case_path);
+    if (ftruncate(fd, 0) != 0 || pwrite(fd, text, (size_t)len, 0) != len) {
+        fprintf(stderr, "lahar: cannot write in the output directory %s: %s; choose another -o or free space "
+                        "there\n", outdir, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
 static int64_t coord_random_run_id(void)
 {
     uint64_t r = 0;
@@ -807,6 +853,9 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", o->outdir, strerror(errno));
         return LAHAR_EXIT_SETUP;
     }
+    int lock_fd = coord_lock_outdir(co.outdir, c->path);
+    if (lock_fd < 0)
+        return LAHAR_EXIT_SETUP;
 
     /* Where the messages go. Default: a private network namespace of our own. */
     char err[1024];
@@ -824,10 +873,12 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         /* nodes started by hand cannot join a namespace made here; the network must be named */
         fprintf(stderr, "lahar: --no-spawn needs --lcm-url URL (or $LCM_DEFAULT_URL), the same URL the nodes you "
                         "start are given, e.g. '%s' inside a network namespace you made\n", LAHAR_NETNS_URL);
+        close(lock_fd);
         return LAHAR_EXIT_SETUP;
     } else {
         if (lahar_netns_enter(err, sizeof err) != 0) {
             fprintf(stderr, "lahar: %s\n", err);
+            close(lock_fd);
             return LAHAR_EXIT_SETUP;
         }
         co.url = LAHAR_NETNS_URL;
@@ -941,5 +992,6 @@ out:
     }
     lahar_link_destroy(co.link);
     lahar_transport_close(co.t);
+    close(lock_fd);
     return status;
 }

@@ -29,5 +29,16 @@ expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait
 expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait 0
 [ ! -e "$work/run" ] || { echo "FAIL an output directory was created for a refused command"; fail=$((fail + 1)); }
 expect 0 "" -- validate "$good"
-echo "$((9 - fail)) passed, $fail failed"
+# an output directory another run holds (OUT/.lahar.lock, flock) is refused, naming the holder
+mkdir -p "$work/busy" && printf 'pid 4242\nhost testhost\nstarted then\ncase other.yaml\n' > "$work/busy/.lahar.lock"
+sh -c 'exec 9<>"$1"; flock 9; exec sleep 30' sh "$work/busy/.lahar.lock" & holder=$!  # the lock dies with it
+i=0; while flock -n "$work/busy/.lahar.lock" true 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
+expect 2 "is in use by another lahar run \(pid 4242, host testhost, started then, case other.yaml\)" -- \
+    run "$good" -o "$work/busy" --in-process -q
+[ ! -e "$work/busy/summary.json" ] || { echo "FAIL the refused run wrote into the busy directory"; fail=$((fail + 1)); }
+kill $holder 2>/dev/null; wait $holder 2>/dev/null
+expect 0 "" -- run "$good" -o "$work/busy" --in-process -q
+grep -q "^pid [0-9]" "$work/busy/.lahar.lock" && ! grep -q 4242 "$work/busy/.lahar.lock" ||
+    { echo "FAIL the run did not write its own pid into the lock file"; fail=$((fail + 1)); }
+echo "$((13 - fail)) passed, $fail failed"
 [ "$fail" -eq 0 ]
