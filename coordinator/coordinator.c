@@ -41,6 +41,9 @@
 #define COORD_STARVED_PROBE_MS 500 /* CPU time must advance within this to count as computing */
 #define COORD_HELLO_PERIOD_MS 100
 #define COORD_STOP_WAIT 3.0      /* s the nodes get to exit after STOP */
+#define COORD_SETUP_POLL_MS 100  /* set-up: how often Ctrl-C and the progress line are looked at */
+#define COORD_SETUP_SHOW 2.0     /* s of set-up after which a progress line is shown (terminal only) */
+#define COORD_SETUP_STOP_WAIT 0.3 /* s a node interrupted in set-up gets to exit before it is killed */
 #define COORD_STEP_RESEND_MS 250 /* re-publish STEP(k) while STATUS(k) is missing */
 
 typedef struct {
@@ -87,6 +90,8 @@ typedef struct {
     int exit_status;
     int progress;           /* progress line on stderr */
     double last_progress;
+    int setup_shown;        /* a set-up progress line is on the terminal (ended by a newline) */
+    double stop_wait;       /* s the nodes get to exit after STOP (0: COORD_STOP_WAIT) */
 } coord;
 
 static volatile sig_atomic_t coord_interrupted;
@@ -267,7 +272,7 @@ static void coord_send_stop(coord *co, int reason, const char *message)
 /* After STOP: give the nodes time to exit (re-sending STOP in case it was lost), then end them. */
 static void coord_finish_nodes(coord *co)
 {
-    double until = lahar_now() + COORD_STOP_WAIT, resend = lahar_now() + 0.1;
+    double until = lahar_now() + (co->stop_wait > 0 ? co->stop_wait : COORD_STOP_WAIT), resend = lahar_now() + 0.1;
     for (;;) {
         int all = 1;
         for (int r = 1; r < LAHAR_NROLES; r++)
@@ -403,6 +408,30 @@ static void coord_summary_work(const coord *co, cJSON *root)
     }
 }
 
+/* While the nodes set up (STATUS(-1) not yet in): a progress line on a terminal once set-up has
+ * taken COORD_SETUP_SHOW s, and Ctrl-C / SIGTERM honoured at once (the nodes are stopped by
+ * the caller; one busy filling particles is killed after COORD_SETUP_STOP_WAIT). 1 when
+ * interrupted. */
+static int coord_setup_wait(coord *co, const coord_node *n)
+{
+    if (coord_interrupted) {
+        co->status = "interrupted";
+        co->stop_wait = COORD_SETUP_STOP_WAIT;
+        snprintf(co->message, sizeof co->message, "interrupted during set-up (waiting for the %s)",
+                 lahar_link_role_name(n->role));
+        return 1;
+    }
+    double waited = lahar_now() - co->wall0;
+    if (co->progress && waited > COORD_SETUP_SHOW && lahar_now() - co->last_progress >= 1.0) {
+        co->last_progress = lahar_now();
+        fprintf(stderr, "\r  setting up: waiting for the %s (filling particles, first rates) %.0f s   ",
+                lahar_link_role_name(n->role), waited);
+        fflush(stderr);
+        co->setup_shown = 1;
+    }
+    return 0;
+}
+
 /* Wait for STATUS(k) of every node; fills the node records. */
 static int coord_collect_status(coord *co, int64_t k)
 {
@@ -416,10 +445,13 @@ static int coord_collect_status(coord *co, int64_t k)
          * 250 ms until STATUS(k) is in (a node that has it already drops the duplicate, and its
          * kept STATUS(k) answers the coordinator's NACK). */
         for (;;) {
-            rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k, COORD_STEP_RESEND_MS, &m);
+            rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k,
+                                 k < 0 ? COORD_SETUP_POLL_MS : COORD_STEP_RESEND_MS, &m);
             if (rc == LAHAR_LINK_TIMEOUT) {
                 if (k >= 0)
                     lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
+                if (k < 0 && coord_setup_wait(co, n)) /* Ctrl-C while a node sets up: stop now */
+                    return LAHAR_EXIT_RUN_ERROR;
             } else if (rc == LAHAR_LINK_LOST && coord_node_starved(co, &co->node[lahar_link_lost_role(co->link)])) {
                 lahar_link_heard_now(co->link, lahar_link_lost_role(co->link));
             } else {
@@ -942,6 +974,10 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         goto stop;
     }
     status = coord_collect_status(&co, -1);
+    if (co.setup_shown) {
+        fprintf(stderr, "\n");
+        co.setup_shown = 0;
+    }
     if (status != LAHAR_EXIT_OK)
         goto stop;
     co.lock0 = lahar_now();
