@@ -12,6 +12,7 @@
 #include "check.h"
 #include "coordinator.h"
 #include "dem_engine.h"
+#include "estimate.h"
 #include "netns.h"
 
 static void usage(FILE *f)
@@ -19,7 +20,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: lahar run CASE.yaml -o OUT [options]     simulate the case, output in OUT\n"
             "       lahar check CASE.yaml -o OUT [options]   simulate, then evaluate the case's check: section\n"
-            "       lahar validate CASE.yaml                 load and validate the case only\n"
+            "       lahar validate CASE.yaml                 load and validate the case only; prints the particle\n"
+            "                                                and body count, memory and cost estimates\n"
             "       lahar bench -o OUT [--quick] [options]   run time against error of the validation cases,\n"
             "                                                co-simulation overhead, DEM subcycling: CSV, PNG\n"
             "                                                and OUT/summary.md (`lahar bench --help`)\n"
@@ -37,6 +39,8 @@ static void usage(FILE *f)
             "                     recv_buf_size=8388608\n"
             "  --wait S           seconds to wait for the nodes to join (default 30)\n"
             "  -q, --quiet        no progress line and no closing hints\n"
+            "  --allow-large      run a case whose estimated memory (`lahar validate` prints it) exceeds\n"
+            "                     this machine's; without it such a run is refused (exit 2)\n"
             "  --evaluate-only    (check) do not simulate: evaluate the check: section on the output\n"
             "                     already in OUT (e.g. after changing a bound, or of a run on a cluster)\n\n"
             "By default lahar creates a private network namespace (unshare of user + network namespaces)\n"
@@ -110,6 +114,48 @@ static int parse_seconds_option(const char *cmd, const char *opt, const char *s,
     return 0;
 }
 
+/* "1.2 GB" */
+static const char *human_bytes(double b, char *buf, size_t n)
+{
+    const char *unit[] = {"B", "kB", "MB", "GB", "TB"};
+    int u = 0;
+    while (b >= 1000.0 && u < 4) {
+        b /= 1000.0;
+        u++;
+    }
+    snprintf(buf, n, "%.3g %s", b, unit[u]);
+    return buf;
+}
+
+/* What the case will cost (coordinator/estimate.h), for `validate`. */
+static void print_estimate(const lahar_case *cs, const lahar_estimate *e)
+{
+    char mem[32], machine[32];
+    printf("  %lld particles%s (%lld soil%s), %d bodies\n", (long long)e->particles, e->exact ? "" : " at most",
+           (long long)e->soil_particles,
+           e->exact ? "" : "; the blocks' lattices: too many points to count with the bodies cut out", e->bodies);
+    printf("  memory: about %s for the run (machine: %s)\n", human_bytes(e->bytes, mem, sizeof mem),
+           human_bytes(lahar_estimate_machine_bytes(), machine, sizeof machine));
+    if (e->particles > 0)
+        printf("  cost: at least %.3g steps to t = %g s (SPH step <= %.3g s by the CFL limit), %.3g particle-steps "
+               "(about %.2g core-hours at 1e6 particle-steps/s)\n",
+               e->steps, cs->t_end, e->dt, e->particle_steps, e->particle_steps / 1e6 / 3600.0);
+}
+
+/* A run whose estimated memory exceeds the machine's is refused (exit 2) unless --allow-large. */
+static int check_memory(const char *cmd, const lahar_case *cs, const lahar_estimate *e)
+{
+    double machine = lahar_estimate_machine_bytes();
+    if (machine <= 0.0 || e->bytes <= machine)
+        return 0;
+    char mem[32], mach[32];
+    fprintf(stderr, "lahar %s: %s needs about %s of memory (%lld particles) but this machine has %s; use a larger "
+                    "sph.dx (memory falls as dx^-%d), or --allow-large to run it anyway\n", cmd, cs->path,
+            human_bytes(e->bytes, mem, sizeof mem), (long long)e->particles, human_bytes(machine, mach, sizeof mach),
+            cs->dim);
+    return -1;
+}
+
 /* The DEM engine the case names must exist in this build (dem_node/dem_engine_registry.c): said at
  * validation, with the case's file and line, not when the DEM node starts. */
 static int check_dem_engine(const lahar_case *cs)
@@ -151,10 +197,11 @@ int main(int argc, char **argv)
         {"in-process", no_argument, NULL, 'i'},   {"no-spawn", no_argument, NULL, 'n'},
         {"lcm-url", required_argument, NULL, 'u'}, {"wait", required_argument, NULL, 'w'},
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
-        {"evaluate-only", no_argument, NULL, 'e'}, {NULL, 0, NULL, 0},
+        {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
+        {NULL, 0, NULL, 0},
     };
     optind = 2;
-    int c, evaluate_only = 0;
+    int c, evaluate_only = 0, allow_large = 0;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
         switch (c) {
         case 'o': o.outdir = optarg; break;
@@ -171,6 +218,7 @@ int main(int argc, char **argv)
             break;
         case 'q': o.quiet = 1; break;
         case 'e': evaluate_only = 1; break;
+        case 'L': allow_large = 1; break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
@@ -201,9 +249,15 @@ int main(int argc, char **argv)
         return LAHAR_EXIT_BAD_INPUT;
     }
     int status = 0;
+    lahar_estimate est;
+    if (is_validate || !evaluate_only)
+        lahar_estimate_case(&cs, &est);
     if (is_validate) {
         printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,
                cs.t_end);
+        print_estimate(&cs, &est);
+    } else if (!evaluate_only && !o.no_spawn && !allow_large && check_memory(cmd, &cs, &est) != 0) {
+        status = LAHAR_EXIT_BAD_INPUT;
     } else {
         status = evaluate_only ? 0 : lahar_coord_run(&cs, &o);
         if (is_check && status == 0) {

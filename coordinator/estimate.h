@@ -1,0 +1,26 @@
+/* What a case will cost before it runs: particles, bodies, memory and particle-steps, so that
+ * `lahar validate` can say it and `lahar run` can refuse a case the machine cannot hold. */
+#ifndef LAHAR_ESTIMATE_H
+#define LAHAR_ESTIMATE_H
+#include <stdint.h>
+#include "scene.h"
+
+typedef struct {
+    int64_t particles;     /* SPH particles at t = 0 (exact when `exact`, else the blocks' lattice) */
+    int exact;             /* 1: counted point by point with the bodies cut out (lahar_case_block_lattice) */
+    int64_t soil_particles;
+    int bodies;
+    double bytes;          /* peak memory of the run, estimated (all nodes) */
+    double dt;             /* the largest SPH step the CFL limit allows (0: no particles) */
+    double steps;          /* steps to t_end at min(dt, time.dt_max): a lower bound */
+    double particle_steps; /* particles x steps */
+} lahar_estimate;
+
+/* Fills *e for case c. Counting point by point is skipped above LAHAR_ESTIMATE_COUNT_MAX lattice
+ * points (the count of the blocks' lattices is given instead, an upper bound). */
+#define LAHAR_ESTIMATE_COUNT_MAX 250000
+void lahar_estimate_case(const lahar_case *c, lahar_estimate *e);
+
+/* The machine's physical memory in bytes (0 if unknown). */
+double lahar_estimate_machine_bytes(void);
+#endif
