@@ -1250,3 +1250,28 @@ int lahar_output_last_snapshot(const char *outdir, const char *file, char *group
     free(list);
     return cnt > 0 ? 0 : -1;
 }
+
+int lahar_output_release_swmr(const char *path)
+{
+    if (access(path, F_OK) != 0)
+        return 0;
+    hid_t f = (hid_t)lahar_h5_file_open(path, H5F_ACC_RDONLY, H5P_DEFAULT, 0);
+    if (f >= 0) {
+        H5Fclose(f);
+        return 0;
+    }
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    hbool_t clear = 1;
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    herr_t set = H5Pset(fapl, "clear_status_flags", &clear);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+    f = set >= 0 ? (hid_t)lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0) : -1;
+    H5Pclose(fapl);
+    if (f < 0)
+        return -1;
+    H5Fclose(f);
+    return 1;
+}

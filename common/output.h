@@ -94,6 +94,13 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
  * the file is missing or has none. */
 int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t);
 
+/* A file whose SWMR writer died (forces.h5 after a node was killed) keeps the "open for writing"
+ * flags in its superblock, and h5dump / h5py refuse it. Clears them when they are set, as h5clear
+ * -s does (HDF5's file-access property "clear_status_flags"), so every row the writer flushed can
+ * be read. Only for a file no process writes any more. 0 nothing to do (or no such file), 1
+ * cleared, -1 the file cannot be opened even so. */
+int lahar_output_release_swmr(const char *path);
+
 /* Display mesh of a sphero-polyhedron for viewers (not used by the physics): a closed surface of
  * triangles in 3D (spheres: icospheres; polyhedra: core faces offset by the sweep radius plus
  * flat bevels along edges and fans at corners; rods: spheres + tubes), line segments in the

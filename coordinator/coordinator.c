@@ -303,6 +303,30 @@ static void coord_finish_nodes(coord *co)
     }
 }
 
+/* A node process that died (killed, crashed) leaves the SWMR force stream flagged as open for
+ * writing, and h5dump / h5py refuse it: once every node process is gone, clear the flags so the
+ * rows it flushed can be read (nodes on other hosts, --no-spawn, are not ours to judge). */
+static void coord_release_files(coord *co)
+{
+    int died = 0;
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        const coord_node *n = &co->node[r];
+        if (n->pid > 0 && !n->exited)
+            return; /* still running: the file is its */
+        died |= n->pid > 0 && n->exited && n->exit_status != 0;
+    }
+    if (!died)
+        return;
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/forces.h5", co->outdir);
+    int rc = lahar_output_release_swmr(path);
+    if (rc == 1 && !co->o->quiet)
+        fprintf(stderr, "lahar: %s: cleared the open-for-writing flags the dead node left; the rows it wrote are "
+                        "readable\n", path);
+    else if (rc < 0)
+        fprintf(stderr, "lahar: %s cannot be opened (its writer died while writing)\n", path);
+}
+
 static void coord_read_hello(coord_node *n, const lahar_link_msg *m)
 {
     lahar_hello_t h;
@@ -999,6 +1023,7 @@ stop:
             status = LAHAR_EXIT_RUN_ERROR;
         }
 out:
+    coord_release_files(&co);
     co.exit_status = status;
     if (status != LAHAR_EXIT_OK)
         fprintf(stderr, "lahar: %s\n", co.message[0] ? co.message : "run failed");

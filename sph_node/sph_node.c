@@ -747,6 +747,23 @@ static void sph_node_final_snapshot(sph_node *s, const lahar_link_msg *stop, int
     sph_node_mark_last(s, "stopped", why);
 }
 
+/* STOP came while the node waited for BODY_STATE(k) after sph_fluid_step_begin (typically: the
+ * DEM node died): the particles are drifted but not kicked, a state of no time. On a stop for an
+ * error the step is finished with the moving bodies where the last BODY_STATE put them (t_k) and
+ * that state is written as the final snapshot of t_{k+1}, marked `stopped` with the coordinator's
+ * reason and that caveat, so the run's particle file ends where the run ended (lcm_types/README.md). */
+static void sph_node_stopped_half_step(sph_node *s, const lahar_link_msg *stop, int64_t k, const lahar_step_t *step)
+{
+    char why[512], mark[768];
+    if (lahar_node_stop_reason(stop, why, sizeof why) <= 0)
+        return;
+    if (sph_fluid_step_end(&s->f, step->dt, s->states) < 0 || sph_node_snapshot(s, k + 1, step->t_next) != 0)
+        return;
+    snprintf(mark, sizeof mark, "%s (step %lld finished with the moving bodies at their state of t = %.9g s: no "
+             "BODY_STATE came for it)", why, (long long)k, step->t);
+    sph_node_mark_last(s, "stopped", mark);
+}
+
 static int sph_node_loop(sph_node *s)
 {
     char err[2048];
@@ -799,8 +816,11 @@ static int sph_node_loop(sph_node *s)
         if (has_dem && s->nmoving > 0) {
             /* the moving bodies at t_{k+1}, after the DEM node's advance with LOADS(k) */
             rc = lahar_link_wait(s->link, LAHAR_ROLE_DEM, LAHAR_FRAME_T_MSG_BODY_STATE, k, -1, &msg);
-            if (rc == LAHAR_LINK_STOP)
+            if (rc == LAHAR_LINK_STOP) {
+                if (begun)
+                    sph_node_stopped_half_step(s, &msg, k, &step);
                 return 0;
+            }
             if (rc == LAHAR_LINK_LOST)
                 return 3;
             if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {

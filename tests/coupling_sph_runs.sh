@@ -3,7 +3,7 @@
 # LOADS / BODY_STATE between the nodes, the force stream and contacts.h5.
 #
 #   coupling_sph_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
-#   TEST: modes | far_body | hydrostatic | crossing
+#   TEST: modes | far_body | hydrostatic | crossing | dem_killed
 #
 # modes        a box dropped into a small 2D tank of water: `lahar run --in-process` (memq://) and
 #              `lahar run` (processes in lahar's own private network namespace) write bitwise the
@@ -172,6 +172,47 @@ yc = float(np.mean(ys))
 print("contacts.h5: %d snapshots; centre of pressure at %.4f m, h/3 = %.4f m" % (len(ys), yc, h / 3))
 assert abs(yc - h / 3) / (h / 3) < 0.10, yc
 PY
+    ;;
+dem_killed)
+    # kill -9 the DEM node while the box sinks into the water: the coordinator exits 3; the force
+    # stream the DEM node was writing (SWMR) opens with h5dump, as the closing message promises;
+    # the SPH node, stopped while it waited for the box's state, ends particles.h5 with a snapshot
+    # marked `stopped` (the coordinator's reason); summary.json lists the DEM node as killed.
+    write_tank drop.yaml 30 0.05 0.05
+    echo "  - {name: box, shape: box, size: [0.05, 0.05], radius: 0.002, material: wood, position: [0.1, 0.13], velocity: [0, -1]}" >> drop.yaml
+    "$bin/lahar" run drop.yaml -o killed -q 2> stderr.txt &
+    lahar_pid=$!
+    dem_pid=""
+    for _ in $(seq 200); do
+        for stat in /proc/[0-9]*/stat; do
+            read -r pid comm state ppid rest < "$stat" 2>/dev/null || continue
+            [ "$ppid" = "$lahar_pid" ] && [ "$comm" = "(lahar-dem)" ] && dem_pid=$pid
+        done
+        [ -n "$dem_pid" ] && [ -e killed/forces.h5 ] && break
+        sleep 0.05
+    done
+    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found"; }
+    sleep 1.0
+    kill -9 "$dem_pid"
+    wait "$lahar_pid"
+    rc=$?
+    cat stderr.txt
+    [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
+    h5dump -H killed/forces.h5 > /dev/null || fail "forces.h5 of the killed DEM node does not open with h5dump"
+    rows=$("$python" -c "import h5py; print(h5py.File('killed/forces.h5', 'r')['t'].shape[0])") ||
+        fail "forces.h5 of the killed DEM node does not open with h5py"
+    [ "$rows" -gt 0 ] || fail "forces.h5 has no rows"
+    "$python" - <<'PY' || fail "particles.h5 does not end with a snapshot marked stopped"
+import h5py, sys
+with h5py.File("killed/particles.h5", "r") as f:
+    last = sorted(f["snapshots"])[-1]
+    mark = f["snapshots"][last].attrs.get("stopped")
+    mark = mark.decode() if isinstance(mark, bytes) else mark
+    print(f"last particle snapshot {last}: stopped = {mark!r}")
+    sys.exit(0 if mark and "lost the DEM node" in mark else 1)
+PY
+    [ "$(summary killed "s['nodes']['dem']['exit_status']")" = 137 ] || fail "summary.json does not list the DEM node as killed (137)"
+    echo "forces.h5: $rows rows readable after the DEM node was killed"
     ;;
 crossing)
     cat > jet.yaml <<'YAML'
