@@ -95,6 +95,12 @@ typedef struct {
 } coord;
 
 static volatile sig_atomic_t coord_interrupted;
+
+/* Silence after which a node is lost (--node-timeout, else COORD_NODE_SILENCE). */
+static double coord_silence(const coord *co)
+{
+    return co->o->node_timeout_s > 0.0 ? co->o->node_timeout_s : COORD_NODE_SILENCE;
+}
 static void coord_on_sigint(int sig)
 {
     (void)sig;
@@ -254,8 +260,8 @@ static int coord_node_starved(coord *co, coord_node *n)
     if (n->starved_s == 0.0)
         fprintf(stderr, "\nlahar: warning: the %s has been silent for %.1f s but is still computing (the machine "
                         "is overloaded?); waiting up to %.0f s more\n",
-                lahar_link_role_name(n->role), COORD_NODE_SILENCE, COORD_NODE_STARVED_MAX);
-    n->starved_s += COORD_NODE_SILENCE + 1e-3 * COORD_STARVED_PROBE_MS;
+                lahar_link_role_name(n->role), coord_silence(co), COORD_NODE_STARVED_MAX);
+    n->starved_s += coord_silence(co) + 1e-3 * COORD_STARVED_PROBE_MS;
     return 1;
 }
 
@@ -384,7 +390,7 @@ static int coord_hello(coord *co)
             lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_HELLO, -1);
         }
         coord_read_hello(n, &m);
-        lahar_link_watch(co->link, r, COORD_NODE_SILENCE);
+        lahar_link_watch(co->link, r, coord_silence(co));
     }
     return LAHAR_EXIT_OK;
 }
@@ -494,7 +500,7 @@ static int coord_collect_status(coord *co, int64_t k)
             snprintf(co->message, sizeof co->message,
                      "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
                      "(t = %.9g s); stopping the run",
-                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, COORD_NODE_SILENCE + ln->starved_s, how,
+                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, coord_silence(co) + ln->starved_s, how,
                      (long long)last, co->sim_time);
             co->status = "node lost";
             return LAHAR_EXIT_NODE_LOST;

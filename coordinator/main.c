@@ -38,6 +38,9 @@ static void usage(FILE *f)
             "                     from $LCM_DEFAULT_URL). Set ttl yourself (ttl=0: this host only) and\n"
             "                     recv_buf_size=8388608\n"
             "  --wait S           seconds to wait for the nodes to join (default 30)\n"
+            "  --node-timeout S   a node silent for S seconds is lost (default 2). A node lahar started\n"
+            "                     that is silent but still using CPU is waited for up to 120 s more\n"
+            "                     (an overloaded machine); a node whose process ended is lost at once\n"
             "  -q, --quiet        no progress line and no closing hints\n"
             "  --allow-large      run a case whose estimated memory (`lahar validate` prints it) exceeds\n"
             "                     this machine's; without it such a run is refused (exit 2)\n"
@@ -48,7 +51,7 @@ static void usage(FILE *f)
             "inside it: nothing leaves the machine and two runs never hear each other. The nodes are\n"
             "started next to this executable (lahar-dem, lahar-sph) and die with it.\n\n"
             "Exit status: 0 finished (check: all metrics pass), 1 a node reported an error or a check\n"
-            "metric failed, 2 bad input or setup failure, 3 a node was lost (silent for 2 s).\n",
+            "metric failed, 2 bad input or setup failure, 3 a node was lost (--node-timeout).\n",
             LAHAR_NETNS_URL);
 }
 
@@ -198,6 +201,7 @@ int main(int argc, char **argv)
         {"lcm-url", required_argument, NULL, 'u'}, {"wait", required_argument, NULL, 'w'},
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
         {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
+        {"node-timeout", required_argument, NULL, 'T'},
         {NULL, 0, NULL, 0},
     };
     optind = 2;
@@ -219,6 +223,10 @@ int main(int argc, char **argv)
         case 'q': o.quiet = 1; break;
         case 'e': evaluate_only = 1; break;
         case 'L': allow_large = 1; break;
+        case 'T':
+            if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, &o.node_timeout_s) != 0)
+                return 2;
+            break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }

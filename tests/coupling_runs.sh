@@ -205,6 +205,29 @@ node_stopped)
     [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
     "$python" -c "import sys; sys.exit(0 if $elapsed < 6.0 else 1)" || fail "took ${elapsed} s to notice (limit 6 s)"
     grep -q "DEM node.*hangs" stderr.txt || fail "message does not name the DEM node as hung"
+    # --node-timeout 4: the same hung node is lost after 4 s of silence, not 2
+    "$bin/lahar" run long.yaml -o stopped4 -q --node-timeout 4 2> stderr4.txt &
+    lahar_pid=$!
+    dem_pid=""
+    for _ in $(seq 100); do
+        dem_pid=$(child_pid "$lahar_pid" lahar-dem)
+        [ -n "$dem_pid" ] && [ -e stopped4/bodies.h5 ] && break
+        sleep 0.05
+    done
+    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found (--node-timeout 4)"; }
+    sleep 0.5
+    kill -STOP "$dem_pid"
+    t0=$(date +%s.%N)
+    wait "$lahar_pid"
+    rc=$?
+    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+    kill -9 "$dem_pid" 2>/dev/null
+    cat stderr4.txt
+    echo "--node-timeout 4: coordinator exited with $rc after ${elapsed} s"
+    [ "$rc" -eq 3 ] || fail "--node-timeout 4: exit status $rc, expected 3"
+    "$python" -c "import sys; sys.exit(0 if 4.0 <= $elapsed < 8.0 else 1)" ||
+        fail "--node-timeout 4: lost after ${elapsed} s (want 4-8 s)"
+    grep -q "silent for 4.0 s" stderr4.txt || fail "--node-timeout 4: the message does not give the 4 s"
     ;;
 coordinator_killed)
     # A node started by hand (--no-spawn: no PR_SET_PDEATHSIG) gives up 5 s after the coordinator
