@@ -1275,3 +1275,8 @@ int lahar_output_release_swmr(const char *path)
     H5Fclose(f);
     return 1;
 }
+
+const char *const lahar_output_run_files[] = {
+    "summary.json", "check.json", "check.png",   "lahar.xmf", "bodies.h5", "bodies.xmf",
+    "particles.h5", "particles.xmf", "forces.h5", "contacts.h5", NULL,
+};

@@ -94,6 +94,11 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
  * the file is missing or has none. */
 int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t);
 
+/* The files a run writes into OUT (NULL-terminated): HDF5 streams, XDMF sidecars, the
+ * coordinator's summary.json and `lahar check`'s check.json / check.png. A new output file is
+ * added here, so that `lahar run --overwrite` removes it with the rest of an earlier run. */
+extern const char *const lahar_output_run_files[];
+
 /* A file whose SWMR writer died (forces.h5 after a node was killed) keeps the "open for writing"
  * flags in its superblock, and h5dump / h5py refuse it. Clears them when they are set, as h5clear
  * -s does (HDF5's file-access property "clear_status_flags"), so every row the writer flushed can

@@ -869,6 +869,33 @@ static int coord_lock_outdir(const char *outdir, const char *case_path)
     return fd;
 }
 
+/* OUT holding an earlier run's files (common/output.h, lahar_output_run_files) is refused, so
+ * that runs never mix (a water run's particles.h5 left beside a later DEM-only run, lahar.xmf
+ * pointing at both); with --overwrite those files are removed first. 0 to go on, -1 refused. */
+static int coord_clear_outdir(const char *outdir, int overwrite)
+{
+    char path[PATH_MAX + 32], found[256] = "";
+    size_t nf = 0;
+    for (int i = 0; lahar_output_run_files[i]; i++) {
+        snprintf(path, sizeof path, "%s/%s", outdir, lahar_output_run_files[i]);
+        if (access(path, F_OK) != 0)
+            continue;
+        if (overwrite) {
+            if (unlink(path) != 0) {
+                fprintf(stderr, "lahar: --overwrite: cannot remove %s: %s\n", path, strerror(errno));
+                return -1;
+            }
+        } else if (nf < sizeof found) {
+            nf += (size_t)snprintf(found + nf, sizeof found - nf, "%s%s", nf ? ", " : "", lahar_output_run_files[i]);
+        }
+    }
+    if (!found[0])
+        return 0;
+    fprintf(stderr, "lahar: %s holds the output of an earlier run (%s); add --overwrite to replace it (those files "
+                    "are removed first), or choose another -o\n", outdir, found);
+    return -1;
+}
+
 static int64_t coord_random_run_id(void)
 {
     uint64_t r = 0;
@@ -918,6 +945,10 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     int lock_fd = coord_lock_outdir(co.outdir, c->path);
     if (lock_fd < 0)
         return LAHAR_EXIT_SETUP;
+    if (coord_clear_outdir(co.outdir, o->overwrite) != 0) {
+        close(lock_fd);
+        return LAHAR_EXIT_SETUP;
+    }
 
     /* Where the messages go. Default: a private network namespace of our own. */
     char err[1024];

@@ -29,6 +29,8 @@ static void usage(FILE *f)
             "Options of run and check:\n"
             "  -o, --output OUT   output directory (created): bodies.h5, forces.h5, particles.h5, *.xmf,\n"
             "                     summary.json (and check.json for `check`)\n"
+            "  --overwrite        OUT holds an earlier run: remove its files (summary.json, *.h5, *.xmf,\n"
+            "                     check.*) first; without it such an OUT is refused (exit 2)\n"
             "  --threads N        OpenMP threads per node (default: OpenMP's default)\n"
             "  --in-process       run the nodes as threads of this process over memq:// (no network;\n"
             "                     gives bitwise the same results as separate processes)\n"
@@ -201,7 +203,7 @@ int main(int argc, char **argv)
         {"lcm-url", required_argument, NULL, 'u'}, {"wait", required_argument, NULL, 'w'},
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
         {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
-        {"node-timeout", required_argument, NULL, 'T'},
+        {"node-timeout", required_argument, NULL, 'T'}, {"overwrite", no_argument, NULL, 'O'},
         {NULL, 0, NULL, 0},
     };
     optind = 2;
@@ -223,6 +225,7 @@ int main(int argc, char **argv)
         case 'q': o.quiet = 1; break;
         case 'e': evaluate_only = 1; break;
         case 'L': allow_large = 1; break;
+        case 'O': o.overwrite = 1; break;
         case 'T':
             if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, &o.node_timeout_s) != 0)
                 return 2;

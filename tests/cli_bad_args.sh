@@ -3,7 +3,7 @@
 # option or the case file, line and key (coordinator/main.c), before anything runs.
 # usage: cli_bad_args.sh LAHAR FIXTURES_DIR WORK_DIR
 lahar=$1 fixtures=$2 work=$3
-fail=0 n=0
+fail=0 pass=0
 rm -rf "$work" && mkdir -p "$work"
 good=$fixtures/../../cases/dem_bounce_3d.yaml
 expect() { # expect STATUS PATTERN -- ARGS...
@@ -16,7 +16,7 @@ expect() { # expect STATUS PATTERN -- ARGS...
         echo "     (wanted a line matching: $pattern)"
         fail=$((fail + 1))
     else
-        echo "ok   lahar $*: exit $got, $(head -n 1 "$work/err")"
+        pass=$((pass + 1)); echo "ok   lahar $*: exit $got, $(head -n 1 "$work/err")"
     fi
 }
 expect 2 "unknown_engine.yaml:5: dem.engine: unknown DEM engine 'nosuch'; engines in this build: spheropoly" -- \
@@ -31,10 +31,9 @@ expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait
 expect 0 "" -- validate "$good"
 # validate says what the case costs; a case over the machine's memory is refused unless --allow-large
 "$lahar" validate "$fixtures/../../cases/dam_break_2d.yaml" > "$work/validate.txt" 2>&1
-n=$((n + 1))
 if grep -q "^  3200 particles (0 soil), 3 bodies$" "$work/validate.txt" && grep -q "^  memory: about [0-9.]* MB" "$work/validate.txt" &&
    grep -q "^  cost: at least [0-9.e+]* steps to t = 1 s" "$work/validate.txt"; then
-    echo "ok   validate dam_break_2d.yaml: $(sed -n 2p "$work/validate.txt")"
+    pass=$((pass + 1)); echo "ok   validate dam_break_2d.yaml: $(sed -n 2p "$work/validate.txt")"
 else
     echo "FAIL validate dam_break_2d.yaml does not state its 3200 particles, memory and cost:"; sed 's/^/    /' "$work/validate.txt"
     fail=$((fail + 1))
@@ -43,6 +42,17 @@ python3 "$fixtures/../../tools/case_override.py" "$fixtures/../../cases/dam_brea
 expect 2 "giant.yaml needs about [0-9.]* [GT]B of memory \(1875000000 particles\) but this machine has .*--allow-large" -- \
     run "$work/giant.yaml" -o "$work/giant" --in-process
 [ ! -e "$work/giant" ] || { echo "FAIL an output directory was created for a refused case"; fail=$((fail + 1)); }
+# an OUT with an earlier run's files is refused; --overwrite removes them first (a water run's
+# particles.h5 must not stay beside a DEM-only run)
+mkdir -p "$work/reuse" && echo stale > "$work/reuse/particles.h5" && echo '{}' > "$work/reuse/summary.json"
+expect 2 "holds the output of an earlier run \(summary.json, particles.h5\); add --overwrite" -- \
+    run "$good" -o "$work/reuse" --in-process -q
+expect 0 "" -- run "$good" -o "$work/reuse" --in-process -q --overwrite
+if [ -e "$work/reuse/particles.h5" ] || grep -q particles "$work/reuse/lahar.xmf"; then
+    echo "FAIL --overwrite left the earlier run's particles.h5 (or lahar.xmf still points at it)"; fail=$((fail + 1))
+else
+    pass=$((pass + 1)); echo "ok   --overwrite removed the earlier run's particles.h5; lahar.xmf has the bodies only"
+fi
 # an output directory another run holds (OUT/.lahar.lock, flock) is refused, naming the holder
 mkdir -p "$work/busy" && printf 'pid 4242\nhost testhost\nstarted then\ncase other.yaml\n' > "$work/busy/.lahar.lock"
 sh -c 'exec 9<>"$1"; flock 9; exec sleep 30' sh "$work/busy/.lahar.lock" & holder=$!  # the lock dies with it
@@ -54,5 +64,5 @@ kill $holder 2>/dev/null; wait $holder 2>/dev/null
 expect 0 "" -- run "$good" -o "$work/busy" --in-process -q
 grep -q "^pid [0-9]" "$work/busy/.lahar.lock" && ! grep -q 4242 "$work/busy/.lahar.lock" ||
     { echo "FAIL the run did not write its own pid into the lock file"; fail=$((fail + 1)); }
-echo "$((16 - fail)) passed, $fail failed"
+echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -19,7 +19,7 @@ rm -rf "$out" && mkdir -p "$out" || exit 2
 sed -E "s/^(time: *\{.*end: *)[^,} ]+/\10.95/" "$case" > "$out/case.yaml" || exit 2
 grep -qE "^time: *\{.*end: *0\.95[,} ]" "$out/case.yaml" || { echo "example_debris: cannot set time.end in $case" >&2; exit 2; }
 start=$(date +%s)
-"$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q
+"$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q --overwrite
 rc=$?
 echo "example_debris: lahar check exit $rc, $(( $(date +%s) - start )) s wall"
 [ $rc -eq 0 ] || { cat "$out/run/check.json" 2>/dev/null; exit 1; }

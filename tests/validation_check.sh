@@ -45,7 +45,7 @@ for kv in "$@"; do
 done
 start=$(date +%s)
 # shellcheck disable=SC2086
-"$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q $threads
+"$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q --overwrite $threads
 rc=$?
 echo "validation_check: $(basename "$case") $* -> exit $rc, $(( $(date +%s) - start )) s wall"
 if [ $rc -eq 0 ]; then

@@ -58,7 +58,7 @@ class Run:
         path = os.path.join(out, "case.yaml")
         case_override.write_case(case, path, "%s (tests/stress/stress.py)" % label)
         t0 = time.time()
-        p = subprocess.run([args.lahar, "run", path, "-o", os.path.join(out, "run"), "-q", "--in-process",
+        p = subprocess.run([args.lahar, "run", path, "-o", os.path.join(out, "run"), "-q", "--in-process", "--overwrite",
                             "--threads", str(args.threads)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            text=True)
         self.wall = time.time() - t0
