@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "auth.h"
 #include "lahar_heartbeat_t.h"
 #include "lahar_nack_t.h"
 
@@ -17,7 +18,7 @@
 #define LINK_NACK_FIRST 0.010
 #define LINK_NACK_MAX 0.200
 #define LINK_MAX_MISSING 256
-#define LINK_FRAME_BUF (LAHAR_FRAME_PAYLOAD + 256)
+#define LINK_FRAME_BUF (LAHAR_FRAME_PAYLOAD + 256 + LAHAR_AUTH_MACBYTES)
 #define LINK_MAX_MESSAGE (1 << 28) /* as LCM_MAX_MESSAGE_SIZE: a larger claim is a corrupt frame */
 
 static const char *const link_channels[LAHAR_NMSG] = {
@@ -124,6 +125,14 @@ struct lahar_link {
     double hb_period;
     _Atomic int64_t completed_step;
     int64_t hb_seq;
+
+    /* authenticated run (lahar_link_set_auth_key): every frame sent carries a MAC, every frame
+     * heard without a valid one is dropped and counted; so is a frame of a message already taken
+     * that is not flagged as a re-send, and a heartbeat or NACK not newer than the last */
+    int auth;
+    uint8_t auth_key[LAHAR_AUTH_KEYBYTES];
+    lahar_link_auth_stats auth_stats;
+    int64_t last_seq_hb[LAHAR_NROLES], last_seq_nack[LAHAR_NROLES];
 };
 
 /* ---- sending ------------------------------------------------------------------------------- */
@@ -147,11 +156,17 @@ static int link_publish_frames(lahar_link *l, int type, int64_t step, int64_t se
             .offset = offset, .flags = (int8_t)(resend ? LAHAR_FRAME_T_FLAG_RESEND : 0),
             .size = chunk, .payload = (uint8_t *)(data + offset),
         };
+        static const uint8_t no_mac[LAHAR_AUTH_MACBYTES];
+        f.mac_size = l->auth ? LAHAR_AUTH_MACBYTES : 0;
+        f.mac = (uint8_t *)no_mac;
         int n = lahar_frame_t_encode(l->frame_buf, 0, LINK_FRAME_BUF, &f);
         if (n < 0) {
             rc = -1;
             continue;
         }
+        if (l->auth) /* the MAC (the encoding's last bytes) covers everything before mac_size */
+            lahar_auth_mac(l->frame_buf + n - LAHAR_AUTH_MACBYTES, l->frame_buf,
+                           (size_t)(n - LAHAR_AUTH_MACBYTES - 2), l->auth_key);
         lahar_link_stats *s = &l->stats[type];
         /* A datagram the kernel refuses (a firewall drop, a full buffer) is a lost frame like any
          * other: the receiver NACKs it and the kept copy goes out again. */
@@ -346,7 +361,7 @@ static void link_on_nack(lahar_link *l, const uint8_t *data, int size)
 /* Decode a frame_t without copying its payload (the generated decoder would allocate a copy of
  * every frame): the header is decoded field by field with LCM's own primitives, in the order of
  * lcm_types/frame_t.lcm, and the payload, the last field, is used where it lies. */
-static int link_frame_parse(const void *buf, int len, lahar_frame_t *f)
+static int link_frame_parse(const void *buf, int len, lahar_frame_t *f, int *signed_len)
 {
     int pos = 0, n;
     int64_t hash;
@@ -374,7 +389,15 @@ static int link_frame_parse(const void *buf, int len, lahar_frame_t *f)
     if (f->size < 0 || f->size > len - pos)
         return -1;
     f->payload = (uint8_t *)buf + pos;
-    return pos + f->size;
+    pos += f->size;
+    *signed_len = pos;
+    if ((n = __int16_t_decode_array(buf, pos, len - pos, &f->mac_size, 1)) < 0)
+        return -1;
+    pos += n;
+    if (f->mac_size < 0 || f->mac_size > len - pos)
+        return -1;
+    f->mac = (uint8_t *)buf + pos;
+    return pos + f->mac_size;
 }
 
 static void link_on_frame(const char *channel, const void *data, size_t size, void *user)
@@ -382,8 +405,13 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     (void)channel;
     lahar_link *l = user;
     lahar_frame_t f;
-    if (size > (size_t)INT32_MAX || link_frame_parse(data, (int)size, &f) < 0)
+    int signed_len;
+    if (size > (size_t)INT32_MAX || link_frame_parse(data, (int)size, &f, &signed_len) < 0)
         return;
+    if (l->auth && (f.mac_size != LAHAR_AUTH_MACBYTES || !lahar_auth_verify(f.mac, data, (size_t)signed_len, l->auth_key))) {
+        l->auth_stats.frames_rejected++; /* forged, altered, or from a run without this key */
+        return;
+    }
     int64_t run = atomic_load(&l->run_id);
     if (run == 0 && f.sender == LAHAR_ROLE_COORDINATOR && f.type == LAHAR_FRAME_T_MSG_HELLO && f.run_id != 0) {
         atomic_store(&l->run_id, f.run_id); /* a node started by hand joins the first run it hears */
@@ -407,6 +435,14 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     else if (f.index == 0)
         st->msgs_heard++;
 
+    if (l->auth && (f.type == LAHAR_FRAME_T_MSG_HEARTBEAT || f.type == LAHAR_FRAME_T_MSG_NACK)) {
+        int64_t *last = f.type == LAHAR_FRAME_T_MSG_HEARTBEAT ? &l->last_seq_hb[f.sender] : &l->last_seq_nack[f.sender];
+        if (f.msg_seq <= *last) {
+            l->auth_stats.frames_replayed++;
+            return;
+        }
+        *last = f.msg_seq;
+    }
     if (f.type == LAHAR_FRAME_T_MSG_HEARTBEAT && f.nframes == 1) {
         lahar_heartbeat_t hb;
         if (lahar_heartbeat_t_decode(f.payload, 0, f.size, &hb) >= 0) {
@@ -421,8 +457,13 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
             link_on_nack(l, f.payload, f.size);
         return;
     }
-    if (!(l->want & LAHAR_MSG_BIT(f.type)) || link_window_seen(&l->window[f.sender][f.type], f.msg_seq))
+    if (!(l->want & LAHAR_MSG_BIT(f.type)))
         return;
+    if (link_window_seen(&l->window[f.sender][f.type], f.msg_seq)) {
+        if (l->auth && !(f.flags & LAHAR_FRAME_T_FLAG_RESEND))
+            l->auth_stats.frames_replayed++; /* a re-send says so: a first publication comes once */
+        return;
+    }
     link_slot *s = link_slot_for(l, &f);
     if (!s || s->complete || s->nframes != f.nframes || s->total != f.total_size || s->got.data[f.index])
         return;
@@ -715,4 +756,19 @@ void lahar_link_get_stats(const lahar_link *l, lahar_link_stats out[LAHAR_NMSG])
     pthread_mutex_lock((pthread_mutex_t *)&l->send_lock);
     memcpy(out, l->stats, sizeof l->stats);
     pthread_mutex_unlock((pthread_mutex_t *)&l->send_lock);
+}
+
+void lahar_link_set_auth_key(lahar_link *l, const uint8_t key[LAHAR_AUTH_KEYBYTES])
+{
+    pthread_mutex_lock(&l->send_lock);
+    memcpy(l->auth_key, key, LAHAR_AUTH_KEYBYTES);
+    l->auth = 1;
+    pthread_mutex_unlock(&l->send_lock);
+}
+
+int lahar_link_auth(const lahar_link *l, lahar_link_auth_stats *out)
+{
+    if (out)
+        *out = l->auth_stats;
+    return l->auth;
 }

@@ -97,6 +97,16 @@ void lahar_link_poll(lahar_link *l, int timeout_ms);
 /* Seconds spent inside wait/poll since creation (the "wait time" of a node). */
 double lahar_link_wait_seconds(const lahar_link *l);
 
+/* Authenticated runs (common/auth.h): from this call on, every frame sent carries a MAC under
+ * key, and frames heard without a valid one are dropped. Call before the link sends or hears. */
+typedef struct {
+    uint64_t frames_rejected; /* no MAC or a wrong one: forged, altered, or another key */
+    uint64_t frames_replayed; /* valid MAC but a copy of what was taken already (not a re-send) */
+} lahar_link_auth_stats;
+void lahar_link_set_auth_key(lahar_link *l, const uint8_t key[32]);
+/* 1 when the link authenticates; *out (may be NULL) gets what it dropped so far. */
+int lahar_link_auth(const lahar_link *l, lahar_link_auth_stats *out);
+
 /* Heartbeat thread: publishes heartbeat_t with the last completed step every period_s. */
 int lahar_link_heartbeat_start(lahar_link *l, double period_s);
 void lahar_link_heartbeat_stop(lahar_link *l);

@@ -3,6 +3,8 @@
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include "auth.h"
 #include "netns.h"
 #include "lahar_stop_t.h"
 #include "scene_msg.h"
@@ -10,7 +12,7 @@
 static void node_usage(FILE *f, const char *prog, const char *about, const char *exit_codes)
 {
     fprintf(f,
-            "usage: %s [--lcm-url URL] [--run-id ID] [--threads N] [--wait S]\n"
+            "usage: %s [--lcm-url URL] [--run-id ID] [--threads N] [--wait S] [--auth-key FILE]\n"
             "%s\n"
             "`lahar run` starts it by itself; start it by hand only with `lahar run --no-spawn`.\n\n"
             "  --lcm-url URL   LCM URL of the run (default: $LCM_DEFAULT_URL, else\n"
@@ -19,6 +21,8 @@ static void node_usage(FILE *f, const char *prog, const char *about, const char 
             "  --run-id ID     join only this run (default: the first run announced)\n"
             "  --threads N     OpenMP threads of the node's loops (default: OpenMP's default)\n"
             "  --wait S        seconds to wait for the coordinator's announcement (default 30)\n"
+            "  --auth-key FILE the run's key (the coordinator's --auth-key; also $LAHAR_AUTH_KEY):\n"
+            "                  messages without its MAC are dropped\n"
             "  -h, --help      this help\n"
             "%s\n",
             prog, about, LAHAR_NETNS_URL, exit_codes);
@@ -31,10 +35,11 @@ int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *a
     o->run_id = 0;
     o->threads = 0;
     o->join_wait_s = 0.0;
+    o->auth_key_path = getenv(LAHAR_AUTH_ENV);
     static const struct option opts[] = {
         {"lcm-url", required_argument, NULL, 'u'}, {"run-id", required_argument, NULL, 'r'},
         {"threads", required_argument, NULL, 't'}, {"wait", required_argument, NULL, 'w'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+        {"auth-key", required_argument, NULL, 'k'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0},
     };
     int c;
     while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
@@ -43,6 +48,7 @@ int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *a
         case 'r': o->run_id = strtoll(optarg, NULL, 0); break;
         case 't': o->threads = atoi(optarg); break;
         case 'w': o->join_wait_s = atof(optarg); break;
+        case 'k': o->auth_key_path = optarg; break;
         case 'h': node_usage(stdout, prog, about, exit_codes); return 0;
         default: node_usage(stderr, prog, about, exit_codes); return 2;
         }
@@ -75,6 +81,19 @@ int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, 
         lahar_transport_close(*t);
         *t = NULL;
         return 2;
+    }
+    if (o->auth_key_path && *o->auth_key_path) {
+        uint8_t key[LAHAR_AUTH_KEYBYTES];
+        if (lahar_auth_key_load(o->auth_key_path, key, err, sizeof err) != 0) {
+            fprintf(stderr, "%s: %s\n", prog, err);
+            lahar_link_destroy(*l);
+            lahar_transport_close(*t);
+            *l = NULL;
+            *t = NULL;
+            return 2;
+        }
+        lahar_link_set_auth_key(*l, key);
+        memset(key, 0, sizeof key);
     }
     return 0;
 }

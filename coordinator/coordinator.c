@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include "auth.h"
 #include "dem_node.h"
 #include "instability.h"
 #include "lahar_hello_t.h"
@@ -92,6 +93,8 @@ typedef struct {
     double last_progress;
     int setup_shown;        /* a set-up progress line is on the terminal (ended by a newline) */
     double stop_wait;       /* s the nodes get to exit after STOP (0: COORD_STOP_WAIT) */
+    char auth_key_path[PATH_MAX]; /* authenticated run: the key file (absolute), passed to the nodes */
+    uint8_t auth_key[LAHAR_AUTH_KEYBYTES];
 } coord;
 
 static volatile sig_atomic_t coord_interrupted;
@@ -169,7 +172,8 @@ static int coord_start_node(coord *co, coord_node *n)
     }
     snprintf(run, sizeof run, "%lld", (long long)co->run_id);
     snprintf(threads, sizeof threads, "%d", co->o->threads);
-    char *argv[] = {exe, "--lcm-url", (char *)co->url, "--run-id", run, "--threads", threads, NULL};
+    char *argv[] = {exe, "--lcm-url", (char *)co->url, "--run-id", run, "--threads", threads,
+                    co->auth_key_path[0] ? "--auth-key" : NULL, co->auth_key_path, NULL};
     pid_t parent = getpid();
     fflush(NULL);
     pid_t pid = fork();
@@ -791,6 +795,11 @@ static void coord_write_summary(coord *co)
         }
     }
     cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
+    lahar_link_auth_stats as = {0};
+    cJSON *auth = cJSON_AddObjectToObject(root, "auth");
+    cJSON_AddBoolToObject(auth, "enabled", co->link && lahar_link_auth(co->link, &as));
+    cJSON_AddNumberToObject(auth, "frames_rejected", (double)as.frames_rejected);
+    cJSON_AddNumberToObject(auth, "frames_replayed", (double)as.frames_replayed);
     coord_summary_work(co, root);
     coord_summary_instability(co, root);
     char *text = cJSON_Print(root);
@@ -977,6 +986,20 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         co.url = LAHAR_NETNS_URL;
         co.mode = "processes";
     }
+    /* an authenticated run (--auth-key or $LAHAR_AUTH_KEY): memq:// inside this process has no
+     * one to keep out, every network run takes the key */
+    const char *key_path = o->auth_key_path ? o->auth_key_path : getenv(LAHAR_AUTH_ENV);
+    if (key_path && *key_path && !o->in_process) {
+        if (!realpath(key_path, co.auth_key_path) ||
+            lahar_auth_key_load(co.auth_key_path, co.auth_key, err, sizeof err) != 0) {
+            if (!co.auth_key_path[0] || errno == ENOENT)
+                snprintf(err, sizeof err, "auth key %s: %s (make one with `lahar keygen FILE`)", key_path,
+                         strerror(errno));
+            fprintf(stderr, "lahar: %s\n", err);
+            close(lock_fd);
+            return LAHAR_EXIT_SETUP;
+        }
+    }
     co.run_id = coord_random_run_id();
     co.progress = !o->quiet && isatty(STDERR_FILENO);
     co.last_progress = co.wall0;
@@ -1000,6 +1023,8 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         snprintf(co.message, sizeof co.message, "%s", err);
         goto out;
     }
+    if (co.auth_key_path[0])
+        lahar_link_set_auth_key(co.link, co.auth_key);
     if (!o->no_spawn)
         for (int r = 1; r < LAHAR_NROLES; r++)
             if (co.node[r].needed && coord_start_node(&co, &co.node[r]) != 0) {

@@ -13,6 +13,7 @@
 #include "coordinator.h"
 #include "dem_engine.h"
 #include "estimate.h"
+#include "auth.h"
 #include "netns.h"
 
 static void usage(FILE *f)
@@ -25,6 +26,7 @@ static void usage(FILE *f)
             "       lahar bench -o OUT [--quick] [options]   run time against error of the validation cases,\n"
             "                                                co-simulation overhead, DEM subcycling: CSV, PNG\n"
             "                                                and OUT/summary.md (`lahar bench --help`)\n"
+            "       lahar keygen FILE                        a new key for --auth-key (mode 0600)\n"
             "       lahar --help | --version\n\n"
             "Options of run and check:\n"
             "  -o, --output OUT   output directory (created): bodies.h5, forces.h5, particles.h5, *.xmf,\n"
@@ -40,6 +42,10 @@ static void usage(FILE *f)
             "                     from $LCM_DEFAULT_URL). Set ttl yourself (ttl=0: this host only) and\n"
             "                     recv_buf_size=8388608\n"
             "  --wait S           seconds to wait for the nodes to join (default 30)\n"
+            "  --auth-key FILE    authenticate every message with this key (also $LAHAR_AUTH_KEY):\n"
+            "                     for runs across machines; the nodes need the same --auth-key.\n"
+            "                     Forged, altered and replayed messages are dropped and counted in\n"
+            "                     summary.json (auth). Make a key with `lahar keygen FILE`\n"
             "  --node-timeout S   a node silent for S seconds is lost (default 2). A node lahar started\n"
             "                     that is silent but still using CPU is waited for up to 120 s more\n"
             "                     (an overloaded machine); a node whose process ended is lost at once\n"
@@ -189,9 +195,23 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "bench"))
         return bench_exec(argc, argv);
+    if (!strcmp(cmd, "keygen")) {
+        char err[512];
+        if (argc != 3 || argv[2][0] == '-') {
+            fprintf(stderr, "usage: lahar keygen FILE   (a new key for authenticated runs, mode 0600)\n");
+            return 2;
+        }
+        if (lahar_auth_keygen(argv[2], err, sizeof err) != 0) {
+            fprintf(stderr, "lahar keygen: %s\n", err);
+            return 2;
+        }
+        printf("lahar keygen: wrote a new key to %s; copy it (privately) to every host of the run and give it "
+               "to lahar, lahar-dem and lahar-sph with --auth-key %s\n", argv[2], argv[2]);
+        return 0;
+    }
     int is_run = !strcmp(cmd, "run"), is_check = !strcmp(cmd, "check"), is_validate = !strcmp(cmd, "validate");
     if (!is_run && !is_check && !is_validate) {
-        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, bench)\n", cmd);
+        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, bench, keygen)\n", cmd);
         usage(stderr);
         return 2;
     }
@@ -204,6 +224,7 @@ int main(int argc, char **argv)
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
         {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
         {"node-timeout", required_argument, NULL, 'T'}, {"overwrite", no_argument, NULL, 'O'},
+        {"auth-key", required_argument, NULL, 'K'},
         {NULL, 0, NULL, 0},
     };
     optind = 2;
@@ -226,6 +247,7 @@ int main(int argc, char **argv)
         case 'e': evaluate_only = 1; break;
         case 'L': allow_large = 1; break;
         case 'O': o.overwrite = 1; break;
+        case 'K': o.auth_key_path = optarg; break;
         case 'T':
             if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, &o.node_timeout_s) != 0)
                 return 2;

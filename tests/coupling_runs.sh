@@ -7,7 +7,7 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | node_stopped | coordinator_killed | concurrent |
-#         cross_host | no_namespace | engine_error | cli
+#         cross_host | cross_host_auth | no_namespace | engine_error | cli
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -289,6 +289,54 @@ cross_host)
         wait \$dem" || fail "cross-host run failed"
     same_as_reference xhost
     [ "$(summary xhost "s['mode']")" = no-spawn ] || fail "mode is not no-spawn"
+    ;;
+cross_host_auth)
+    # An authenticated run across two "hosts" (--auth-key on the coordinator and the DEM node)
+    # with a hostile peer on the coordinator's host (tests/lahar_attack.c) that re-publishes every
+    # small frame it hears altered, with its MAC zeroed, and verbatim: the run's bodies are
+    # bitwise those of the in-process reference, and summary.json counts the rejected and the
+    # replayed frames. Then a DEM node without the key cannot join the keyed run (exit 2).
+    reference
+    "$bin/lahar" keygen run.key > /dev/null || fail "lahar keygen failed"
+    [ "$(stat -c %a run.key)" = 600 ] || fail "the key file is not mode 0600"
+    hosts="
+        ip link set lo up
+        unshare --net sleep 600 & host_b=\$!
+        trap 'kill \$host_b 2>/dev/null' EXIT
+        for _ in \$(seq 50); do [ \"\$(readlink /proc/\$host_b/ns/net)\" != \"\$(readlink /proc/self/ns/net)\" ] && break; sleep 0.02; done
+        ip link add lahar_a type veth peer name lahar_b netns \$host_b
+        ip addr add 10.231.7.1/24 dev lahar_a
+        ip link set lahar_a up multicast on
+        ip route add 224.0.0.0/4 dev lahar_a
+        nsenter --net=/proc/\$host_b/ns/net sh -c '
+            ip link set lo up
+            ip addr add 10.231.7.2/24 dev lahar_b
+            ip link set lahar_b up multicast on
+            ip route add 224.0.0.0/4 dev lahar_b'"
+    unshare --user --map-root-user --net bash -c "
+        set -e
+        $hosts
+        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --auth-key run.key & dem=\$!
+        '$LAHAR_ATTACK' '$URL_LINK' 4 > attack.txt & attacker=\$!
+        '$bin/lahar' run case.yaml -o auth -q --no-spawn --lcm-url '$URL_LINK' --auth-key run.key
+        wait \$dem
+        wait \$attacker" || fail "authenticated cross-host run failed"
+    cat attack.txt
+    same_as_reference auth
+    [ "$(summary auth "s['auth']['enabled']")" = True ] || fail "summary.json: auth not enabled"
+    rejected=$(summary auth "s['auth']['frames_rejected']")
+    replayed=$(summary auth "s['auth']['frames_replayed']")
+    echo "coordinator dropped $rejected altered or forged frames and $replayed replayed ones"
+    [ "$rejected" -gt 0 ] && [ "$replayed" -gt 0 ] || fail "the hostile frames were not counted (rejected $rejected, replayed $replayed)"
+    unshare --user --map-root-user --net bash -c "
+        $hosts
+        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --wait 5 > /dev/null 2>&1 & dem=\$!
+        set +e
+        '$bin/lahar' run case.yaml -o keyless -q --no-spawn --lcm-url '$URL_LINK' --auth-key run.key --wait 3 2> keyless.txt
+        echo \$? > keyless_rc.txt
+        kill \$dem 2>/dev/null; wait \$dem 2>/dev/null; true"
+    cat keyless.txt
+    [ "$(cat keyless_rc.txt)" = 2 ] || fail "a DEM node without the key joined the keyed run (exit $(cat keyless_rc.txt), want 2)"
     ;;
 engine_error)
     # An engine failure (here: a 6 m/s impact overlapping two balls by more than a tight
