@@ -125,6 +125,20 @@ typedef struct {
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
 } lahar_sph_options;
 
+/* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).
+ * body < 0: a point in the fluid, pressure by Shepard interpolation of the water particles.
+ * body >= 0: a point on that body's swept surface (the loader projects x onto it and stores the
+ * outward normal n), pressure by Adami, Hu & Adams 2012 eq. 27 at the surface point; with size > 0
+ * the mean over a segment (2D) or disc (3D) of that diameter on the surface. */
+typedef struct {
+    char name[LAHAR_NAME_MAX];
+    double x[3];           /* world point at the scene pose (on the surface when body >= 0) */
+    double n[3];           /* body probes: outward surface normal at x (world, scene pose) */
+    int body;              /* index into lahar_case.bodies, or -1 */
+    double size;           /* sensor diameter, m (0: the point) */
+    double rate;           /* samples per second (0: every step) */
+} lahar_probe;
+
 typedef struct {
     int enabled;           /* 1 if the case has a check: section */
     char reference[256];   /* name of the reference the check compares against */
@@ -170,6 +184,9 @@ typedef struct {
     /* DEM engine options */
     char dem_engine[LAHAR_NAME_MAX]; /* "spheropoly" by default */
     double dem_dt_safety;  /* fraction of the contact period used as the DEM step, default 0.02 */
+
+    int nprobe;            /* pressure probes (probes: section; 0 = none, no gauges.h5) */
+    lahar_probe *probes;
 
     lahar_check check;
     lahar_stability stability; /* instability checks (stability: section) */
