@@ -97,6 +97,7 @@ typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
 typedef enum { LAHAR_SPH_WALL_PRESSURE_PENALTY = 0, LAHAR_SPH_WALL_PRESSURE_GHOST = 1 } lahar_sph_wall_pressure;
+typedef enum { LAHAR_SPH_PENALTY_STEP = 0, LAHAR_SPH_PENALTY_ACOUSTIC = 1 } lahar_sph_penalty_stiffness;
 
 typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
@@ -121,6 +122,9 @@ typedef struct {
                                                    hydrostatic per block (lahar_sph_node_fill) */
     lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, paper 000
                                               eq. 15) or ghost layers (sph_node/sph_coupling.h) */
+    lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of paper 000 eq. 15 with the
+                                              step's dt (step, default) or the acoustic step
+                                              cfl h / c0 (acoustic: independent of the step) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
 } lahar_sph_options;
