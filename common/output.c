@@ -1353,7 +1353,7 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
                           "pressure probes (case section probes:): per probe /probes/NAME/t (s), step and p (Pa, "
                           "gauge: 0 at the free surface). Fluid points: Shepard interpolation of the water "
                           "particles' pressure (DualSPHysics MeasureTool, dry below sum V W = 0.5: 0). Points on a "
-                          "body: Adami, Hu & Adams 2012 eq. 27 at the surface point (dry below sum V W = 0.25: 0), "
+                          "body: Adami, Hu & Adams 2012 eq. 27 at the surface point (dry below sum V W = 0.1: 0), "
                           "averaged over the sensor's segment (2D) or disc (3D) of diameter size");
     rc |= out_attr_string(o->file, "lahar_version", LAHAR_VERSION);
     hid_t pg = out_group(o->file, "probes");

@@ -9,7 +9,7 @@
 #include "vec.h"
 
 #define SPH_PROBE_DRY_FLUID 0.5 /* DualSPHysics MeasureTool kclimit */
-#define SPH_PROBE_DRY_WALL 0.25 /* half of it: only the fluid side of a wall holds particles */
+#define SPH_PROBE_DRY_WALL 0.1  /* wetted: ~1/2 on a flat wall, ~1/4 in a 90 degree corner */
 
 /* Points of a sensor of diameter size about x with normal n (world, scene pose), at most dx/4
  * apart (midpoints of equal parts of the segment; in 3D the points of a square grid inside the

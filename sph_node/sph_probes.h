@@ -12,8 +12,9 @@
  *   p_w = [sum_f p_f W_wf + b . sum_f rho_f (x_w - x_f) W_wf] / sum_f W_wf,
  * b the fluid's body force (gravity + sph.body_force; the body's own acceleration a_w of eq. 27 is
  * not known on the SPH node and is left out: exact for fixed bodies). The water particles are
- * the f. Only the fluid side holds particles, so a wetted wall point has sum_f V_f W_wf near 1/2;
- * below 1/4 (half of DualSPHysics' 0.5, the kernel cut by the wall) the point is dry and reads 0.
+ * the f. Only the fluid side holds particles, so a wetted wall point has sum_f V_f W_wf near 1/2
+ * (near 1/4 in a 90 degree corner: a sensor 3 mm above a floor); below 0.1 the point is dry and
+ * reads 0 (corner probes in a tank at rest read rho g (h - y) within 0.6 % of rho g h).
  * A sensor of diameter `size` > 0 averages the value over points at most dx/4 apart across a
  * segment (2D) or a disc (3D) of that diameter in the surface's tangent plane, each projected onto
  * the surface at setup. Points and normals are kept in the body frame and follow moving bodies.

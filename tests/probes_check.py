@@ -43,6 +43,7 @@ def main():
     probes = ("[{name: wall_05, position: [0.4, 0.05], body: wall_right},"
               " {name: wall_10_sensor, position: [0.4, 0.1], body: wall_right, size: 0.009},"
               " {name: floor_20, position: [0.2, 0.0], body: floor},"
+              " {name: corner_03, position: [0.4, 0.003], body: wall_right, size: 0.0042},"
               " {name: fluid_10, position: [0.2, 0.1]},"
               " {name: fluid_03_100hz, position: [0.1, 0.03], rate: 100},"
               " {name: dry, position: [0.2, 0.25]}]")
@@ -63,7 +64,7 @@ def main():
     f = h5py.File(os.path.join(a.out, "with", "gauges.h5"), "r")
     ff = h5py.File(os.path.join(a.out, "with", "forces.h5"), "r")
     dt_max = float(np.diff(ff["t"][:]).max())
-    for name in ("wall_05", "wall_10_sensor", "floor_20", "fluid_10", "fluid_03_100hz", "dry"):
+    for name in ("wall_05", "wall_10_sensor", "floor_20", "corner_03", "fluid_10", "fluid_03_100hz", "dry"):
         g = f["probes"][name]
         t, p = g["t"][:], g["p"][:]
         y = float(g.attrs["position"][1])
