@@ -10,7 +10,12 @@ endif()
 add_test(NAME probes_tank_2d
   COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/probes_check.py $<TARGET_FILE:lahar>
           ${CMAKE_CURRENT_BINARY_DIR}/probes/tank_2d)
-set_tests_properties(probes_tank_2d PROPERTIES LABELS "sph;probes" TIMEOUT 300)
+# 3D: cases/hydrostatic_3d.yaml at dx 10 mm, 0.1 s, disc sensors (20 mm on a wall, 10 mm on the
+# floor) and a point in the water within 1 % of rho g h (measured -0.27, -0.24, -0.08 %).
+add_test(NAME probes_tank_3d
+  COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/probes_check.py $<TARGET_FILE:lahar>
+          ${CMAKE_CURRENT_BINARY_DIR}/probes/tank_3d --3d)
+set_tests_properties(probes_tank_2d probes_tank_3d PROPERTIES LABELS "sph;probes" TIMEOUT 300)
 
 # Wall-force chatter (sph.penalty_stiffness): a tank at rest with penalty walls at a step 8 times
 # below the CFL step; the step-to-step change of the wall force is <= 0.5 % of rho g h^2 / 2 with

@@ -2,6 +2,11 @@
 """Pressure probes (case section probes:, sph_node/sph_probes.h) in a tank at rest.
 
   probes_check.py LAHAR OUT [--dx M] [--wall penalty|ghost] [--tol F]
+  probes_check.py LAHAR OUT --3d
+
+--3d: cases/hydrostatic_3d.yaml (0.1 x 0.05 m, 0.1 m deep) at dx 10 mm to t = 0.1 s with a 20 mm
+disc sensor on the x = 0.1 m wall, a 10 mm disc on the floor and a point in the water: each mean
+over t > 0.05 s within tol x rho g h of rho g (h - z).
 
 Runs cases/hydrostatic_2d.yaml (0.4 m x 0.2 m of water, walls of DEM boxes) at dx (default 10 mm)
 to t = 0.5 s with probes on the right wall (a point, and a 9 mm sensor), on the floor, in the
@@ -37,8 +42,11 @@ def main():
     ap.add_argument("--dx", type=float, default=0.01)
     ap.add_argument("--wall", default="ghost", choices=["penalty", "ghost"])
     ap.add_argument("--tol", type=float, default=0.01)
+    ap.add_argument("--3d", dest="three", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
+    if a.three:
+        return check_3d(a)
     case = os.path.join(HERE, "..", "cases", "hydrostatic_2d.yaml")
     probes = ("[{name: wall_05, position: [0.4, 0.05], body: wall_right},"
               " {name: wall_10_sensor, position: [0.4, 0.1], body: wall_right, size: 0.009},"
@@ -94,6 +102,37 @@ def main():
         elif len(t) != len(ff["t"][:]) + 1:
             print(f"probes_check: FAIL {name}: {len(t)} samples, expected one per step + t = 0 ({len(ff['t']) + 1})")
             ok = False
+    print("probes_check:", "PASS" if ok else "FAIL")
+    return 0 if ok else 1
+
+
+def check_3d(a):
+    h = 0.1
+    yml = os.path.join(a.out, "tank_3d.yaml")
+    probes = ("[{name: wall_x, position: [0.1, 0.025, 0.04], body: wall_xmax, size: 0.02},"
+              " {name: floor, position: [0.05, 0.025, 0.0], body: floor, size: 0.01},"
+              " {name: fluid, position: [0.05, 0.025, 0.05]}]")
+    ov = ["sph.dx=0.01", "time.end=0.1", "time.output_interval=0.1", f"probes={probes}"]
+    if case_override.main(["case_override.py", os.path.join(HERE, "..", "cases", "hydrostatic_3d.yaml"), yml] + ov):
+        return 1
+    r = subprocess.run([a.lahar, "run", yml, "-o", os.path.join(a.out, "run3d"), "--in-process", "--threads", "1", "-q"])
+    if r.returncode != 0:
+        print(f"probes_check: lahar run {yml} exited {r.returncode}")
+        return 1
+    f = h5py.File(os.path.join(a.out, "run3d", "gauges.h5"), "r")
+    ok = True
+    for name in ("wall_x", "floor", "fluid"):
+        g = f["probes"][name]
+        t, p = g["t"][:], g["p"][:]
+        z = float(g.attrs["position"][2])
+        ref = RHO * G * (h - z)
+        m = t > 0.05
+        err = (p[m].mean() - ref) / (RHO * G * h)
+        good = abs(err) <= a.tol
+        print(f"probes_check: 3D {name} (z = {z:.3f} m, size {float(g.attrs['size']) * 1000:g} mm): mean p "
+              f"{p[m].mean():.1f} Pa, rho g (h - z) = {ref:.1f} Pa, error {100 * err:+.3f} % of rho g h "
+              f"(bound {100 * a.tol:g} %) {'ok' if good else 'FAIL'}")
+        ok &= bool(good)
     print("probes_check:", "PASS" if ok else "FAIL")
     return 0 if ok else 1
 
