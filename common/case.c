@@ -6,6 +6,7 @@
 #include "case.h"
 
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -1645,12 +1646,13 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "shifting", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "shifting", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
     static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
     static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
+    static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
     lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
@@ -1697,6 +1699,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                                                 LAHAR_SPH_INITIAL_PRESSURE_NONE);
     o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(&m, "wall_pressure", wall_pressure_names, 0,
                                                           LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->penalty_stiffness = (lahar_sph_penalty_stiffness)rmap_enum(&m, "penalty_stiffness", penalty_stiffness_names, 0,
+                                                                  LAHAR_SPH_PENALTY_STEP);
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);
@@ -1838,6 +1842,135 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     check_blocks_placement(r, bl, c);
 }
 
+/* probes: [{name, position, body, size, rate}, ...] (lahar_probe, common/scene.h). A fluid probe
+ * must lie in the box of the bodies and blocks and outside every body; a body probe within sph.dx
+ * of the body's swept surface (it is projected onto it, and the outward normal stored). */
+static void case_domain_box(const lahar_case *c, double lo[3], double hi[3])
+{
+    for (int a = 0; a < 3; a++)
+        lo[a] = DBL_MAX, hi[a] = -DBL_MAX;
+    for (int b = 0; b < c->nbody; b++) {
+        const lahar_body *bd = &c->bodies[b];
+        for (int v = 0; v < bd->shape.nv; v++) {
+            vec3 w = geom_world_vertex(&bd->shape, bd->x, bd->q, v);
+            double wa[3] = {w.x, w.y, w.z};
+            for (int a = 0; a < c->dim; a++) {
+                lo[a] = fmin(lo[a], wa[a] - bd->shape.radius);
+                hi[a] = fmax(hi[a], wa[a] + bd->shape.radius);
+            }
+        }
+    }
+    for (int k = 0; k < c->nblock; k++)
+        for (int a = 0; a < c->dim; a++) {
+            lo[a] = fmin(lo[a], c->blocks[k].lo[a]);
+            hi[a] = fmax(hi[a], c->blocks[k].hi[a]);
+        }
+    for (int a = c->dim; a < 3; a++)
+        lo[a] = hi[a] = 0.0;
+}
+
+static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const pkeys[] = {"name", "position", "body", "size", "rate", NULL};
+    if (!n || r->failed)
+        return;
+    if (n->type != YAML_SEQUENCE_NODE) {
+        rd_fail(r, n, "probes", "expected a list of probes (lines starting with `- `), got %s", node_kind(n));
+        return;
+    }
+    if (c->nblock == 0) {
+        rd_fail(r, n, "probes", "pressure probes read the SPH fluid, but the case has no sph: blocks; remove probes "
+                "or add an sph section");
+        return;
+    }
+    int np = seq_len(n);
+    if (np == 0)
+        return;
+    c->probes = calloc((size_t)np, sizeof *c->probes);
+    if (!c->probes) {
+        rd_fail(r, n, "probes", "out of memory");
+        return;
+    }
+    const int dim = r->dim;
+    const double dx = c->sph_dx;
+    double lo[3], hi[3];
+    case_domain_box(c, lo, hi);
+    for (int i = 0; i < np && !r->failed; i++) {
+        lahar_probe *pr = &c->probes[i];
+        c->nprobe = i + 1;
+        char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+        snprintf(prefix, sizeof prefix, "probes[%d]", i);
+        snprintf(def, sizeof def, "probe%d", i);
+        rmap pm;
+        if (rmap_open(r, seq_item(r, n, i), prefix, &pm) != 0)
+            return;
+        rmap_check_keys(&pm, pkeys);
+        rmap_name(&pm, "name", 0, def, pr->name);
+        for (int j = 0; j < i && !r->failed; j++)
+            if (strcmp(c->probes[j].name, pr->name) == 0)
+                rmap_fail(&pm, "name", "'%s' is already the name of probes[%d]; probe names must be unique", pr->name, j);
+        rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[0.5, 0.0, 0.01]" : "[0.5, 0.01]");
+        pr->size = rmap_num(&pm, "size", 0, 0.0, "0.009");
+        pr->rate = rmap_num(&pm, "rate", 0, 0.0, "20000");
+        pr->body = -1;
+        const char *bname = rmap_str(&pm, "body", 0, NULL, "wall_right");
+        if (r->failed)
+            return;
+        if (!(pr->size >= 0.0) || !isfinite(pr->size)) {
+            rmap_fail(&pm, "size", "must be >= 0 (got %g): the sensor's diameter in m (0 = a point)", pr->size);
+            return;
+        }
+        if (!(pr->rate >= 0.0) || !isfinite(pr->rate)) {
+            rmap_fail(&pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)", pr->rate);
+            return;
+        }
+        if (pr->size > 0.0 && !bname) {
+            rmap_fail(&pm, "size", "is the diameter of a sensor on a body's surface; give body: NAME, or remove size "
+                      "for a point probe in the fluid");
+            return;
+        }
+        for (int a = 0; a < dim; a++)
+            if (!(pr->x[a] >= lo[a] - dx && pr->x[a] <= hi[a] + dx)) {
+                rmap_fail(&pm, "position", "lies outside the domain (the box of the bodies and blocks, %c in [%g, %g]; "
+                          "got %c = %g)", "xyz"[a], lo[a], hi[a], "xyz"[a], pr->x[a]);
+                return;
+            }
+        if (!bname) {
+            for (int b = 0; b < c->nbody; b++)
+                if (lahar_body_contains(&c->bodies[b], dim, pr->x)) {
+                    rmap_fail(&pm, "position", "lies inside body '%s'; a probe without body: is a point in the fluid "
+                              "(give body: %s for a sensor on its surface)", c->bodies[b].name, c->bodies[b].name);
+                    return;
+                }
+            continue;
+        }
+        pr->body = lahar_case_find_body(c, bname);
+        if (pr->body < 0) {
+            rmap_fail(&pm, "body", "unknown body '%s'; give the name of one of the case's bodies", bname);
+            return;
+        }
+        const lahar_body *bd = &c->bodies[pr->body];
+        vec3 cp;
+        int feat;
+        double dcore = geom_point_body_core(&bd->shape, bd->x, bd->q, v3_load(pr->x), &cp, &feat);
+        double R = bd->shape.radius, gap = dcore - R;
+        int inside_core = dcore > R && lahar_body_contains(bd, dim, pr->x);
+        if (inside_core || fabs(gap) > dx || !(dcore > 1e-9 * dx)) {
+            if (inside_core)
+                rmap_fail(&pm, "position", "must lie on the surface of body '%s' (within sph.dx = %g m of it), but it "
+                          "is inside its core; move the point onto the surface", bname, dx);
+            else
+                rmap_fail(&pm, "position", "must lie on the surface of body '%s' (within sph.dx = %g m of it), but it "
+                          "is %g m %s it; move the point onto the surface", bname, dx, fabs(gap), gap > 0 ? "off" : "inside");
+            return;
+        }
+        vec3 nn = v3_scale(v3_sub(v3_load(pr->x), cp), 1.0 / dcore);
+        vec3 xs = v3_axpy(R, nn, cp);
+        pr->x[0] = xs.x, pr->x[1] = xs.y, pr->x[2] = dim == 3 ? xs.z : 0.0;
+        pr->n[0] = nn.x, pr->n[1] = nn.y, pr->n[2] = dim == 3 ? nn.z : 0.0;
+    }
+}
+
 static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"fields", "forces", NULL};
@@ -1947,7 +2080,7 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
 static void read_case(reader *r, lahar_case *c)
 {
     static const char *const keys[] = {"dimensions", "gravity", "time", "materials", "dem", "bodies", "output",
-                                       "check", "sph", "stability", NULL};
+                                       "check", "sph", "stability", "probes", NULL};
     yaml_node_t *root = yaml_document_get_root_node(r->doc);
     if (!root) {
         rd_fail(r, NULL, "", "the case file is empty; a case needs at least dimensions, time and bodies or sph");
@@ -1991,6 +2124,7 @@ static void read_case(reader *r, lahar_case *c)
             check_overlaps(r, bodies, c);
     }
     read_sph(r, sph, c);
+    read_probes(r, rmap_get(&m, "probes"), c);
     read_output(r, rmap_get(&m, "output"), c);
     read_check(r, rmap_get(&m, "check"), c);
 }
@@ -2064,6 +2198,7 @@ void lahar_case_free(lahar_case *c)
         for (int i = 0; i < c->nblock; i++)
             lahar_particle_block_free(&c->blocks[i]);
     free(c->blocks);
+    free(c->probes);
     memset(c, 0, sizeof *c);
 }
 

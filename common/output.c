@@ -1278,5 +1278,207 @@ int lahar_output_release_swmr(const char *path)
 
 const char *const lahar_output_run_files[] = {
     "summary.json", "check.json", "check.png",   "lahar.xmf", "bodies.h5", "bodies.xmf",
-    "particles.h5", "particles.xmf", "forces.h5", "contacts.h5", NULL,
+    "particles.h5", "particles.xmf", "forces.h5", "contacts.h5", "gauges.h5", NULL,
 };
+
+/* ---------------------------------------------------------------- gauges ---------------- */
+
+#define GAUGE_BUFFER_ROWS 1024
+
+typedef struct {
+    hid_t t, step, p;
+    int64_t rows;
+    int nbuf;
+    double *bt, *bp;
+    int64_t *bstep;
+} gauge_stream;
+
+struct lahar_gauge_output {
+    hid_t file;
+    int n;
+    gauge_stream *g;
+    double last_flush;
+};
+
+static int gauge_flush(lahar_gauge_output *o)
+{
+    int rc = 0;
+    for (int k = 0; k < o->n; k++) {
+        gauge_stream *g = &o->g[k];
+        if (g->nbuf == 0)
+            continue;
+        hsize_t rows = (hsize_t)g->nbuf, start = (hsize_t)g->rows;
+        struct {
+            hid_t id, mtype;
+            const void *buf;
+        } ds[] = {{g->step, H5T_NATIVE_INT64, g->bstep}, {g->p, H5T_NATIVE_DOUBLE, g->bp}, {g->t, H5T_NATIVE_DOUBLE, g->bt}};
+        /* t last: a SWMR reader that sees n rows of t finds them in step and p */
+        for (size_t d = 0; d < sizeof ds / sizeof ds[0]; d++) {
+            hsize_t newd = start + rows;
+            if (H5Dset_extent(ds[d].id, &newd) < 0) {
+                rc = -1;
+                continue;
+            }
+            hid_t fsp = H5Dget_space(ds[d].id), msp = H5Screate_simple(1, &rows, NULL);
+            H5Sselect_hyperslab(fsp, H5S_SELECT_SET, &start, NULL, &rows, NULL);
+            if (H5Dwrite(ds[d].id, ds[d].mtype, msp, fsp, H5P_DEFAULT, ds[d].buf) < 0)
+                rc = -1;
+            H5Sclose(msp);
+            H5Sclose(fsp);
+            if (H5Dflush(ds[d].id) < 0)
+                rc = -1;
+        }
+        g->rows += g->nbuf;
+        g->nbuf = 0;
+    }
+    o->last_flush = out_wall_seconds();
+    return rc;
+}
+
+lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case *c, char *err, size_t n)
+{
+    if (n)
+        err[0] = '\0';
+    if (c->nprobe <= 0)
+        return NULL;
+    lahar_gauge_output *o = calloc(1, sizeof *o);
+    if (!o || !(o->g = calloc((size_t)c->nprobe, sizeof *o->g))) {
+        free(o);
+        snprintf(err, n, "out of memory for the gauge stream");
+        return NULL;
+    }
+    o->n = c->nprobe;
+    o->file = H5I_INVALID_HID;
+    for (int k = 0; k < o->n; k++) {
+        gauge_stream *g = &o->g[k];
+        g->t = g->step = g->p = H5I_INVALID_HID;
+        g->bt = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bt);
+        g->bp = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bp);
+        g->bstep = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bstep);
+        if (!g->bt || !g->bp || !g->bstep) {
+            snprintf(err, n, "out of memory for the gauge stream");
+            lahar_gauge_output_close(o);
+            return NULL;
+        }
+    }
+    char path[OUT_PATH_MAX];
+    snprintf(path, sizeof path, "%s/gauges.h5", outdir);
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    o->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
+    H5Pclose(fapl);
+    if (o->file < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file", path);
+        lahar_gauge_output_close(o);
+        return NULL;
+    }
+    int rc = 0;
+    hid_t h = out_header_group(o->file, c);
+    if (h < 0)
+        rc = -1;
+    else
+        H5Gclose(h);
+    rc |= out_attr_string(o->file, "units", "SI");
+    rc |= out_attr_string(o->file, "description",
+                          "pressure probes (case section probes:): per probe /probes/NAME/t (s), step and p (Pa, "
+                          "gauge: 0 at the free surface). Fluid points: Shepard interpolation of the water "
+                          "particles' pressure (DualSPHysics MeasureTool, dry below sum V W = 0.5: 0). Points on a "
+                          "body: Adami, Hu & Adams 2012 eq. 27 at the surface point (dry below sum V W = 0.1: 0), "
+                          "averaged over the sensor's segment (2D) or disc (3D) of diameter size");
+    rc |= out_attr_string(o->file, "lahar_version", LAHAR_VERSION);
+    hid_t pg = out_group(o->file, "probes");
+    if (pg < 0)
+        rc = -1;
+    const char **names = malloc((size_t)o->n * sizeof *names);
+    for (int k = 0; k < o->n && pg >= 0 && !rc; k++) {
+        const lahar_probe *pr = &c->probes[k];
+        gauge_stream *g = &o->g[k];
+        if (names)
+            names[k] = pr->name;
+        hid_t gg = out_group(pg, pr->name);
+        if (gg < 0) {
+            rc = -1;
+            break;
+        }
+        rc |= out_attr(gg, "position", H5T_NATIVE_DOUBLE, 3, pr->x);
+        rc |= out_attr_string(gg, "body", pr->body >= 0 ? c->bodies[pr->body].name : "");
+        if (pr->body >= 0)
+            rc |= out_attr(gg, "normal", H5T_NATIVE_DOUBLE, 3, pr->n);
+        rc |= out_attr_double(gg, "size", pr->size);
+        rc |= out_attr_double(gg, "rate", pr->rate);
+        rc |= out_attr_string(gg, "method", pr->body >= 0 ? "wall: Adami, Hu & Adams 2012 eq. 27"
+                                                            : "fluid: Shepard interpolation (DualSPHysics MeasureTool)");
+        struct {
+            hid_t *id;
+            const char *name, *units;
+            hid_t type;
+        } ds[] = {{&g->t, "t", "s", H5T_IEEE_F64LE}, {&g->step, "step", "", H5T_STD_I64LE}, {&g->p, "p", "Pa", H5T_IEEE_F64LE}};
+        for (size_t d = 0; d < sizeof ds / sizeof ds[0]; d++) {
+            hsize_t dim0 = 0, maxd = H5S_UNLIMITED, ch = GAUGE_BUFFER_ROWS;
+            hid_t sp = H5Screate_simple(1, &dim0, &maxd), dcpl = out_dcpl();
+            H5Pset_chunk(dcpl, 1, &ch);
+            *ds[d].id = H5Dcreate2(gg, ds[d].name, ds[d].type, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+            H5Pclose(dcpl);
+            H5Sclose(sp);
+            if (*ds[d].id < 0 || (ds[d].units[0] && out_attr_string(*ds[d].id, "units", ds[d].units)))
+                rc = -1;
+        }
+        H5Gclose(gg);
+    }
+    if (pg >= 0)
+        H5Gclose(pg);
+    if (names) {
+        hid_t st = out_str_type();
+        rc |= out_attr(o->file, "probe_names", st, o->n, names);
+        H5Tclose(st);
+        free(names);
+    } else {
+        rc = -1;
+    }
+    if (rc || H5Fstart_swmr_write(o->file) < 0) {
+        snprintf(err, n, "%s: cannot create the gauge datasets / start SWMR writing", path);
+        lahar_gauge_output_close(o);
+        return NULL;
+    }
+    o->last_flush = out_wall_seconds();
+    return o;
+}
+
+int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, const double *p, const int *due)
+{
+    if (!o)
+        return 0;
+    int full = 0;
+    for (int k = 0; k < o->n; k++) {
+        if (!due[k])
+            continue;
+        gauge_stream *g = &o->g[k];
+        g->bt[g->nbuf] = t;
+        g->bstep[g->nbuf] = step;
+        g->bp[g->nbuf] = p[k];
+        full |= ++g->nbuf == GAUGE_BUFFER_ROWS;
+    }
+    if (full || out_wall_seconds() - o->last_flush >= FORCES_FLUSH_SECONDS)
+        return gauge_flush(o);
+    return 0;
+}
+
+void lahar_gauge_output_close(lahar_gauge_output *o)
+{
+    if (!o)
+        return;
+    if (o->file >= 0)
+        gauge_flush(o);
+    for (int k = 0; k < o->n; k++) {
+        gauge_stream *g = &o->g[k];
+        hid_t ids[] = {g->t, g->step, g->p};
+        for (size_t d = 0; d < 3; d++)
+            if (ids[d] >= 0)
+                H5Dclose(ids[d]);
+        free(g->bt), free(g->bp), free(g->bstep);
+    }
+    if (o->file >= 0)
+        H5Fclose(o->file);
+    free(o->g);
+    free(o);
+}

@@ -9,7 +9,8 @@
  *   OUT/forces.h5   per-body force stream (SWMR: readable while the run appends to it).
  *   OUT/particles.h5 + OUT/particles.xmf   SPH particles (SoA datasets, fields selectable).
  *   OUT/lahar.xmf   bodies and particles in one XDMF (lahar_output_xdmf_combine).
- *   OUT/contacts.h5 fluid contact points and their forces on the bodies marked record_contacts. */
+ *   OUT/contacts.h5 fluid contact points and their forces on the bodies marked record_contacts.
+ *   OUT/gauges.h5   pressure probes of the case (probes:), SWMR like forces.h5. */
 #ifndef LAHAR_OUTPUT_H
 #define LAHAR_OUTPUT_H
 #include <stddef.h>
@@ -79,6 +80,17 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
                                const int32_t *npoints, const double (*x)[3], const double (*f)[3],
                                const double (*force)[3], const double (*torque)[3]);
 void lahar_contact_output_close(lahar_contact_output *o);
+
+/* Pressure probes of the case (probes:, OUT/gauges.h5, SWMR like forces.h5: readable while the
+ * run appends): per probe /probes/NAME/{t, step, p} with units attributes and the probe's
+ * position, body, normal, size, rate and method as attributes of its group. open returns NULL
+ * with err empty when the case has no probes (nothing is written), NULL with a message on
+ * failure. write appends (step, t, p[k]) to every probe k with due[k] set (buffered; flushed
+ * every 1024 rows or 0.5 s of wall time and at close). o NULL: no-op. */
+typedef struct lahar_gauge_output lahar_gauge_output;
+lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case *c, char *err, size_t n);
+int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, const double *p, const int *due);
+void lahar_gauge_output_close(lahar_gauge_output *o);
 
 /* Write OUT/lahar.xmf: one temporal collection whose time steps hold the body grids and the
  * particle grid of the snapshots found in OUT/bodies.h5 and OUT/particles.h5 (either may be

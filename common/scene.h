@@ -97,6 +97,7 @@ typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
 typedef enum { LAHAR_SPH_WALL_PRESSURE_PENALTY = 0, LAHAR_SPH_WALL_PRESSURE_GHOST = 1 } lahar_sph_wall_pressure;
+typedef enum { LAHAR_SPH_PENALTY_STEP = 0, LAHAR_SPH_PENALTY_ACOUSTIC = 1 } lahar_sph_penalty_stiffness;
 
 typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
@@ -121,9 +122,26 @@ typedef struct {
                                                    hydrostatic per block (lahar_sph_node_fill) */
     lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, paper 000
                                               eq. 15) or ghost layers (sph_node/sph_coupling.h) */
+    lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of paper 000 eq. 15 with the
+                                              step's dt (step, default) or the acoustic step
+                                              cfl h / c0 (acoustic: independent of the step) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
 } lahar_sph_options;
+
+/* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).
+ * body < 0: a point in the fluid, pressure by Shepard interpolation of the water particles.
+ * body >= 0: a point on that body's swept surface (the loader projects x onto it and stores the
+ * outward normal n), pressure by Adami, Hu & Adams 2012 eq. 27 at the surface point; with size > 0
+ * the mean over a segment (2D) or disc (3D) of that diameter on the surface. */
+typedef struct {
+    char name[LAHAR_NAME_MAX];
+    double x[3];           /* world point at the scene pose (on the surface when body >= 0) */
+    double n[3];           /* body probes: outward surface normal at x (world, scene pose) */
+    int body;              /* index into lahar_case.bodies, or -1 */
+    double size;           /* sensor diameter, m (0: the point) */
+    double rate;           /* samples per second (0: every step) */
+} lahar_probe;
 
 typedef struct {
     int enabled;           /* 1 if the case has a check: section */
@@ -171,6 +189,9 @@ typedef struct {
     char dem_engine[LAHAR_NAME_MAX]; /* "spheropoly" by default */
     int dem_engine_line;             /* line of `dem.engine` in the case file (0: not given), for messages */
     double dem_dt_safety;  /* fraction of the contact period used as the DEM step, default 0.02 */
+
+    int nprobe;            /* pressure probes (probes: section; 0 = none, no gauges.h5) */
+    lahar_probe *probes;
 
     lahar_check check;
     lahar_stability stability; /* instability checks (stability: section) */

@@ -38,6 +38,7 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     m->wall_viscous = (int8_t)o->wall_viscous;
     m->initial_pressure = (int8_t)o->initial_pressure;
     m->wall_pressure = (int8_t)o->wall_pressure;
+    m->penalty_stiffness = (int8_t)o->penalty_stiffness;
 }
 
 static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *o)
@@ -67,6 +68,7 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     o->wall_viscous = (lahar_sph_wall_viscous)m->wall_viscous;
     o->initial_pressure = (lahar_sph_initial_pressure)m->initial_pressure;
     o->wall_pressure = (lahar_sph_wall_pressure)m->wall_pressure;
+    o->penalty_stiffness = (lahar_sph_penalty_stiffness)m->penalty_stiffness;
 }
 
 int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
@@ -104,8 +106,20 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->body_record_contacts = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *m->body_record_contacts);
     m->nblock = c->nblock;
     m->blocks = calloc((size_t)(c->nblock > 0 ? c->nblock : 1), sizeof *m->blocks);
-    if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks)
+    m->nprobe = c->nprobe;
+    m->probes = calloc((size_t)(c->nprobe > 0 ? c->nprobe : 1), sizeof *m->probes);
+    if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks || !m->probes)
         goto fail;
+    for (int i = 0; i < c->nprobe; i++) {
+        const lahar_probe *a = &c->probes[i];
+        lahar_probe_t *b = &m->probes[i];
+        b->name = (char *)a->name;
+        memcpy(b->x, a->x, sizeof b->x);
+        memcpy(b->n, a->n, sizeof b->n);
+        b->body = a->body;
+        b->size = a->size;
+        b->rate = a->rate;
+    }
     for (int i = 0; i < c->nmaterial; i++) {
         const lahar_material *a = &c->materials[i];
         lahar_material_t *b = &m->materials[i];
@@ -209,6 +223,7 @@ void lahar_scene_msg_release(lahar_scene_t *m)
     free(m->bodies);
     free(m->body_record_contacts);
     free(m->blocks);
+    free(m->probes);
     memset(m, 0, sizeof *m);
 }
 
@@ -216,7 +231,7 @@ void lahar_scene_msg_release(lahar_scene_t *m)
 int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
 {
     memset(c, 0, sizeof *c);
-    if (m->nmaterial < 0 || m->nbody < 0 || m->nblock < 0 || (m->dim != 2 && m->dim != 3)) {
+    if (m->nmaterial < 0 || m->nbody < 0 || m->nblock < 0 || m->nprobe < 0 || (m->dim != 2 && m->dim != 3)) {
         snprintf(err, errlen, "malformed scene message (counts or dimension)");
         return -1;
     }
@@ -348,6 +363,26 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         for (int k = 0; k < a->ntri; k++)
             for (int j = 0; j < 3; j++)
                 b->tri[k][j] = a->tri[k][j];
+    }
+    if (m->nprobe > 0) {
+        if (!(c->probes = calloc((size_t)m->nprobe, sizeof *c->probes)))
+            goto oom;
+        c->nprobe = m->nprobe;
+    }
+    for (int i = 0; i < m->nprobe; i++) {
+        const lahar_probe_t *a = &m->probes[i];
+        lahar_probe *b = &c->probes[i];
+        if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0)) {
+            snprintf(err, errlen, "malformed scene message (probe %d)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        scene_copy_name(b->name, a->name);
+        memcpy(b->x, a->x, sizeof b->x);
+        memcpy(b->n, a->n, sizeof b->n);
+        b->body = a->body;
+        b->size = a->size;
+        b->rate = a->rate;
     }
     return 0;
 oom:

@@ -562,8 +562,9 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
 {
     const int64_t n = p->n;
     const double support = c->k.support;
-    /* eq. 15: K_n = 0.1 m_min / dt^2 */
-    const double kn = 0.1 * c->m_min / (dt * dt);
+    /* eq. 15: K_n = 0.1 m_min / dt^2; with kn_dt > 0 the acoustic step instead (sph_coupling.h) */
+    const double dtk = c->kn_dt > 0.0 ? c->kn_dt : dt;
+    const double kn = 0.1 * c->m_min / (dtk * dtk);
     c->kn = kn;
     const double w0 = kernel_w(&c->k, 0.0), hd = pow(c->k.h, c->dim);
     if (n > c->pcap)

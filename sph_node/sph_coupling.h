@@ -98,6 +98,16 @@ typedef struct {
     double **gtab_body;        /* per body: G(d) of a disc/sphere (one core point), layers curved
                                   with its surface; NULL entries (and NULL): the flat gtab */
     sph_wall_pressure pressure;  /* sph_coupling_set_wall_pressure; default penalty only */
+    double kn_dt;                /* > 0: K_n = 0.1 m_min / kn_dt^2 whatever the step (sph.penalty_stiffness:
+                                    acoustic, kn_dt = cfl h / c0); 0 (default): the step's dt, eq. 15
+                                    as printed. With the step's dt the penalty spring's period stays
+                                    ~20 steps, so a smaller step (dt_max, a DEM-limited coordinator
+                                    step) makes it stiffer: each particle's bounce becomes a shorter,
+                                    higher spike (peak ~ m v sqrt(0.1)/dt) and the wall force a train
+                                    of spikes and zeros. A stiffness set by a velocity scale, not by
+                                    the step, is what Monaghan-type boundary forces use (Monaghan
+                                    1994, J. Comput. Phys. 110:399; Monaghan & Kajtar 2009, Comput.
+                                    Phys. Commun. 180:1811: constants from c0^2 or g H) */
     double body_force[3];        /* b of the ghost pressure extrapolation */
     double *wtab, wtab_dd;       /* GHOST: wall table (sph_coupling.c) on d = gtab_d0 + k wtab_dd */
     double *qtab, qtab_dd;       /* GHOST: corner table on d = gtab_d0 + k qtab_dd */

@@ -110,6 +110,10 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     for (int a = 0; a < 3; a++)
         bh[a] = f->prm.periodic[a] ? 0.0 : f->prm.body_force[a];
     f->cpl.cells = &f->cells;
+    /* K_n with the acoustic step (sph_coupling.kn_dt): the CFL step at rest, cfl h / c (the
+     * larger of c0 and the soil's sound speed) */
+    if (f->prm.penalty_acoustic)
+        f->cpl.kn_dt = f->prm.cfl * f->k.h / fmax(f->prm.c0, f->has_soil ? f->soil.cs : 0.0);
     if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
         sph_coupling_free(&f->cpl);
         return -1;

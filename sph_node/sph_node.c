@@ -35,6 +35,7 @@
 #include "scene_msg.h"
 #include "shape_build.h"
 #include "transport.h"
+#include "sph_probes.h"
 #include "vec.h"
 
 #define ROLE LAHAR_ROLE_SPH
@@ -171,6 +172,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
     prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
                                                                             : SPH_WALL_PRESSURE_PENALTY;
+    prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->sps = o->sps;
@@ -236,6 +238,9 @@ typedef struct {
     int64_t c_cap;
     int at_output_time;          /* step k starts at an output time (contacts.h5 is written then) */
     double kinetic_energy;       /* of the last snapshot (J, J/m in 2D) */
+    /* pressure probes (probes: in the case; nothing allocated or sampled without them) */
+    sph_probes probes;
+    lahar_gauge_output *gauges;
 } sph_node;
 
 static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t);
@@ -350,6 +355,8 @@ static void sph_node_free(sph_node *s)
     free(s->out_pressure);
     lahar_body_output_close(s->bout);
     lahar_contact_output_close(s->cout);
+    lahar_gauge_output_close(s->gauges);
+    sph_probes_free(&s->probes);
     free(s->reports);
     free(s->c_x);
     free(s->c_f);
@@ -764,6 +771,36 @@ static void sph_node_stopped_half_step(sph_node *s, const lahar_link_msg *stop, 
     sph_node_mark_last(s, "stopped", mark);
 }
 
+/* Pressure probes (sph_probes.h): set up, and the sample of t = 0. Nothing without probes. */
+static int sph_node_probes_open(sph_node *s, char *err, size_t errlen)
+{
+    const lahar_case *c = &s->ns.scene;
+    if (c->nprobe <= 0)
+        return 0;
+    if (sph_probes_init(&s->probes, c) != 0) {
+        snprintf(err, errlen, "out of memory for the probes");
+        return -1;
+    }
+    if (!(s->gauges = lahar_gauge_output_open(s->ns.output_dir, c, err, errlen)))
+        return -1;
+    sph_probes_sample(&s->probes, &s->f, c, s->nbody > 0 ? s->states : NULL, 0.0);
+    if (lahar_gauge_output_write(s->gauges, 0, 0.0, s->probes.value, s->probes.due) != 0) {
+        snprintf(err, errlen, "cannot write gauges.h5 in %s", s->ns.output_dir);
+        return -1;
+    }
+    return 0;
+}
+
+/* The probes due at the state of step k + 1 (time t). 0 or -1 (gauges.h5 not written). */
+static int sph_node_probes_sample(sph_node *s, int64_t k, double t)
+{
+    if (!s->gauges)
+        return 0;
+    if (sph_probes_sample(&s->probes, &s->f, &s->ns.scene, s->nbody > 0 ? s->states : NULL, t) == 0)
+        return 0;
+    return lahar_gauge_output_write(s->gauges, k + 1, t, s->probes.value, s->probes.due);
+}
+
 static int sph_node_loop(sph_node *s)
 {
     char err[2048];
@@ -851,6 +888,9 @@ static int sph_node_loop(sph_node *s)
             if (unstable) {
                 st.error = 1;
                 lahar_instability_encode(&u, err, sizeof err);
+            } else if (!st.error && sph_node_probes_sample(s, k, step.t_next) != 0) {
+                st.error = 1;
+                snprintf(err, sizeof err, "cannot write gauges.h5 in %s", s->ns.output_dir);
             }
         }
         /* on an error the state reached is kept as the last snapshot to look at: after the step,
@@ -985,6 +1025,8 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     else if (sph_node_snapshot(&s, 0, 0.0) != 0)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
     else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
+        /* the message is in err */
+    } else if (sph_node_probes_open(&s, err, sizeof err) != 0) {
         /* the message is in err */
     }
     char desc[256];
