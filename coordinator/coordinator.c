@@ -327,14 +327,20 @@ static void coord_release_files(coord *co)
     }
     if (!died)
         return;
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s/forces.h5", co->outdir);
-    int rc = lahar_output_release_swmr(path);
-    if (rc == 1 && !co->o->quiet)
-        fprintf(stderr, "lahar: %s: cleared the open-for-writing flags the dead node left; the rows it wrote are "
-                        "readable\n", path);
-    else if (rc < 0)
-        fprintf(stderr, "lahar: %s cannot be opened (its writer died while writing)\n", path);
+    for (int i = 0; lahar_output_run_files[i]; i++) { /* every HDF5 file (forces.h5 and gauges.h5 are SWMR) */
+        const char *name = lahar_output_run_files[i];
+        size_t len = strlen(name);
+        if (len < 3 || strcmp(name + len - 3, ".h5") != 0)
+            continue;
+        char path[PATH_MAX + 32];
+        snprintf(path, sizeof path, "%s/%s", co->outdir, name);
+        int rc = lahar_output_release_swmr(path);
+        if (rc == 1 && !co->o->quiet)
+            fprintf(stderr, "lahar: %s: cleared the open-for-writing flags the dead node left; the rows it wrote "
+                            "are readable\n", path);
+        else if (rc < 0)
+            fprintf(stderr, "lahar: %s cannot be opened (its writer died while writing)\n", path);
+    }
 }
 
 static void coord_read_hello(coord_node *n, const lahar_link_msg *m)
