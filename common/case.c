@@ -1646,7 +1646,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "shifting", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "shifting", "shifting_density", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1691,6 +1691,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     double shep = rmap_num(&m, "shepard_interval", 0, 0.0, "30");
     o->shifting = rmap_num(&m, "shifting", 0, 0.0, "0.01");
     o->sps = rmap_bool(&m, "sps", 0);
+    o->shifting_density = rmap_bool(&m, "shifting_density", 0);
     o->sps_cs = rmap_num(&m, "sps_cs", 0, 0.12, "0.12");
     o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
     o->kappa = rmap_num(&m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
@@ -1739,6 +1740,9 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                   "confined flows only, lahar detects no free surface)", o->shifting);
     else if (!(o->sps_cs > 0 && o->sps_cs < 1))
         rmap_fail(&m, "sps_cs", "must be in (0, 1) (got %g); 0.12 is usual", o->sps_cs);
+    else if (o->shifting_density && !(o->shifting > 0.0))
+        rmap_fail(&m, "shifting_density", "corrects the density for the particle shift, but shifting is off; remove it or "
+                  "set shifting > 0");
     else if (rmap_get(&m, "sps_cs") && !o->sps)
         rmap_fail(&m, "sps_cs", "is the Smagorinsky constant of sps: true, but sps is off; remove it or set sps: true");
     else if (!(o->kappa > 0 && o->kappa <= 4))

@@ -1224,3 +1224,197 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
     snprintf(r->title, sizeof r->title, "dam_break: %" PRId64 " particles, H0 = %.4g m", n0, H0);
     return 0;
 }
+
+/* ---------------------------------------------------------------- lid-driven cavity ----- */
+
+/* Ghia, Ghia & Shin 1982 (J. Comput. Phys. 48:387-411), Re = 100: Table I, u/U along the vertical
+ * centreline at heights y/L; Table II, v/U along the horizontal centreline at x/L. The interior
+ * points only (the end points are the boundary conditions). Source and the full table:
+ * docs/reference/ghia_1982_re100.txt. */
+static const double ghia_y[] = {0.9766, 0.9688, 0.9609, 0.9531, 0.8516, 0.7344, 0.6172, 0.5000,
+                                0.4531, 0.2813, 0.1719, 0.1016, 0.0703, 0.0625, 0.0547};
+static const double ghia_u[] = {0.84123, 0.78871, 0.73722, 0.68717, 0.23151, 0.00332, -0.13641, -0.20581,
+                                -0.21090, -0.15662, -0.10150, -0.06434, -0.04775, -0.04192, -0.03717};
+static const double ghia_x[] = {0.9688, 0.9609, 0.9531, 0.9453, 0.9063, 0.8594, 0.8047, 0.5000,
+                                0.2344, 0.2266, 0.1563, 0.0938, 0.0781, 0.0703, 0.0625};
+static const double ghia_v[] = {-0.05906, -0.07391, -0.08864, -0.10313, -0.16914, -0.22445, -0.24533, 0.05454,
+                                0.17527, 0.17507, 0.16077, 0.12317, 0.10890, 0.10091, 0.09233};
+#define GHIA_NU ((int)(sizeof ghia_y / sizeof ghia_y[0]))
+#define GHIA_NV ((int)(sizeof ghia_x / sizeof ghia_x[0]))
+#define CAVITY_NPROF 81 /* plotted profile points per centreline */
+
+/* Lid-driven square cavity (2D): the fluid fills a square of side L (the particles' extent at the
+ * first snapshot plus dx/2 each side) closed by fixed walls and a lid, the prescribed body moving
+ * along +x above it at U = |v|; Re = rho U L / mu must be 100 (within 1 %), Ghia's tables.
+ *  - u_max_error / u_l2_error: the velocity u/U along x = L/2 at Ghia's interior heights
+ *    (Table I), max and root mean square of |u - u_Ghia| / U; v_max_error / v_l2_error the same
+ *    for v/U along y = L/2 (Table II). The particle velocities are sampled at each point by a
+ *    Shepard mean with the weight exp(-(r/dx)^2), r < 2 dx, summed over the late window's
+ *    snapshots (t >= t_last - 0.1 (t_last - t_first)): the steady state, with the particle noise
+ *    averaged out.
+ *  - volume_drift: |<V>/V(0) - 1|, <V> the late window's mean of V = sum_i m_i/rho_i with m_i = rho0
+ *    dx^2 (the lattice's mass without a hydrostatic start): in a closed box the particles fill the
+ *    same area all along, so the total volume their densities claim must stay. Information:
+ *    volume_deviation_max, max over the snapshots of |V(t)/V(0) - 1| (the lid's impulsive start
+ *    compresses the fluid by a few 1e-3 for about a second: a sound wave, not a drift).
+ *  - information: the Reynolds number, V at the end over the box area L^2, mean and max rho/rho0
+ *    at the end, the mean u/U of the particles within dx of the lid in its middle half at the end. */
+int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    if (fluid_need(d, LAHAR_PFIELD_VELOCITY, "lid_driven_cavity", r))
+        return -1;
+    lahar_check_particles *p = d->particles;
+    if (!(p->fields & LAHAR_PFIELD_DENSITY)) {
+        snprintf(r->err, sizeof r->err, "lid_driven_cavity: particles.h5 lacks the density; add density to output: fields");
+        return -1;
+    }
+    const double dx = fluid_dx(c, d), rho0 = c->sph_density, mu = c->sph.mu;
+    int lid = -1;
+    for (int j = 0; j < c->nbody && lid < 0; j++)
+        if (c->bodies[j].motion == LAHAR_MOTION_PRESCRIBED && v3_norm(v3_load(c->bodies[j].v)) > 0.0)
+            lid = j;
+    if (c->dim != 2 || lid < 0 || !(dx > 0.0) || !(mu > 0.0) || c->sph.initial_pressure != LAHAR_SPH_INITIAL_PRESSURE_NONE) {
+        snprintf(r->err, sizeof r->err,
+                 "lid_driven_cavity: needs a 2D case with a moving prescribed body (the lid), sph.viscosity > 0 and "
+                 "no hydrostatic start");
+        return -1;
+    }
+    const double *lv = c->bodies[lid].v, U = fabs(lv[0]);
+    if (!(lv[0] > 0.0) || fabs(lv[1]) > 1e-9 * U) {
+        snprintf(r->err, sizeof r->err, "lid_driven_cavity: the lid '%s' must move along +x (velocity %g, %g)",
+                 c->bodies[lid].name, lv[0], lv[1]);
+        return -1;
+    }
+    if (fluid_read(d, 0, r))
+        return -1;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        x0 = fmin(x0, p->x[i]), x1 = fmax(x1, p->x[i]);
+        y0 = fmin(y0, p->y[i]), y1 = fmax(y1, p->y[i]);
+    }
+    x0 -= 0.5 * dx, x1 += 0.5 * dx, y0 -= 0.5 * dx, y1 += 0.5 * dx;
+    const double L = x1 - x0, Re = rho0 * U * L / mu;
+    if (!(fabs(y1 - y0 - L) < dx) || !(c->bodies[lid].x[1] > y1)) {
+        snprintf(r->err, sizeof r->err,
+                 "lid_driven_cavity: the fluid must fill a square (%g x %g m) under the lid '%s'", L, y1 - y0,
+                 c->bodies[lid].name);
+        return -1;
+    }
+    if (fabs(Re - 100.0) > 1.0) {
+        snprintf(r->err, sizeof r->err,
+                 "lid_driven_cavity: Ghia et al.'s tables here are for Re = 100; rho U L / mu = %g (U = %g m/s, L = "
+                 "%g m)",
+                 Re, U, L);
+        return -1;
+    }
+    /* sample points: Ghia's (u then v), then the plotted profiles (u then v) */
+    enum { NPT = GHIA_NU + GHIA_NV + 2 * CAVITY_NPROF };
+    double px[NPT], py[NPT], su[NPT], sw[NPT];
+    int np = 0;
+    for (int k = 0; k < GHIA_NU; k++, np++)
+        px[np] = x0 + 0.5 * L, py[np] = y0 + ghia_y[k] * L;
+    for (int k = 0; k < GHIA_NV; k++, np++)
+        px[np] = x0 + ghia_x[k] * L, py[np] = y0 + 0.5 * L;
+    for (int k = 0; k < 2 * CAVITY_NPROF; k++, np++) {
+        double s = (0.5 * dx + (L - dx) * (k % CAVITY_NPROF) / (CAVITY_NPROF - 1.0));
+        px[np] = k < CAVITY_NPROF ? x0 + 0.5 * L : x0 + s;
+        py[np] = k < CAVITY_NPROF ? y0 + s : y0 + 0.5 * L;
+    }
+    for (int k = 0; k < NPT; k++)
+        su[k] = sw[k] = 0.0;
+    const double m = rho0 * dx * dx, R2 = 4.0 * dx * dx;
+    const double tfirst = p->t[0], tlast = p->t[p->nsnap - 1], twin = tlast - 0.1 * (tlast - tfirst);
+    double V0 = NAN, V = NAN, dev = 0.0, Vwin = 0.0, rho_mean = NAN, rho_max = NAN, ulid = NAN;
+    int nwin = 0;
+    int pv = lahar_check_panel(r, "total volume sum m/rho over the box area L^2", "t [s]", "V / L^2");
+    lahar_check_curve(r, pv, 1, "lahar");
+    for (int64_t k = 0; k < p->nsnap; k++) {
+        if (fluid_read(d, k, r))
+            return -1;
+        double s = 0.0, sr = 0.0, rmax = 0.0, sl = 0.0;
+        int nl = 0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            s += m / p->density[i];
+            sr += p->density[i];
+            rmax = fmax(rmax, p->density[i]);
+            if (p->y[i] > y1 - dx && fabs(p->x[i] - x0 - 0.5 * L) < 0.25 * L)
+                sl += p->vx[i], nl++;
+        }
+        V = s;
+        if (k == 0)
+            V0 = V;
+        dev = fmax(dev, fabs(V / V0 - 1.0));
+        rho_mean = sr / (double)(p->cur_n ? p->cur_n : 1) / rho0;
+        rho_max = rmax / rho0;
+        ulid = nl ? sl / nl / U : NAN;
+        lahar_check_point(r, p->t[k], V / (L * L));
+        if (p->t[k] < twin)
+            continue;
+        nwin++;
+        Vwin += V;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            for (int q = 0; q < NPT; q++) {
+                const double ddx = p->x[i] - px[q], ddy = p->y[i] - py[q], r2 = ddx * ddx + ddy * ddy;
+                if (r2 >= R2)
+                    continue;
+                const double w = exp(-r2 / (dx * dx));
+                su[q] += w * (q < GHIA_NU || (q >= GHIA_NU + GHIA_NV && q < GHIA_NU + GHIA_NV + CAVITY_NPROF)
+                                  ? p->vx[i]
+                                  : p->vy[i]);
+                sw[q] += w;
+            }
+    }
+    double val[NPT];
+    for (int q = 0; q < NPT; q++)
+        val[q] = sw[q] > 0.0 ? su[q] / sw[q] / U : NAN;
+    double umax = 0.0, u2 = 0.0, vmax = 0.0, v2 = 0.0;
+    for (int k = 0; k < GHIA_NU; k++) {
+        double e = fabs(val[k] - ghia_u[k]);
+        umax = fmax(umax, e), u2 += e * e;
+    }
+    for (int k = 0; k < GHIA_NV; k++) {
+        double e = fabs(val[GHIA_NU + k] - ghia_v[k]);
+        vmax = fmax(vmax, e), v2 += e * e;
+    }
+    if (!isfinite(umax + vmax)) {
+        snprintf(r->err, sizeof r->err, "lid_driven_cavity: a centreline point has no particle within 2 dx");
+        return -1;
+    }
+    int pu = lahar_check_panel(r, "u / U along the vertical centreline x = L/2", "u / U", "y / L");
+    lahar_check_curve(r, pu, 0, "Ghia, Ghia & Shin 1982, Table I (Re = 100)");
+    for (int k = 0; k < GHIA_NU; k++)
+        lahar_check_point(r, ghia_u[k], ghia_y[k]);
+    lahar_check_curve(r, pu, 1, "lahar (late-window mean)");
+    for (int k = 0; k < CAVITY_NPROF; k++)
+        lahar_check_point(r, val[GHIA_NU + GHIA_NV + k], (py[GHIA_NU + GHIA_NV + k] - y0) / L);
+    int pw = lahar_check_panel(r, "v / U along the horizontal centreline y = L/2", "x / L", "v / U");
+    lahar_check_curve(r, pw, 0, "Ghia, Ghia & Shin 1982, Table II (Re = 100)");
+    for (int k = 0; k < GHIA_NV; k++)
+        lahar_check_point(r, ghia_x[k], ghia_v[k]);
+    lahar_check_curve(r, pw, 1, "lahar (late-window mean)");
+    for (int k = 0; k < CAVITY_NPROF; k++)
+        lahar_check_point(r, (px[GHIA_NU + GHIA_NV + CAVITY_NPROF + k] - x0) / L,
+                          val[GHIA_NU + GHIA_NV + CAVITY_NPROF + k]);
+    lahar_check_value(r, "u_max_error", umax);
+    lahar_check_value(r, "v_max_error", vmax);
+    lahar_check_value(r, "u_l2_error", sqrt(u2 / GHIA_NU));
+    lahar_check_value(r, "v_l2_error", sqrt(v2 / GHIA_NV));
+    lahar_check_value(r, "volume_drift", fabs(Vwin / nwin / V0 - 1.0));
+    lahar_check_value(r, "volume_deviation_max", dev);
+    lahar_check_value(r, "volume_end_over_box", V / (L * L));
+    lahar_check_value(r, "density_mean_end", rho_mean);
+    lahar_check_value(r, "density_max_end", rho_max);
+    lahar_check_value(r, "u_under_lid_end", ulid);
+    lahar_check_value(r, "reynolds", Re);
+    lahar_check_value(r, "window_snapshots", nwin);
+    snprintf(r->convention, sizeof r->convention,
+             "errors in units of the lid speed U at Ghia et al.'s interior points (docs/reference/"
+             "ghia_1982_re100.txt); volume V = sum rho0 dx^2 / rho_i");
+    snprintf(r->note, sizeof r->note,
+             "lid %s at U = %g m/s, L = %g m, Re = %.4g; profiles: Shepard mean (weight exp(-(r/dx)^2), r < 2 dx) "
+             "over %d late-window snapshots",
+             c->bodies[lid].name, U, L, Re, nwin);
+    snprintf(r->title, sizeof r->title, "lid_driven_cavity: Re = %.4g, max |u - u_Ghia| = %.3g U, max |v - v_Ghia| = %.3g U",
+             Re, umax, vmax);
+    return 0;
+}

@@ -127,6 +127,8 @@ typedef struct {
                                               cfl h / c0 (acoustic: independent of the step) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
+    int shifting_density;  /* 1: the shift changes the density as the continuity equation would (keeps
+                              the total volume of a closed box); default 0 (sph_node/sph_fluid.c) */
 } lahar_sph_options;
 
 /* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).

@@ -31,6 +31,7 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     memcpy(m->hi, o->hi, sizeof m->hi);
     m->shepard_interval = o->shepard_interval;
     m->shifting = o->shifting;
+    m->shifting_density = (int8_t)(o->shifting_density != 0);
     m->sps = (int8_t)(o->sps != 0);
     m->sps_cs = o->sps_cs;
     m->halo = o->halo;
@@ -61,6 +62,7 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     memcpy(o->hi, m->hi, sizeof o->hi);
     o->shepard_interval = m->shepard_interval;
     o->shifting = m->shifting;
+    o->shifting_density = m->shifting_density != 0;
     o->sps = m->sps != 0;
     o->sps_cs = m->sps_cs;
     o->halo = m->halo;

@@ -77,6 +77,7 @@ typedef struct {
                                (sph_coupling.kn_dt); 0 (default): the step's dt as printed */
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
+    int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */

@@ -175,6 +175,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
+    prm->shifting_density = o->shifting_density;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
     for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */

@@ -5,6 +5,7 @@
  *     (eq. 20) and the torque (x_s - x_b) x (-F) (eq. 21);
  *  2. a particle sliding along the plate outside the halo: only the viscous force
  *     m (2 mu/rho) G(d) u_rel, opposed to the motion; none beyond the kernel support;
+ *  2b. ghost walls: no continuity rate at the corner of a sliding lid for a particle at rest;
  *  3. a rotating, translating free disc: u_rel = u - v - w x (x_s - x_b) (eq. 16), torque R F_t;
  *  4. crossings: a particle inside the sweep or deep inside the core is counted and named, and the
  *     normal force pushes it out; 3D box: face and edge normals;
@@ -105,6 +106,44 @@ int main(void)
         x[1] = support * 1.0001;
         one_particle(&f, 2, x, v, 1, &plate);
         CHECK(f.cpl.ncontacts == 0 && f.p.ax[0] == 0.0, "force beyond the kernel support");
+        sph_fluid_free(&f);
+    }
+    /* 2b. ghost walls at a corner: the plate slides along +x (a lid) into a fixed wall at x = 0.
+     * A particle at rest in the corner moves along neither wall's normal relative to that wall, so
+     * the walls' continuity rates must give it nothing; the corner correction once took the
+     * plate's velocity along the side wall's normal (a source: a closed box lost volume). */
+    {
+        lahar_body walls[2];
+        plate2d(&walls[0]);
+        walls[0].motion = LAHAR_MOTION_PRESCRIBED;
+        walls[0].v[0] = 0.5;
+        walls[0].mass = 1e6;
+        walls[0].inertia[2] = 1.0;
+        memset(&walls[1], 0, sizeof walls[1]);
+        double half[2] = {0.02, 1.0}, R = 0.01, t[3] = {-0.03, 0.0, 0.0}; /* swept face at x = 0 */
+        lahar_shape_make_box2d(&walls[1].shape, half, R);
+        lahar_shape_transform(&walls[1].shape, NULL, t, 1.0);
+        walls[1].motion = LAHAR_MOTION_FIXED;
+        walls[1].convex = 1;
+        walls[1].q[0] = 1.0;
+        sph_params prm = {0};
+        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.c0 = 10, prm.mu = MU;
+        prm.wall_pressure = SPH_WALL_PRESSURE_GHOST;
+        char err[256];
+        if (sph_fluid_init(&f, &prm, 4, err, sizeof err) != 0)
+            abort();
+        double x[3] = {0.7 * DX, 0.7 * DX, 0}, v[3] = {0, 0, 0};
+        sph_particles_add(&f.p, x, v, m2, RHO, 0);
+        if (sph_fluid_attach_bodies(&f, 2, walls) != 0)
+            abort();
+        sph_cells_sort(&f.cells, &f.p);
+        sph_fluid_rates(&f, NULL, DT);
+        /* scale: the rate one wall's ghosts give a particle approaching it at the lid's speed */
+        const double scale = RHO * 0.5 / DX;
+        CHECK(f.cpl.ncontacts == 2 && fabs(f.p.drho[0]) < 1e-12 * scale,
+              "corner of a sliding lid and a fixed wall: continuity rate %.3e kg/m^3/s for a particle at rest (0; "
+              "scale %.3g)", f.p.drho[0], scale);
+        printf("ghost corner of a sliding lid: continuity rate of a particle at rest %.1e kg/m^3/s\n", f.p.drho[0]);
         sph_fluid_free(&f);
     }
     /* 3. rotating, translating free disc */
