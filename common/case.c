@@ -1643,7 +1643,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "shifting", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "soil_wall_stress", "shifting", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1695,6 +1695,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                                                 LAHAR_SPH_INITIAL_PRESSURE_NONE);
     o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(&m, "wall_pressure", wall_pressure_names, 0,
                                                           LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(&m, "soil_wall_stress", wall_pressure_names, 0,
+                                                             LAHAR_SPH_WALL_PRESSURE_PENALTY);
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);

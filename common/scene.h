@@ -121,6 +121,9 @@ typedef struct {
                                                    hydrostatic per block (lahar_sph_node_fill) */
     lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, paper 000
                                               eq. 15) or ghost layers (sph_node/sph_coupling.h) */
+    lahar_sph_wall_pressure soil_wall_stress; /* the soil's wall term: penalty + friction spring only
+                                                 (default, paper 000 eq. 15, 22-27) or ghost layers
+                                                 carrying the soil stress (sph_node/sph_coupling.h) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
 } lahar_sph_options;

@@ -73,6 +73,7 @@ typedef struct {
     double lo[3], hi[3];
     sph_wall_viscous wall_viscous;
     sph_wall_pressure wall_pressure; /* default penalty only (paper 000 eq. 15); sph_coupling.h */
+    sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */

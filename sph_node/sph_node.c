@@ -171,6 +171,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
     prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
                                                                             : SPH_WALL_PRESSURE_PENALTY;
+    prm->soil_wall_stress = o->soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
+                                                                                  : SPH_WALL_PRESSURE_PENALTY;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->sps = o->sps;
