@@ -347,14 +347,14 @@ static vec3 ghost_soil_accel(const sph_coupling *c, const double si[SPH_NSTRESS]
         K[v] = (1 - fi) * ((1 - fj) * t00[v] + fj * t01[v]) + fi * ((1 - fj) * t10[v] + fj * t11[v]);
     for (int a = 0; a < SPH_NSTRESS; a++)
         S[a] = si[a] + sbar[a];
-    /* S.A with A = K0 n + K1 e and the shear across the wall (S_nt) taken out */
-    vec3 sn = sym_mul(S, n), se = sym_mul(S, e);
-    double s_nn = v3_dot(n, sn);
-    vec3 se_t = v3_axpy(-v3_dot(n, se), n, se);
-    vec3 sa = v3_axpy(K[1], se_t, v3_scale(n, K[0] * s_nn));
-    double gn = v3_dot(g, n), ge = v3_dot(g, e);
-    vec3 bg = v3_axpy(K[3] * gn + K[4] * ge, e, v3_scale(n, K[2] * gn + K[3] * ge));
-    return v3_axpy(-1.0 / rho, sa, bg);
+    /* the push along n only: -(S.A)_n / rho + (B g)_n with A = K0 n + K1 e and the shear across the
+     * wall (S_ne) taken out. The part along the wall, -K1 S_ee / rho + (B g)_e, is left out: on a
+     * full flat wall it vanishes (K1 = K3 = 0), and where the ghosts are cut (a side wall, cut
+     * where the normal stress reaches 0) it would take the soil's vertical stress S_ee, which
+     * does not vanish there, against a one-sided ghost region: a spurious push along the wall
+     * that made a collapsing column unstable. */
+    double s_nn = v3_dot(n, sym_mul(S, n)), gn = v3_dot(g, n), ge = v3_dot(g, e);
+    return v3_scale(n, -K[0] * s_nn / rho + K[2] * gn + K[3] * ge);
 }
 
 /* The corner correction: half of wall a's ghosts behind the perpendicular wall b (corner table),

@@ -57,3 +57,17 @@ add_test(NAME soil_darcy_column_2d
           ${CMAKE_CURRENT_BINARY_DIR}/soil/darcy_column_2d)
 set_tests_properties(soil_darcy_column_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Dry-sand column collapses (phi = 30 deg) against the run-out scalings of Lube et al. (2005) and
+# Lajeunesse et al. (2005) (docs/soil/column_collapse_scalings.md): the mass run-out L_99 inside
+# the band of the two experiments at a = 1 and a = 2, the deposit at rest (E_k end / peak < 0.01),
+# no particle through the floor or wall, the surface at or below phi. dx = 10 mm (the cases' 5 mm
+# and the 2.5 mm sweep in cases/README.md); about 5 s and 10 s on 1 thread.
+add_test(NAME soil_granular_column_a1_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_column_a1_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_column_a1_2d dx=0.01)
+add_test(NAME soil_granular_column_a2_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_column_a2_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_column_a2_2d dx=0.01)
+set_tests_properties(soil_granular_column_a1_2d soil_granular_column_a2_2d PROPERTIES LABELS "validation;slow;soil"
+  TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
