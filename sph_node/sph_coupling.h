@@ -191,8 +191,10 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  * (Shepard mean over i and its soil neighbours, carried to x_i with the weight term; g the soil's
  * gravity). 000 eq. 5 summed over the ghosts (m_g = rho_i V_g, rho_g = rho_i) then reads
  *   a = -(sigma_i + sigmabar_i) . A / rho_i + B g    (A, B the tables of the water's ghosts)
- * with the shear across the wall, (sigma_i + sigmabar_i)_nt, set to zero (free slip: the ghosts
- * push along n only on a flat wall; the wall friction stays with the spring of eq. 22-27, whose
+ * with the shear across the wall, (sigma_i + sigmabar_i)_nt, set to zero, and only the component
+ * along n kept (free slip: on a full flat wall the rest vanishes; where the ghosts are cut, along
+ * a side wall, it would push along the wall with the soil's vertical stress, which does not
+ * vanish where the normal stress does). The wall friction stays with the spring of eq. 22-27, whose
  * cap mu_phi |F_n| then takes F_n = the penalty force plus the ghosts' push along n, and which
  * acts while that total is > 0). Ghosts stand where the extrapolated normal stress is
  * compressive (the water's cut with p = -sigmabar_nn). Without them, the one-sided kernel of the
@@ -200,7 +202,10 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  * soil row resting on a DEM floor reads ~20 % high in sigma_v (cases/soil_geostatic_2d.yaml).
  * The soil's continuity and velocity gradient take no ghost terms (in a layer at rest the stress
  * is set by equilibrium, i.e. by the divergence), and the concave-corner correction of the water
- * is not applied to the soil. Returns 0 or -1 (out of memory). */
+ * is not applied to the soil. Limitation: for soil at rest only. A collapsing column
+ * (cases/granular_column_a1_2d.yaml with it) blows up within 0.1 s: the ghosts stand under the
+ * whole floor within the support, also beside the soil's toe, where their Shepard stress (from the
+ * column) pushes the toe particles up and out. Returns 0 or -1 (out of memory). */
 int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx);
 
 /* Before sph_coupling_apply, with the cells sorted for the particles' current positions: marks,
