@@ -207,7 +207,9 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  * first particle thrown out is at the toe (x = 0.097 m, 0.41 m/s up after 0.02 s), then stresses
  * of -40 kPa (10 x the column's weight) appear inside. The cause is not established; suspected:
  * the ghosts stand under the whole floor within the support, also beside the toe, with the
- * Shepard stress of the column. Leaving the friction cap without the ghosts' push does not help.
+ * Shepard stress of the column. Not the cure (each tried at dx 10 mm, still unstable): the
+ * friction cap without the ghosts' push; 2 sigmabar instead of sigma_i + sigmabar (no own-stress
+ * feedback); ghosts on the floor only (none on the side wall).
  * Returns 0 or -1 (out of memory). */
 int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx);
 
