@@ -1646,7 +1646,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "shifting", "shifting_density", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "soil_wall_stress", "shifting", "shifting_density", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1702,6 +1702,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                                           LAHAR_SPH_WALL_PRESSURE_PENALTY);
     o->penalty_stiffness = (lahar_sph_penalty_stiffness)rmap_enum(&m, "penalty_stiffness", penalty_stiffness_names, 0,
                                                                   LAHAR_SPH_PENALTY_STEP);
+    o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(&m, "soil_wall_stress", wall_pressure_names, 0,
+                                                             LAHAR_SPH_WALL_PRESSURE_PENALTY);
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);

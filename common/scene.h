@@ -125,6 +125,9 @@ typedef struct {
     lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of paper 000 eq. 15 with the
                                               step's dt (step, default) or the acoustic step
                                               cfl h / c0 (acoustic: independent of the step) */
+    lahar_sph_wall_pressure soil_wall_stress; /* the soil's wall term: penalty + friction spring only
+                                                 (default, paper 000 eq. 15, 22-27) or ghost layers
+                                                 carrying the soil stress (sph_node/sph_coupling.h) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
     int shifting_density;  /* 1: the shift changes the density as the continuity equation would (keeps

@@ -40,6 +40,7 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     m->initial_pressure = (int8_t)o->initial_pressure;
     m->wall_pressure = (int8_t)o->wall_pressure;
     m->penalty_stiffness = (int8_t)o->penalty_stiffness;
+    m->soil_wall_stress = (int8_t)o->soil_wall_stress;
 }
 
 static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *o)
@@ -71,6 +72,7 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     o->initial_pressure = (lahar_sph_initial_pressure)m->initial_pressure;
     o->wall_pressure = (lahar_sph_wall_pressure)m->wall_pressure;
     o->penalty_stiffness = (lahar_sph_penalty_stiffness)m->penalty_stiffness;
+    o->soil_wall_stress = (lahar_sph_wall_pressure)m->soil_wall_stress;
 }
 
 int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,

@@ -151,12 +151,10 @@ static void ghost_corner_column(const kernel *k, int dim, double da, double db, 
     }
 }
 
-int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx)
+/* The ghost tables (wall and corner), once, for the water's or the soil's ghosts. */
+static int ghost_tables(sph_coupling *c, double dx)
 {
-    c->pressure = mode;
-    for (int a = 0; a < 3; a++)
-        c->body_force[a] = body_force[a];
-    if (mode != SPH_WALL_PRESSURE_GHOST || c->wtab)
+    if (c->wtab)
         return 0;
     const int nd = SPH_COUPLING_WTAB + 1, nq = SPH_COUPLING_QTAB + 1, nzw = 2 * GHOST_NT + 1;
     const int nzq = c->dim == 3 ? 2 * GHOST_NZ + 1 : 2;
@@ -165,7 +163,6 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
     if (!c->wtab || !c->qtab) {
         free(c->wtab), free(c->qtab);
         c->wtab = c->qtab = NULL;
-        c->pressure = SPH_WALL_PRESSURE_PENALTY;
         return -1;
     }
     c->wtab_dd = (c->k.support - c->gtab_d0) / SPH_COUPLING_WTAB;
@@ -176,6 +173,34 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
         for (int j = 0; j < nq; j++)
             ghost_corner_column(&c->k, c->dim, c->gtab_d0 + i * c->qtab_dd, c->gtab_d0 + j * c->qtab_dd, dx,
                                 c->qtab + ((size_t)i * nq + j) * nzq * 9);
+    return 0;
+}
+
+int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx)
+{
+    c->pressure = mode;
+    for (int a = 0; a < 3; a++)
+        c->body_force[a] = body_force[a];
+    if (mode != SPH_WALL_PRESSURE_GHOST)
+        return 0;
+    if (ghost_tables(c, dx) != 0) {
+        c->pressure = SPH_WALL_PRESSURE_PENALTY;
+        return -1;
+    }
+    return 0;
+}
+
+int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx)
+{
+    c->soil_pressure = mode;
+    for (int a = 0; a < 3; a++)
+        c->soil_g[a] = gravity[a];
+    if (mode != SPH_WALL_PRESSURE_GHOST)
+        return 0;
+    if (ghost_tables(c, dx) != 0) {
+        c->soil_pressure = SPH_WALL_PRESSURE_PENALTY;
+        return -1;
+    }
     return 0;
 }
 
@@ -262,6 +287,74 @@ static double ghost_pbar(const sph_coupling *c, const sph_particles *p, int64_t 
         den += w;
     });
     return num / den;
+}
+
+/* The soil ghosts' reference stress for soil particle i (sph_coupling_set_soil_wall): the Shepard
+ * mean over i and its soil neighbours of sigma_j - rho_j g.(x_i - x_j) I (tension positive, so the
+ * water's p_j + rho_j b.x_ij with p = -sigma). */
+static void ghost_soil_sigbar(const sph_coupling *c, const sph_particles *p, int64_t i, double out[SPH_NSTRESS])
+{
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        out[a] = p->sig[a][i];
+    if (!c->cells)
+        return;
+    const kernel *k = &c->k;
+    const double s2 = k->support * k->support, gx = c->soil_g[0], gy = c->soil_g[1], gz = c->soil_g[2];
+    double vw = p->m[i] / p->rho[i] * kernel_w(k, 0.0), den = vw, num[SPH_NSTRESS];
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        num[a] = vw * p->sig[a][i];
+    SPH_FOR_EACH_NEIGHBOUR(c->cells, p, i, p->x[i], p->y[i], p->z[i], s2, {
+        if (p->phase[j] == 0)
+            continue;
+        double w = p->m[j] / p->rho[j] * kernel_w(k, sqrt(r2)), dg = p->rho[j] * (gx * rx + gy * ry + gz * rz);
+        for (int a = 0; a < SPH_NSTRESS; a++)
+            num[a] += w * p->sig[a][j];
+        num[0] -= w * dg, num[3] -= w * dg, num[5] -= w * dg; /* xx, yy, zz */
+        den += w;
+    });
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        out[a] = num[a] / den;
+}
+
+/* sigma (xx, xy, xz, yy, yz, zz) times the vector u. */
+static vec3 sym_mul(const double s[SPH_NSTRESS], vec3 u)
+{
+    return v3(s[0] * u.x + s[1] * u.y + s[2] * u.z, s[1] * u.x + s[3] * u.y + s[4] * u.z,
+              s[2] * u.x + s[4] * u.y + s[5] * u.z);
+}
+
+/* The soil ghosts' acceleration (sph_coupling_set_soil_wall) on a soil particle of stress si,
+ * reference stress sbar and density rho at distance d from a flat wall of normal n. */
+static vec3 ghost_soil_accel(const sph_coupling *c, const double si[SPH_NSTRESS], const double sbar[SPH_NSTRESS],
+                             double rho, double d, vec3 n)
+{
+    const int nzw = 2 * GHOST_NT + 1;
+    int i, j;
+    double fi, fj, K[5], S[SPH_NSTRESS];
+    if (!ghost_grid(d, c->gtab_d0, c->wtab_dd, SPH_COUPLING_WTAB, &i, &fi))
+        return v3(0, 0, 0);
+    vec3 g = v3_load(c->soil_g), gt = v3_axpy(-v3_dot(g, n), n, g), e = v3(0, 0, 0);
+    double gmag = v3_norm(gt), zeta = 2.0 * c->k.support;
+    double snn = v3_dot(n, sym_mul(sbar, n));
+    if (gmag > 1e-9 * v3_norm(g)) { /* the cut where the ghosts' normal stress reaches 0 (ghost_cut) */
+        e = v3_scale(gt, -1.0 / gmag);
+        zeta = -snn / (rho * gmag);
+    }
+    ghost_cut_grid(zeta, c->k.support, GHOST_NT, &j, &fj);
+    const double *t00 = c->wtab + ((size_t)i * nzw + j) * 5, *t01 = t00 + 5, *t10 = t00 + (size_t)nzw * 5,
+                 *t11 = t10 + 5;
+    for (int v = 0; v < 5; v++)
+        K[v] = (1 - fi) * ((1 - fj) * t00[v] + fj * t01[v]) + fi * ((1 - fj) * t10[v] + fj * t11[v]);
+    for (int a = 0; a < SPH_NSTRESS; a++)
+        S[a] = si[a] + sbar[a];
+    /* the push along n only: -(S.A)_n / rho + (B g)_n with A = K0 n + K1 e and the shear across the
+     * wall (S_ne) taken out. The part along the wall, -K1 S_ee / rho + (B g)_e, is left out: on a
+     * full flat wall it vanishes (K1 = K3 = 0), and where the ghosts are cut (a side wall, cut
+     * where the normal stress reaches 0) it would take the soil's vertical stress S_ee, which
+     * does not vanish there, against a one-sided ghost region: a spurious push along the wall
+     * that made a collapsing column unstable. */
+    double s_nn = v3_dot(n, sym_mul(S, n)), gn = v3_dot(g, n), ge = v3_dot(g, e);
+    return v3_scale(n, -K[0] * s_nn / rho + K[2] * gn + K[3] * ge);
 }
 
 /* The corner correction: half of wall a's ghosts behind the perpendicular wall b (corner table),
@@ -588,6 +681,8 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
         vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
         double gd[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
+        double sbar[SPH_NSTRESS] = {0.0}, sown[SPH_NSTRESS] = {0.0}; /* soil ghosts (sph_coupling_set_soil_wall) */
+        int have_sbar = 0;
         vec3 gu[SPH_COUPLING_MAX_PER_PARTICLE];
         const uint32_t near = near_valid ? c->near[i] : ~0u;
         for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
@@ -680,11 +775,26 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                            kernel_dwdr(&c->k, dv) / w0;
                 /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
                 vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
-                if (soil && delta > 0.0) {
-                    ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, kn * delta, kn, dt, hist_d[nh]);
+                /* soil ghost stress (sph_coupling_set_soil_wall): its push along n joins F_n of
+                 * the friction cap */
+                vec3 fg = v3(0, 0, 0);
+                double fgn = 0.0;
+                if (p->phase[i] != 0 && c->soil_pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->sig[0]) {
+                    if (!have_sbar) {
+                        ghost_soil_sigbar(c, p, i, sbar);
+                        for (int a = 0; a < SPH_NSTRESS; a++)
+                            sown[a] = p->sig[a][i];
+                        have_sbar = 1;
+                    }
+                    fg = v3_scale(ghost_soil_accel(c, sown, sbar, p->rho[i], dv, nrm), p->m[i]);
+                    fgn = fmax(v3_dot(fg, nrm), 0.0);
+                }
+                const double fn_tot = (delta > 0.0 ? kn * delta : 0.0) + fgn;
+                if (soil && fn_tot > 0.0) {
+                    ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, fn_tot, kn, dt, hist_d[nh]);
                     hist_b[nh++] = b;
                 }
-                vec3 f = v3_add(fn, ft);
+                vec3 f = v3_add(v3_add(fn, ft), fg);
                 gd[ns] = -1.0;
                 if (c->pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
                     double drw;

@@ -118,6 +118,15 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
         sph_coupling_free(&f->cpl);
         return -1;
     }
+    if (f->has_soil) { /* the soil's ghost stress extrapolates with its gravity (the case's) */
+        double gs[3];
+        for (int a = 0; a < 3; a++)
+            gs[a] = f->prm.periodic[a] ? 0.0 : f->prm.soil_mat.gravity[a];
+        if (sph_coupling_set_soil_wall(&f->cpl, f->prm.soil_wall_stress, gs, f->prm.dx) != 0) {
+            sph_coupling_free(&f->cpl);
+            return -1;
+        }
+    }
     f->has_bodies = 1;
     f->primed = 0;
     return 0;

@@ -75,6 +75,7 @@ typedef struct {
     sph_wall_pressure wall_pressure; /* default penalty only (paper 000 eq. 15); sph_coupling.h */
     int penalty_acoustic;   /* 1: K_n of eq. 15 with the acoustic step cfl h / c0, not the step's dt
                                (sph_coupling.kn_dt); 0 (default): the step's dt as printed */
+    sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
     int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */

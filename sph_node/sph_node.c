@@ -173,6 +173,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
                                                                             : SPH_WALL_PRESSURE_PENALTY;
     prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
+    prm->soil_wall_stress = o->soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
+                                                                                  : SPH_WALL_PRESSURE_PENALTY;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;

@@ -61,6 +61,7 @@ static void test_linear_2d(const char *dir)
                                     "  c0: 20\n"
                                     "  initial_pressure: hydrostatic\n"
                                     "  wall_pressure: ghost\n"
+                                    "  soil_wall_stress: ghost\n"
                                     "  blocks:\n"
                                     "    - {name: water, box: {lo: [0, 0], hi: [0.4, 0.2]}}\n";
     lahar_case c;
@@ -97,6 +98,10 @@ static void test_linear_2d(const char *dir)
     CHECK(c.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && back.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST,
           "wall_pressure not read or lost in the message");
     CHECK(prm.wall_pressure == SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
+    CHECK(c.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST &&
+              back.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST,
+          "soil_wall_stress not read or lost in the message");
+    CHECK(prm.soil_wall_stress == SPH_WALL_PRESSURE_GHOST, "soil_wall_stress not passed to the solver");
     lahar_scene_msg_release(&msg);
     lahar_case_free(&back);
     sph_particles_free(&p);
