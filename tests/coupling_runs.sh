@@ -182,52 +182,39 @@ node_killed)
 node_stopped)
     # SIGSTOP the DEM node mid-run: a node that is alive but hung (its CPU time does not advance)
     # is still lost after 2 s; only a silent node that keeps computing is waited for (starved by
-    # an overloaded machine). Exit 3, the node named, "hangs" in the reason.
+    # an overloaded machine). Exit 3, the node named, "hangs" in the reason. With --node-timeout 4
+    # the same hung node is lost after 4 s of silence, not 2.
     write_case long.yaml 30
-    "$bin/lahar" run long.yaml -o stopped -q 2> stderr.txt &
-    lahar_pid=$!
-    dem_pid=""
-    for _ in $(seq 100); do
-        dem_pid=$(child_pid "$lahar_pid" lahar-dem)
-        [ -n "$dem_pid" ] && [ -e stopped/bodies.h5 ] && break
-        sleep 0.05
-    done
-    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found"; }
-    sleep 0.5
-    kill -STOP "$dem_pid"
-    t0=$(date +%s.%N)
-    wait "$lahar_pid"
-    rc=$?
-    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
-    kill -9 "$dem_pid" 2>/dev/null
-    cat stderr.txt
-    echo "coordinator exited with $rc after ${elapsed} s"
+    stop_dem_run() { # out [lahar options]: run, SIGSTOP the DEM node, set rc and elapsed
+        local out=$1 dem_pid="" lahar_pid t0
+        shift
+        "$bin/lahar" run long.yaml -o "$out" -q "$@" 2> "$out.stderr" &
+        lahar_pid=$!
+        for _ in $(seq 100); do
+            dem_pid=$(child_pid "$lahar_pid" lahar-dem)
+            [ -n "$dem_pid" ] && [ -e "$out/bodies.h5" ] && break
+            sleep 0.05
+        done
+        [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found ($out)"; }
+        sleep 0.5
+        kill -STOP "$dem_pid"
+        t0=$(date +%s.%N)
+        wait "$lahar_pid"
+        rc=$?
+        elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+        kill -9 "$dem_pid" 2>/dev/null
+        cat "$out.stderr"
+        echo "$out: coordinator exited with $rc after ${elapsed} s"
+    }
+    stop_dem_run stopped
     [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
     "$python" -c "import sys; sys.exit(0 if $elapsed < 6.0 else 1)" || fail "took ${elapsed} s to notice (limit 6 s)"
-    grep -q "DEM node.*hangs" stderr.txt || fail "message does not name the DEM node as hung"
-    # --node-timeout 4: the same hung node is lost after 4 s of silence, not 2
-    "$bin/lahar" run long.yaml -o stopped4 -q --node-timeout 4 2> stderr4.txt &
-    lahar_pid=$!
-    dem_pid=""
-    for _ in $(seq 100); do
-        dem_pid=$(child_pid "$lahar_pid" lahar-dem)
-        [ -n "$dem_pid" ] && [ -e stopped4/bodies.h5 ] && break
-        sleep 0.05
-    done
-    [ -n "$dem_pid" ] || { kill -9 "$lahar_pid"; fail "no lahar-dem child found (--node-timeout 4)"; }
-    sleep 0.5
-    kill -STOP "$dem_pid"
-    t0=$(date +%s.%N)
-    wait "$lahar_pid"
-    rc=$?
-    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
-    kill -9 "$dem_pid" 2>/dev/null
-    cat stderr4.txt
-    echo "--node-timeout 4: coordinator exited with $rc after ${elapsed} s"
+    grep -q "DEM node.*hangs" stopped.stderr || fail "message does not name the DEM node as hung"
+    stop_dem_run stopped4 --node-timeout 4
     [ "$rc" -eq 3 ] || fail "--node-timeout 4: exit status $rc, expected 3"
     "$python" -c "import sys; sys.exit(0 if 4.0 <= $elapsed < 12.0 else 1)" ||
         fail "--node-timeout 4: lost after ${elapsed} s (want 4-12 s)"
-    grep -q "silent for 4.0 s" stderr4.txt || fail "--node-timeout 4: the message does not give the 4 s"
+    grep -q "silent for 4.0 s" stopped4.stderr || fail "--node-timeout 4: the message does not give the 4 s"
     ;;
 coordinator_killed)
     # A node started by hand (--no-spawn: no PR_SET_PDEATHSIG) gives up 5 s after the coordinator

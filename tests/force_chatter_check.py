@@ -36,7 +36,7 @@ def run(lahar, out, stiff):
           f"sph.penalty_stiffness={stiff}", "time.end=0.4", "time.dt_max=2e-5", "time.output_interval=0.4"]
     if case_override.main(["case_override.py", os.path.join(HERE, "..", "cases", "hydrostatic_2d.yaml"), yml] + ov):
         sys.exit(2)
-    r = subprocess.run([lahar, "run", yml, "-o", os.path.join(out, stiff), "--in-process", "--threads", "1", "-q"])
+    r = subprocess.run([lahar, "run", yml, "-o", os.path.join(out, stiff), "--in-process", "--threads", "1", "-q", "--overwrite"])
     if r.returncode != 0:
         print(f"force_chatter_check: lahar run {yml} exited {r.returncode}")
         sys.exit(1)

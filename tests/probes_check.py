@@ -62,7 +62,7 @@ def main():
         yml = os.path.join(a.out, f"tank_{tag}.yaml")
         if case_override.main(["case_override.py", case, yml] + ov) != 0:
             return 1
-        r = subprocess.run([a.lahar, "run", yml, "-o", os.path.join(a.out, tag), "--in-process", "--threads", "1", "-q"])
+        r = subprocess.run([a.lahar, "run", yml, "-o", os.path.join(a.out, tag), "--in-process", "--threads", "1", "-q", "--overwrite"])
         if r.returncode != 0:
             print(f"probes_check: lahar run {yml} exited {r.returncode}")
             return 1
@@ -115,7 +115,7 @@ def check_3d(a):
     ov = ["sph.dx=0.01", "time.end=0.1", "time.output_interval=0.1", f"probes={probes}"]
     if case_override.main(["case_override.py", os.path.join(HERE, "..", "cases", "hydrostatic_3d.yaml"), yml] + ov):
         return 1
-    r = subprocess.run([a.lahar, "run", yml, "-o", os.path.join(a.out, "run3d"), "--in-process", "--threads", "1", "-q"])
+    r = subprocess.run([a.lahar, "run", yml, "-o", os.path.join(a.out, "run3d"), "--in-process", "--threads", "1", "-q", "--overwrite"])
     if r.returncode != 0:
         print(f"probes_check: lahar run {yml} exited {r.returncode}")
         return 1
