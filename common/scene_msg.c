@@ -449,6 +449,10 @@ int lahar_node_send_status(lahar_link *l, int role, int64_t step, lahar_status_t
     st->run_id = lahar_link_run_id(l);
     st->step = step;
     st->role = role;
+    lahar_link_auth_stats as = {0};
+    lahar_link_auth(l, &as);
+    st->auth_rejected = (int64_t)as.frames_rejected;
+    st->auth_replayed = (int64_t)as.frames_replayed;
     snprintf((char *)st->message, sizeof st->message, "%s", message ? message : "");
     int rc;
     LAHAR_LINK_SEND(rc, l, LAHAR_FRAME_T_MSG_STATUS, lahar_status_t, step, st);

@@ -415,6 +415,8 @@ static void coord_take_work(coord_node *n, const lahar_status_t *s)
     n->work.work_particle_body = s->work_particle_body;
     n->work.work_body_body = s->work_body_body;
     n->work.work_output_derived = s->work_output_derived;
+    n->work.auth_rejected = s->auth_rejected;
+    n->work.auth_replayed = s->auth_replayed;
 }
 
 /* summary.json "work": what the run computed and sent, per kind (coordinator/README.md). Nodes
@@ -801,11 +803,19 @@ static void coord_write_summary(coord *co)
         }
     }
     cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
+    /* what the coordinator dropped plus what each node reported in its last STATUS */
     lahar_link_auth_stats as = {0};
     cJSON *auth = cJSON_AddObjectToObject(root, "auth");
     cJSON_AddBoolToObject(auth, "enabled", co->link && lahar_link_auth(co->link, &as));
-    cJSON_AddNumberToObject(auth, "frames_rejected", (double)as.frames_rejected);
-    cJSON_AddNumberToObject(auth, "frames_replayed", (double)as.frames_replayed);
+    double rejected = (double)as.frames_rejected, replayed = (double)as.frames_replayed;
+    cJSON_AddNumberToObject(auth, "coordinator_rejected", rejected);
+    cJSON_AddNumberToObject(auth, "coordinator_replayed", replayed);
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        rejected += (double)co->node[r].work.auth_rejected;
+        replayed += (double)co->node[r].work.auth_replayed;
+    }
+    cJSON_AddNumberToObject(auth, "frames_rejected", rejected);
+    cJSON_AddNumberToObject(auth, "frames_replayed", replayed);
     coord_summary_work(co, root);
     coord_summary_instability(co, root);
     char *text = cJSON_Print(root);

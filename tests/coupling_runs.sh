@@ -283,7 +283,8 @@ cross_host_auth)
     # small frame it hears altered, with its MAC zeroed, and verbatim: the run's bodies are
     # bitwise those of the in-process reference, and summary.json counts the rejected and the
     # replayed frames. Then a DEM node without the key cannot join the keyed run (exit 2).
-    reference
+    write_case case.yaml 2   # 2000 steps: the attack runs through most of the run
+    "$bin/lahar" run case.yaml -o ref --in-process -q || fail "in-process reference run failed"
     "$bin/lahar" keygen run.key > /dev/null || fail "lahar keygen failed"
     [ "$(stat -c %a run.key)" = 600 ] || fail "the key file is not mode 0600"
     hosts="
@@ -304,7 +305,7 @@ cross_host_auth)
         set -e
         $hosts
         nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --auth-key run.key & dem=\$!
-        '$LAHAR_ATTACK' '$URL_LINK' 4 > attack.txt & attacker=\$!
+        '$LAHAR_ATTACK' '$URL_LINK' 3 > attack.txt & attacker=\$!
         '$bin/lahar' run case.yaml -o auth -q --no-spawn --lcm-url '$URL_LINK' --auth-key run.key
         wait \$dem
         wait \$attacker" || fail "authenticated cross-host run failed"
@@ -313,7 +314,7 @@ cross_host_auth)
     [ "$(summary auth "s['auth']['enabled']")" = True ] || fail "summary.json: auth not enabled"
     rejected=$(summary auth "s['auth']['frames_rejected']")
     replayed=$(summary auth "s['auth']['frames_replayed']")
-    echo "coordinator dropped $rejected altered or forged frames and $replayed replayed ones"
+    echo "dropped (coordinator + nodes): $rejected altered or forged frames, $replayed replayed ones"
     [ "$rejected" -gt 0 ] && [ "$replayed" -gt 0 ] || fail "the hostile frames were not counted (rejected $rejected, replayed $replayed)"
     unshare --user --map-root-user --net bash -c "
         $hosts

@@ -1,6 +1,6 @@
 /* A hostile peer on a run's multicast group, for the authenticated-run test (coupling_runs.sh
  * cross_host_auth): for `seconds` it records the frames it hears on the LAHAR_* channels and,
- * 0.3 s after each, publishes three copies of it: altered (one byte of the header flipped,
+ * 0.05 s after each (when the run has taken it), publishes three copies of it: altered (one byte of the header flipped,
  * the MAC kept), forged (the MAC zeroed) and replayed (verbatim). An authenticating link must
  * drop all of them and count the first two as rejected and the third as replayed.
  * usage: lahar_attack URL SECONDS   (prints how many frames it sent of each kind) */
@@ -61,7 +61,7 @@ int main(int argc, char **argv)
     int next = 0;
     while (now() < end) {
         lcm_handle_timeout(lcm, 20);
-        while (next < nkept && now() - kept[next].t > 0.3) {
+        while (next < nkept && now() - kept[next].t > 0.05) {
             kept_frame *k = &kept[next++];
             unsigned char *copy = malloc((size_t)k->size);
             if (!copy)
