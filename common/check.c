@@ -737,6 +737,8 @@ static const lahar_check_reference check_references[] = {
      lahar_check_sinking_disc},
     {"dam_break", "collapsing water column: particle count conserved, no particle escapes, front monotonic",
      "escaped_particles", 0.0, lahar_check_dam_break},
+    {"taylor_green", "2D Taylor-Green vortex (periodic): kinetic-energy decay rate vs 16 pi^2 nu / L^2, velocity L2",
+     "energy_decay_rel_error", 0.01, lahar_check_taylor_green},
     {"soil_geostatic", "soil column at rest under gravity: sigma_v vs rho g z, sigma_h vs K0 sigma_v, no creep",
      "sigma_v_rel_error", 0.05, lahar_check_soil_geostatic},
     {"soil_slide", "soil block on a fixed floor under tilted gravity: sliding acceleration vs g (sin - mu_phi cos)",

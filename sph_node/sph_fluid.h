@@ -75,6 +75,8 @@ typedef struct {
     sph_wall_pressure wall_pressure; /* default penalty only (paper 000 eq. 15); sph_coupling.h */
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
+    double background_pressure; /* p_b, Pa (see "Background pressure" above), 0 = off */
+    int transport_velocity; /* 1: Adami et al. 2013 transport velocity (see above), 0 = off */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
@@ -103,6 +105,9 @@ typedef struct {
     /* per particle, in the sorted order of the last evaluation, filled with the EOS so that the
      * pair loop divides nothing per pair: p_i / rho_i^2 and the volume m_i / rho_i */
     double *prho2, *vol;
+    /* transport velocity only (NULL otherwise): the background-pressure acceleration b of the
+     * last evaluation, in its sorted order (sph_fluid.h "Transport velocity") */
+    double *tv_bx, *tv_by, *tv_bz;
     /* soil (prm.soil only; sph_soil.h): its passes run after the water pass, which then skips soil
      * particles and soil neighbours; sigma is integrated in the same leapfrog as v and rho */
     int has_soil;
