@@ -234,6 +234,10 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
     char path[1200];
     snprintf(path, sizeof path, "%s/bodies.h5", outdir);
     if (access(path, R_OK) != 0) {
+        char ppath[1200];
+        snprintf(ppath, sizeof ppath, "%s/particles.h5", outdir);
+        if (access(ppath, R_OK) == 0) /* a scene without bodies (and no DEM node) writes particles only */
+            goto particles;
         snprintf(err, n, "%s: missing (%s); did the run write output?", path, strerror(errno));
         return -1;
     }
@@ -294,6 +298,7 @@ int lahar_check_data_load(const char *outdir, lahar_check_data *d, char *err, si
         lahar_check_data_free(d);
         return -1;
     }
+particles:
     if (check_load_forces(outdir, d)) {
         snprintf(err, n, "%s/forces.h5: unreadable", outdir);
         lahar_check_data_free(d);
