@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <hdf5.h>
 #include <matheval.h>
 #include <yaml.h>
 
@@ -1432,9 +1433,82 @@ static void check_block_expr(reader *r, yaml_node_t *n, const char *key, const c
     snprintf(out, LAHAR_EXPR_MAX, "%s", s);
 }
 
-int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)[3], int64_t n, double (*v)[3],
-                             double *p, char *err, size_t errlen)
+/* The initial-field datasets of an HDF5 file (initial: {file: F.h5}). */
+static const char *const init_sets[4] = {"vx", "vy", "vz", "pressure"};
+
+/* Open file `path` and, for k = 0..3 (vx, vy, vz, pressure), read dataset init_sets[k] into
+ * out[k] (when out[k] is not NULL and the dataset exists) after checking it holds exactly n values;
+ * found[k] = 1 when present. 0, or -1 with a message naming the file and the dataset. */
+static int init_file_read(const char *path, int64_t n, double *out[4], int found[4], char *err, size_t errlen)
 {
+    H5E_auto2_t fn;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &fn, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int rc = 0;
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) {
+        snprintf(err, errlen, "%s: cannot open as HDF5", path);
+        rc = -1;
+    }
+    for (int k = 0; k < 4 && !rc; k++) {
+        found[k] = H5Lexists(f, init_sets[k], H5P_DEFAULT) > 0;
+        if (!found[k])
+            continue;
+        hid_t d = H5Dopen2(f, init_sets[k], H5P_DEFAULT), s = d >= 0 ? H5Dget_space(d) : -1;
+        hssize_t m = s >= 0 ? H5Sget_simple_extent_npoints(s) : -1;
+        if (d < 0 || s < 0 || m < 0 || H5Sget_simple_extent_ndims(s) != 1) {
+            snprintf(err, errlen, "%s: dataset '%s' is not a 1D array of numbers", path, init_sets[k]);
+            rc = -1;
+        } else if ((int64_t)m != n) {
+            snprintf(err, errlen, "%s: dataset '%s' has %lld values, the block has %lld particles (one value per "
+                     "particle, in lattice order)", path, init_sets[k], (long long)m, (long long)n);
+            rc = -1;
+        } else if (out[k] && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out[k]) < 0) {
+            snprintf(err, errlen, "%s: dataset '%s' cannot be read as numbers", path, init_sets[k]);
+            rc = -1;
+        }
+        if (s >= 0)
+            H5Sclose(s);
+        if (d >= 0)
+            H5Dclose(d);
+    }
+    if (f >= 0)
+        H5Fclose(f);
+    H5Eset_auto2(H5E_DEFAULT, fn, data);
+    return rc;
+}
+
+int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)[3], int64_t n, double (*v)[3],
+                             double *p, int *has_p, char *err, size_t errlen)
+{
+    *has_p = pb->pexpr[0] != 0;
+    if (pb->init_file[0]) { /* the loader has checked that no expression is given too */
+        double *buf = malloc((size_t)(n > 0 ? n : 1) * 4 * sizeof *buf);
+        if (!buf) {
+            snprintf(err, errlen, "block '%s': out of memory", pb->name);
+            return -1;
+        }
+        double *out[4] = {buf, buf + n, buf + 2 * n, buf + 3 * n};
+        int found[4] = {0, 0, 0, 0};
+        int rc = init_file_read(pb->init_file, n, out, found, err, errlen);
+        for (int64_t i = 0; i < n && !rc; i++) {
+            for (int a = 0; a < 3; a++)
+                v[i][a] = found[a] ? out[a][i] : pb->v[a];
+            if (found[3])
+                p[i] = out[3][i];
+            for (int k = 0; k < 4; k++)
+                if (found[k] && !isfinite(out[k][i])) {
+                    snprintf(err, errlen, "%s: dataset '%s' value %lld is not finite", pb->init_file, init_sets[k],
+                             (long long)i);
+                    rc = -1;
+                    break;
+                }
+        }
+        *has_p = found[3];
+        free(buf);
+        return rc;
+    }
     void *ev[4] = {NULL, NULL, NULL, NULL};
     const char *src[4] = {pb->vexpr[0], pb->vexpr[1], pb->vexpr[2], pb->pexpr};
     const char *what[4] = {"velocity[0]", "velocity[1]", "velocity[2]", "pressure"};
@@ -1458,7 +1532,7 @@ int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)
                 rc = -1;
             } else if (k < 3 && v)
                 v[i][k] = val;
-            else if (k == 3 && p)
+            else if (k == 3 && p && ev[3])
                 p[i] = val;
         }
     for (int k = 0; k < 4; k++)
@@ -1495,6 +1569,33 @@ static void read_block_fields(reader *r, rmap *bm, lahar_particle_block *pb)
         }
     } else if (vn)
         rmap_vec(bm, "velocity", dim, pb->v, 0, ""); /* its message */
+    yaml_node_t *in = rmap_get(bm, "initial");
+    if (in && !r->failed) {
+        static const char *const ikeys[] = {"file", NULL};
+        key_join(bm->prefix, "initial", key);
+        rmap im;
+        if (rmap_open(r, in, key, &im) != 0)
+            return;
+        rmap_check_keys(&im, ikeys);
+        const char *file = rmap_str(&im, "file", 1, NULL, "initial.h5");
+        if (r->failed)
+            return;
+        char full[2048];
+        if (file[0] == '/')
+            snprintf(full, sizeof full, "%s", file);
+        else
+            snprintf(full, sizeof full, "%s%s", r->dir, file);
+        if (strlen(full) >= sizeof pb->init_file) {
+            rmap_fail(&im, "file", "path longer than %d characters", (int)sizeof pb->init_file - 1);
+            return;
+        }
+        if (vn || pn) {
+            rmap_fail(bm, "initial", "give the initial fields either as velocity:/pressure: keys or in the file, "
+                      "not both");
+            return;
+        }
+        snprintf(pb->init_file, sizeof pb->init_file, "%s", full);
+    }
     if (pn && !r->failed) {
         key_join(bm->prefix, "pressure", key);
         if (pn->type != YAML_SCALAR_NODE || !scalar(pn)[0])
@@ -1520,7 +1621,8 @@ static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
 
 static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c, rmap *bmo)
 {
-    static const char *const bkeys[] = {"name", "box", "polygon", "stl", "velocity", "pressure", "phase", "material", NULL};
+    static const char *const bkeys[] = {"name",  "box",     "polygon", "stl",      "velocity",
+                                        "pressure", "initial", "phase", "material", NULL};
     static const char *const phases[] = {"water", "soil", NULL};
     static const char *const boxkeys[] = {"lo", "hi", NULL};
     const int dim = r->dim;
@@ -2021,6 +2123,28 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
             return;
         }
     check_blocks_placement(r, bl, c);
+    /* initial files: every dataset present holds one value per particle of its block */
+    for (int b = 0; b < c->nblock && !r->failed; b++) {
+        const lahar_particle_block *pb = &c->blocks[b];
+        if (!pb->init_file[0])
+            continue;
+        char key[KEY_MAX], msg[1400];
+        snprintf(key, sizeof key, "sph.blocks[%d].initial.file", b & 0xffff);
+        yaml_node_t *bn = seq_item(r, bl, b);
+        const int64_t np = lahar_case_block_lattice(c, b, NULL, 0);
+        double *none[4] = {NULL, NULL, NULL, NULL};
+        int found[4] = {0, 0, 0, 0};
+        if (np < 0)
+            rd_fail(r, bn, key, "out of memory");
+        else if (init_file_read(pb->init_file, np, none, found, msg, sizeof msg) != 0)
+            rd_fail(r, bn, key, "%s", msg);
+        else if (!found[0] && !found[1] && !found[2] && !found[3])
+            rd_fail(r, bn, key, "%s holds none of the datasets vx, vy, vz, pressure", pb->init_file);
+        else if (found[3] && pb->phase != 0)
+            rd_fail(r, bn, key, "%s: dataset 'pressure' is for water; block '%s' is soil", pb->init_file, pb->name);
+        else if (found[2] && c->dim == 2)
+            rd_fail(r, bn, key, "%s: dataset 'vz' in a 2D case; remove it", pb->init_file);
+    }
 }
 
 static void read_output(reader *r, yaml_node_t *n, lahar_case *c)

@@ -86,6 +86,10 @@ typedef struct {
      * vexpr[a] replaces v[a]; pexpr gives the pressure, whose inverse EOS is the density */
     char vexpr[3][LAHAR_EXPR_MAX];
     char pexpr[LAHAR_EXPR_MAX];
+    /* or from an HDF5 file (case key initial: {file: F.h5}, the path made absolute by the loader;
+     * "" = none): datasets vx, vy (, vz) and/or pressure, one value per particle of the block in
+     * the order of lahar_case_block_lattice */
+    char init_file[1024];
     int nvert;            /* polygon / mesh vertices, world frame (z = 0 in 2D) */
     double (*vert)[3];
     int ntri;             /* mesh triangles (vertex indices, outward orientation not required) */

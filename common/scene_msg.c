@@ -181,6 +181,7 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         for (int k = 0; k < 3; k++)
             b->velocity_expr[k] = (char *)a->vexpr[k];
         b->pressure_expr = (char *)a->pexpr;
+        b->initial_file = (char *)a->init_file;
         b->nvert = a->nvert;
         b->ntri = a->ntri;
         b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
@@ -357,6 +358,12 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
             return -1;
         }
         snprintf(b->pexpr, sizeof b->pexpr, "%s", a->pressure_expr);
+        if (!a->initial_file || strlen(a->initial_file) >= sizeof b->init_file) {
+            snprintf(err, errlen, "malformed scene message (particle block %d: initial file)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        snprintf(b->init_file, sizeof b->init_file, "%s", a->initial_file);
         if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
             goto oom;
         b->nvert = a->nvert;

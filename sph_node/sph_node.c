@@ -116,11 +116,11 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         const lahar_particle_block *pb = &c->blocks[b];
         if (n > 0 && !rc) {
             char err[600];
-            if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, pb->pexpr[0] ? rho : NULL, err,
-                                         sizeof err) != 0) {
+            int has_p = 0;
+            if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, rho, &has_p, err, sizeof err) != 0) {
                 fprintf(stderr, "lahar-sph: %s\n", err);
                 rc = -1;
-            } else if (pb->pexpr[0])
+            } else if (has_p)
                 for (int64_t i = 0; i < n; i++)
                     rho[i] = sph_node_eos_density(c, rho[i]);
         }
