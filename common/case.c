@@ -14,6 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <hdf5.h>
+#include <matheval.h>
 #include <yaml.h>
 
 #include "geometry.h"
@@ -1378,9 +1380,252 @@ static void read_block_phase(rmap *bm, lahar_particle_block *pb, const char *con
                       "case is implemented", name, j, c->materials[c->blocks[j].material].name);
 }
 
+/* --- per-particle initial fields (libmatheval) ----------------------------------------------- */
+
+/* Parse expression s in x, y, z (libmatheval: + - * / ^, sin, cos, tan, exp, log, sqrt, abs, ...,
+ * constants pi, e). Returns the evaluator, or NULL with a reason in why. */
+static void *expr_create(const char *s, char *why, size_t nwhy)
+{
+    char buf[LAHAR_EXPR_MAX];
+    if (strlen(s) >= sizeof buf) {
+        snprintf(why, nwhy, "longer than %d characters", LAHAR_EXPR_MAX - 1);
+        return NULL;
+    }
+    snprintf(buf, sizeof buf, "%s", s);
+    void *ev = evaluator_create(buf);
+    if (!ev) {
+        snprintf(why, nwhy, "cannot parse '%s' (libmatheval syntax: + - * / ^, sin, cos, exp, log, sqrt, ..., "
+                 "constants pi and e, variables x, y, z)", s);
+        return NULL;
+    }
+    char **names = NULL;
+    int count = 0;
+    evaluator_get_variables(ev, &names, &count);
+    for (int k = 0; k < count; k++)
+        if (strcmp(names[k], "x") != 0 && strcmp(names[k], "y") != 0 && strcmp(names[k], "z") != 0) {
+            snprintf(why, nwhy, "unknown variable '%s' in '%s'; only x, y, z (the particle's position, m) and "
+                     "the constants pi, e may appear; write other constants as numbers", names[k], s);
+            evaluator_destroy(ev);
+            return NULL;
+        }
+    return ev;
+}
+
+/* Check the expression of node n (key for messages) and copy it to out; also evaluates it at the
+ * corners and the centre of the block's box: it must be finite there. */
+static void check_block_expr(reader *r, yaml_node_t *n, const char *key, const char *s, const lahar_particle_block *pb,
+                             char out[LAHAR_EXPR_MAX])
+{
+    char why[512];
+    void *ev = expr_create(s, why, sizeof why);
+    if (!ev) {
+        rd_fail(r, n, key, "%s", why);
+        return;
+    }
+    for (int k = 0; k < 9 && !r->failed; k++) {
+        double x[3];
+        for (int a = 0; a < 3; a++)
+            x[a] = k == 8 ? 0.5 * (pb->lo[a] + pb->hi[a]) : ((k >> a) & 1 ? pb->hi[a] : pb->lo[a]);
+        if (r->dim == 2)
+            x[2] = 0.0;
+        double v = evaluator_evaluate_x_y_z(ev, x[0], x[1], x[2]);
+        if (!isfinite(v))
+            rd_fail(r, n, key, "'%s' is not finite at (%g, %g, %g), a point of the block", s, x[0], x[1], x[2]);
+    }
+    evaluator_destroy(ev);
+    snprintf(out, LAHAR_EXPR_MAX, "%s", s);
+}
+
+/* The initial-field datasets of an HDF5 file (initial: {file: F.h5}). */
+static const char *const init_sets[4] = {"vx", "vy", "vz", "pressure"};
+
+/* Open file `path` and, for k = 0..3 (vx, vy, vz, pressure), read dataset init_sets[k] into
+ * out[k] (when out[k] is not NULL and the dataset exists) after checking it holds exactly n values;
+ * found[k] = 1 when present. 0, or -1 with a message naming the file and the dataset. */
+static int init_file_read(const char *path, int64_t n, double *out[4], int found[4], char *err, size_t errlen)
+{
+    H5E_auto2_t fn;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &fn, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    int rc = 0;
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) {
+        snprintf(err, errlen, "%s: cannot open as HDF5", path);
+        rc = -1;
+    }
+    for (int k = 0; k < 4 && !rc; k++) {
+        found[k] = H5Lexists(f, init_sets[k], H5P_DEFAULT) > 0;
+        if (!found[k])
+            continue;
+        hid_t d = H5Dopen2(f, init_sets[k], H5P_DEFAULT), s = d >= 0 ? H5Dget_space(d) : -1;
+        hssize_t m = s >= 0 ? H5Sget_simple_extent_npoints(s) : -1;
+        if (d < 0 || s < 0 || m < 0 || H5Sget_simple_extent_ndims(s) != 1) {
+            snprintf(err, errlen, "%s: dataset '%s' is not a 1D array of numbers", path, init_sets[k]);
+            rc = -1;
+        } else if ((int64_t)m != n) {
+            snprintf(err, errlen, "%s: dataset '%s' has %lld values, the block has %lld particles (one value per "
+                     "particle, in lattice order)", path, init_sets[k], (long long)m, (long long)n);
+            rc = -1;
+        } else if (out[k] && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out[k]) < 0) {
+            snprintf(err, errlen, "%s: dataset '%s' cannot be read as numbers", path, init_sets[k]);
+            rc = -1;
+        }
+        if (s >= 0)
+            H5Sclose(s);
+        if (d >= 0)
+            H5Dclose(d);
+    }
+    if (f >= 0)
+        H5Fclose(f);
+    H5Eset_auto2(H5E_DEFAULT, fn, data);
+    return rc;
+}
+
+int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)[3], int64_t n, double (*v)[3],
+                             double *p, int *has_p, char *err, size_t errlen)
+{
+    *has_p = pb->pexpr[0] != 0;
+    if (pb->init_file[0]) { /* the loader has checked that no expression is given too */
+        double *buf = malloc((size_t)(n > 0 ? n : 1) * 4 * sizeof *buf);
+        if (!buf) {
+            snprintf(err, errlen, "block '%s': out of memory", pb->name);
+            return -1;
+        }
+        double *out[4] = {buf, buf + n, buf + 2 * n, buf + 3 * n};
+        int found[4] = {0, 0, 0, 0};
+        int rc = init_file_read(pb->init_file, n, out, found, err, errlen);
+        for (int64_t i = 0; i < n && !rc; i++) {
+            for (int a = 0; a < 3; a++)
+                v[i][a] = found[a] ? out[a][i] : pb->v[a];
+            if (found[3])
+                p[i] = out[3][i];
+            for (int k = 0; k < 4; k++)
+                if (found[k] && !isfinite(out[k][i])) {
+                    snprintf(err, errlen, "%s: dataset '%s' value %lld is not finite", pb->init_file, init_sets[k],
+                             (long long)i);
+                    rc = -1;
+                    break;
+                }
+        }
+        *has_p = found[3];
+        free(buf);
+        return rc;
+    }
+    void *ev[4] = {NULL, NULL, NULL, NULL};
+    const char *src[4] = {pb->vexpr[0], pb->vexpr[1], pb->vexpr[2], pb->pexpr};
+    const char *what[4] = {"velocity[0]", "velocity[1]", "velocity[2]", "pressure"};
+    int rc = 0;
+    for (int k = 0; k < 4 && !rc; k++)
+        if (src[k][0]) {
+            char why[512];
+            if (!(ev[k] = expr_create(src[k], why, sizeof why))) {
+                snprintf(err, errlen, "block '%s': %s: %s", pb->name, what[k], why);
+                rc = -1;
+            }
+        }
+    for (int64_t i = 0; i < n && !rc; i++)
+        for (int k = 0; k < 4 && !rc; k++) {
+            double val = k < 3 ? pb->v[k] : 0.0;
+            if (ev[k])
+                val = evaluator_evaluate_x_y_z(ev[k], pts[i][0], pts[i][1], pts[i][2]);
+            if (!isfinite(val)) {
+                snprintf(err, errlen, "block '%s': %s '%s' is not finite at (%g, %g, %g)", pb->name, what[k], src[k],
+                         pts[i][0], pts[i][1], pts[i][2]);
+                rc = -1;
+            } else if (k < 3 && v)
+                v[i][k] = val;
+            else if (k == 3 && p && ev[3])
+                p[i] = val;
+        }
+    for (int k = 0; k < 4; k++)
+        if (ev[k])
+            evaluator_destroy(ev[k]);
+    return rc;
+}
+
+/* velocity: [numbers or expressions] and pressure: (number or expression) of block pb, checked once
+ * the block's box is known. */
+static void read_block_fields(reader *r, rmap *bm, lahar_particle_block *pb)
+{
+    const int dim = r->dim;
+    yaml_node_t *vn = rmap_get(bm, "velocity"), *pn = rmap_get(bm, "pressure");
+    char key[KEY_MAX];
+    if (vn && vn->type == YAML_SEQUENCE_NODE && seq_len(vn) == dim) {
+        for (int a = 0; a < dim && !r->failed; a++) {
+            yaml_node_t *it = seq_item(r, vn, a);
+            snprintf(key, sizeof key, "%.*s.velocity[%d]", KEY_MAX - 32, bm->prefix, a & 3);
+            if (!it || it->type != YAML_SCALAR_NODE) {
+                rd_fail(r, it ? it : vn, key, "expected a number or an expression in x, y, z, got %s",
+                        it ? node_kind(it) : "nothing");
+                return;
+            }
+            const char *s = scalar(it);
+            char *end = NULL;
+            double v = strtod(s, &end);
+            while (end && (*end == ' ' || *end == '\t'))
+                end++;
+            if (end != s && end && *end == '\0' && isfinite(v))
+                pb->v[a] = v;
+            else
+                check_block_expr(r, it, key, s, pb, pb->vexpr[a]);
+        }
+    } else if (vn)
+        rmap_vec(bm, "velocity", dim, pb->v, 0, ""); /* its message */
+    yaml_node_t *in = rmap_get(bm, "initial");
+    if (in && !r->failed) {
+        static const char *const ikeys[] = {"file", NULL};
+        key_join(bm->prefix, "initial", key);
+        rmap im;
+        if (rmap_open(r, in, key, &im) != 0)
+            return;
+        rmap_check_keys(&im, ikeys);
+        const char *file = rmap_str(&im, "file", 1, NULL, "initial.h5");
+        if (r->failed)
+            return;
+        char full[2048];
+        if (file[0] == '/')
+            snprintf(full, sizeof full, "%s", file);
+        else
+            snprintf(full, sizeof full, "%s%s", r->dir, file);
+        if (strlen(full) >= sizeof pb->init_file) {
+            rmap_fail(&im, "file", "path longer than %d characters", (int)sizeof pb->init_file - 1);
+            return;
+        }
+        if (vn || pn) {
+            rmap_fail(bm, "initial", "give the initial fields either as velocity:/pressure: keys or in the file, "
+                      "not both");
+            return;
+        }
+        snprintf(pb->init_file, sizeof pb->init_file, "%s", full);
+    }
+    if (pn && !r->failed) {
+        key_join(bm->prefix, "pressure", key);
+        if (pn->type != YAML_SCALAR_NODE || !scalar(pn)[0])
+            rd_fail(r, pn, key, "expected a number or an expression in x, y, z (Pa), got %s",
+                    pn->type == YAML_SCALAR_NODE ? "an empty value" : node_kind(pn));
+        else if (pb->phase != 0)
+            rd_fail(r, pn, key, "sets the initial pressure of water; block '%s' is soil (its stress starts at 0)",
+                    pb->name);
+        else
+            check_block_expr(r, pn, key, scalar(pn), pb, pb->pexpr);
+    }
+}
+
+static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c, rmap *bm);
+
 static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
 {
-    static const char *const bkeys[] = {"name", "box", "polygon", "stl", "velocity", "phase", "material", NULL};
+    rmap bm;
+    read_block_geometry(r, n, i, c, &bm);
+    if (!r->failed)
+        read_block_fields(r, &bm, &c->blocks[i]);
+}
+
+static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c, rmap *bmo)
+{
+    static const char *const bkeys[] = {"name",  "box",     "polygon", "stl",      "velocity",
+                                        "pressure", "initial", "phase", "material", NULL};
     static const char *const phases[] = {"water", "soil", NULL};
     static const char *const boxkeys[] = {"lo", "hi", NULL};
     const int dim = r->dim;
@@ -1388,22 +1633,21 @@ static void read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
     char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
     snprintf(prefix, sizeof prefix, "sph.blocks[%d]", i);
     snprintf(def, sizeof def, "block%d", i);
-    rmap bm, xm;
-    if (rmap_open(r, n, prefix, &bm) != 0)
+    rmap xm;
+    if (rmap_open(r, n, prefix, bmo) != 0)
         return;
-    rmap_check_keys(&bm, bkeys);
-    rmap_name(&bm, "name", 0, def, pb->name);
+    rmap_check_keys(bmo, bkeys);
+    rmap_name(bmo, "name", 0, def, pb->name);
     for (int j = 0; j < i && !r->failed; j++)
         if (strcmp(c->blocks[j].name, pb->name) == 0)
-            rmap_fail(&bm, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
-    rmap_vec(&bm, "velocity", dim, pb->v, 0, "");
-    read_block_phase(&bm, pb, phases, c);
-    yaml_node_t *bx = rmap_get(&bm, "box"), *pg = rmap_get(&bm, "polygon"), *st = rmap_get(&bm, "stl");
+            rmap_fail(bmo, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
+    read_block_phase(bmo, pb, phases, c);
+    yaml_node_t *bx = rmap_get(bmo, "box"), *pg = rmap_get(bmo, "polygon"), *st = rmap_get(bmo, "stl");
     if (r->failed)
         return;
     if (!!bx + !!pg + !!st != 1) {
         if (!bx && !pg && !st)
-            rmap_missing(&bm, "box", dim == 3 ? "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}  (or polygon: / stl:)"
+            rmap_missing(bmo, "box", dim == 3 ? "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}  (or polygon: / stl:)"
                                               : "{lo: [0, 0], hi: [0.1, 0.1]}  (or polygon: [[x, y], ...])");
         else
             rd_fail(r, n, prefix, "give exactly one of box, polygon (2D) or stl (3D) per block");
@@ -1646,7 +1890,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const keys[] = {"dx", "density", "kernel", "h_over_dx", "c0", "eos", "gamma", "viscosity",
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
-                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "soil_wall_stress", "shifting", "shifting_density", "blocks", NULL};
+                                       "initial_pressure", "wall_pressure", "penalty_stiffness", "soil_wall_stress", "shifting", "shifting_density", "background_pressure",
+                                       "transport_velocity", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1692,6 +1937,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     o->shifting = rmap_num(&m, "shifting", 0, 0.0, "0.01");
     o->sps = rmap_bool(&m, "sps", 0);
     o->shifting_density = rmap_bool(&m, "shifting_density", 0);
+    o->transport_velocity = rmap_bool(&m, "transport_velocity", 0);
     o->sps_cs = rmap_num(&m, "sps_cs", 0, 0.12, "0.12");
     o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
     o->kappa = rmap_num(&m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
@@ -1825,6 +2071,49 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_fail(&m, "c0", "must be > 0 m/s (got %g); about 10 x the largest expected flow speed", o->c0);
         return;
     }
+    /* background pressure p_b (sph_node/sph_fluid.h): default 0, or rho0 c0^2 with the transport
+     * velocity (Adami et al. 2013 take p_b = p0 = rho0 c0^2) */
+    o->background_pressure = rmap_num(&m, "background_pressure", 0,
+                                      o->transport_velocity ? c->sph_density * o->c0 * o->c0 : 0.0, "1e4");
+    if (r->failed)
+        return;
+    if (!(o->background_pressure >= 0.0)) {
+        rmap_fail(&m, "background_pressure", "must be >= 0 Pa (got %g); 0 = off, rho0 c0^2 = %g is usual with "
+                  "transport_velocity", o->background_pressure, c->sph_density * o->c0 * o->c0);
+        return;
+    }
+    if (o->transport_velocity) {
+        /* the transport velocity moves particles towards sparse places, as shifting does: no free
+         * surface, no walls (a body's side has no particles, the background pressure would push the
+         * water into it: Adami et al. 2013 put wall particles there), water only */
+        const char *why = NULL;
+        char buf[256];
+        for (int a = 0; a < dim && !why; a++)
+            if (!o->periodic[a] && c->gravity[a] + o->body_force[a] != 0.0) {
+                snprintf(buf, sizeof buf, "gravity + body_force acts along the non-periodic axis %c (a free surface "
+                         "would form, which the background pressure would tear open)", "xyz"[a]);
+                why = buf;
+            }
+        for (int a = 0; a < dim && !why; a++)
+            if (!o->periodic[a]) {
+                snprintf(buf, sizeof buf, "axis %c is not periodic (water would meet a free surface or a wall there; "
+                         "only fully periodic domains are supported)", "xyz"[a]);
+                why = buf;
+            }
+        if (!why && c->nbody > 0)
+            why = "the case has bodies (their surfaces have no wall particles for the background pressure)";
+        for (int b = 0; b < c->nblock && !why; b++)
+            if (c->blocks[b].phase == 1)
+                why = "the case has soil (water only)";
+        if (!why && o->shifting > 0.0)
+            why = "shifting is on too (the transport velocity already regularises the particles; use one of them)";
+        if (!why && !(o->background_pressure > 0.0))
+            why = "background_pressure is 0 (it drives the transport velocity; omit it for rho0 c0^2)";
+        if (why) {
+            rmap_fail(&m, "transport_velocity", "needs a fully periodic water-only flow, but %s", why);
+            return;
+        }
+    }
     /* the smallest step this fluid will ask for must stay above time.dt_min */
     double dt_c = o->cfl * h / o->c0, nu = o->mu / c->sph_density;
     double dt_v = nu > 0 ? o->cfl_visc * h * h / nu : INFINITY;
@@ -1846,6 +2135,28 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
             return;
         }
     check_blocks_placement(r, bl, c);
+    /* initial files: every dataset present holds one value per particle of its block */
+    for (int b = 0; b < c->nblock && !r->failed; b++) {
+        const lahar_particle_block *pb = &c->blocks[b];
+        if (!pb->init_file[0])
+            continue;
+        char key[KEY_MAX], msg[1400];
+        snprintf(key, sizeof key, "sph.blocks[%d].initial.file", b & 0xffff);
+        yaml_node_t *bn = seq_item(r, bl, b);
+        const int64_t np = lahar_case_block_lattice(c, b, NULL, 0);
+        double *none[4] = {NULL, NULL, NULL, NULL};
+        int found[4] = {0, 0, 0, 0};
+        if (np < 0)
+            rd_fail(r, bn, key, "out of memory");
+        else if (init_file_read(pb->init_file, np, none, found, msg, sizeof msg) != 0)
+            rd_fail(r, bn, key, "%s", msg);
+        else if (!found[0] && !found[1] && !found[2] && !found[3])
+            rd_fail(r, bn, key, "%s holds none of the datasets vx, vy, vz, pressure", pb->init_file);
+        else if (found[3] && pb->phase != 0)
+            rd_fail(r, bn, key, "%s: dataset 'pressure' is for water; block '%s' is soil", pb->init_file, pb->name);
+        else if (found[2] && c->dim == 2)
+            rd_fail(r, bn, key, "%s: dataset 'vz' in a 2D case; remove it", pb->init_file);
+    }
 }
 
 /* probes: [{name, position, body, size, rate}, ...] (lahar_probe, common/scene.h). A fluid probe

@@ -34,6 +34,14 @@ void lahar_case_free(lahar_case *c);
  * count) and returns how many there are, or -1 when out of memory. The SPH node fills its
  * particles with this (mass rho0 dx^D each, the block's velocity). */
 int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap);
+/* The per-particle initial fields of block pb at its n lattice points pts (in the order of
+ * lahar_case_block_lattice): from the expressions of the case keys velocity: / pressure:
+ * (libmatheval) or from the datasets vx, vy, vz, pressure of its initial file (HDF5). v[i] = the
+ * block's velocity with every given component replaced; p[i] = the pressure when the block gives
+ * one (*has_p = 1; p untouched otherwise). 0, or -1 with a message naming the block and the
+ * expression, or the file and the dataset (missing file, wrong size, not finite). */
+int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)[3], int64_t n, double (*v)[3],
+                             double *p, int *has_p, char *err, size_t errlen);
 
 /* 1 if the world point x lies in body b's solid at its stored pose: within the sweep radius of
  * the core, or inside a closed core (2D: a closed ring of vertices, polygons, boxes and closed

@@ -1418,3 +1418,88 @@ int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d
              Re, umax, vmax);
     return 0;
 }
+
+/* taylor_green: the 2D Taylor-Green vortex on the periodic square [lo, lo + L)^2 (both axes
+ * periodic with the same period L, no bodies):
+ *   u = -U cos(2 pi x'/L) sin(2 pi y'/L) e^{-8 pi^2 nu t/L^2},  v = U sin(2 pi x'/L) cos(2 pi y'/L) e^{...},
+ * x' = x - lo, nu = mu / rho0. The kinetic energy decays as e^{-16 pi^2 nu t / L^2}. Measured at
+ * every snapshot: E = rho0 dx^D / 2 sum |v|^2 (the particles' mass taken as rho0 dx^D: the initial
+ * pressure changes masses by p/c0^2, below 1e-2 here); U from the first snapshot, U^2 = 2 <|v|^2>.
+ * Metrics:
+ *   energy_decay_rel_error = |k / k_exact - 1|, k the least-squares slope of -ln(E/E0) over all
+ *     snapshots (a line through the origin), k_exact = 16 pi^2 nu / L^2;
+ *   velocity_l2_rel_error = sqrt(sum |v - v_exact|^2 / sum |v_exact|^2) at the last snapshot;
+ *   density_mean_rel_change = max over snapshots of |mean rho / rho0 - 1|;
+ *   volume_rel_change = max over snapshots of |sum (rho0 dx^D / rho_i) / L^2 - 1| (sum m/rho against
+ *     the box). */
+int lahar_check_taylor_green(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    if (fluid_need(d, LAHAR_PFIELD_VELOCITY | LAHAR_PFIELD_DENSITY, "taylor_green", r) != 0)
+        return -1;
+    const double L = c->sph.hi[0] - c->sph.lo[0];
+    if (c->dim != 2 || !c->sph.periodic[0] || !c->sph.periodic[1] || fabs(c->sph.hi[1] - c->sph.lo[1] - L) > 1e-12 * L ||
+        p->nsnap < 3 || !p->density) {
+        snprintf(r->err, sizeof r->err, "taylor_green: needs a 2D case periodic on x and y with the same period, "
+                 ">= 3 snapshots and the fields velocity and density");
+        return -1;
+    }
+    const double rho0 = c->sph_density, nu = c->sph.mu / rho0, dx = fluid_dx(c, d), m0 = rho0 * dx * dx;
+    const double k_exact = 16.0 * M_PI * M_PI * nu / (L * L), tw = 2.0 * M_PI / L;
+    double E0 = 0.0, U = 0.0, stt = 0.0, sty = 0.0, dmax = 0.0, vmax = 0.0, l2 = 0.0;
+    for (int64_t k = 0; k < p->nsnap; k++) {
+        if (fluid_read(d, k, r) != 0)
+            return -1;
+        const double t = p->t[k], dec = exp(-8.0 * M_PI * M_PI * nu * t / (L * L));
+        double v2 = 0.0, rho = 0.0, vol = 0.0, e2 = 0.0, x2 = 0.0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            const double vx = p->vx[i], vy = p->vy[i];
+            v2 += vx * vx + vy * vy;
+            rho += p->density[i];
+            vol += m0 / p->density[i];
+            if (k == p->nsnap - 1) {
+                const double xs = p->x[i] - c->sph.lo[0], ys = p->y[i] - c->sph.lo[1];
+                const double ue = -U * cos(tw * xs) * sin(tw * ys) * dec, ve = U * sin(tw * xs) * cos(tw * ys) * dec;
+                e2 += (vx - ue) * (vx - ue) + (vy - ve) * (vy - ve);
+                x2 += ue * ue + ve * ve;
+            }
+        }
+        const double n = (double)(p->cur_n > 0 ? p->cur_n : 1), E = 0.5 * m0 * v2;
+        if (k == 0) {
+            E0 = E;
+            U = sqrt(2.0 * v2 / n);
+        }
+        if (!(E0 > 0.0)) {
+            snprintf(r->err, sizeof r->err, "taylor_green: the first snapshot has no kinetic energy (initial velocity?)");
+            return -1;
+        }
+        if (k == p->nsnap - 1)
+            l2 = x2 > 0.0 ? sqrt(e2 / x2) : INFINITY;
+        const double y = -log(E / E0);
+        stt += t * t, sty += t * y;
+        dmax = fmax(dmax, fabs(rho / n / rho0 - 1.0));
+        vmax = fmax(vmax, fabs(vol / (L * L) - 1.0));
+        if (r->nseries < LAHAR_CHECK_MAX_SERIES) {
+            r->series_t[r->nseries] = t;
+            r->series_measured[r->nseries] = E / E0;
+            r->series_reference[r->nseries] = exp(-k_exact * t);
+            r->nseries++;
+        }
+    }
+    const double k_fit = stt > 0.0 ? sty / stt : 0.0;
+    lahar_check_value(r, "energy_decay_rel_error", fabs(k_fit / k_exact - 1.0));
+    lahar_check_value(r, "velocity_l2_rel_error", l2);
+    lahar_check_value(r, "density_mean_rel_change", dmax);
+    lahar_check_value(r, "volume_rel_change", vmax);
+    lahar_check_value(r, "energy_decay_rate", k_fit);
+    lahar_check_value(r, "energy_decay_rate_exact", k_exact);
+    lahar_check_value(r, "reynolds", U * L / nu);
+    lahar_check_value(r, "t_last", p->t[p->nsnap - 1]);
+    snprintf(r->title, sizeof r->title, "Taylor-Green vortex, Re = %.4g, %lld particles", U * L / nu,
+             (long long)p->n[0]);
+    snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
+    snprintf(r->ylabel, sizeof r->ylabel, "E / E0");
+    snprintf(r->convention, sizeof r->convention, "E = rho0 dx^2/2 sum |v|^2; rate fitted over all snapshots, "
+             "exact 16 pi^2 nu / L^2; L2 error at t = %.3g s", p->t[p->nsnap - 1]);
+    return 0;
+}

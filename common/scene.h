@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #define LAHAR_NAME_MAX 64
+#define LAHAR_EXPR_MAX 256 /* an initial-field expression of a particle block (case key velocity:, pressure:) */
 
 typedef enum { LAHAR_MOTION_FREE = 0, LAHAR_MOTION_FIXED = 1, LAHAR_MOTION_PRESCRIBED = 2 } lahar_motion;
 typedef enum { LAHAR_CONTACT_LINEAR = 0, LAHAR_CONTACT_HERTZ = 1, LAHAR_CONTACT_SOIL = 2 } lahar_contact_model;
@@ -80,6 +81,15 @@ typedef struct {
     lahar_block_kind kind;
     double lo[3], hi[3];  /* box, or the bounding box of the polygon / mesh */
     double v[3];          /* initial velocity */
+    /* per-particle initial fields (case keys velocity: / pressure: as expressions in x, y, z,
+     * evaluated by libmatheval at each particle when the SPH node fills the block; "" = none):
+     * vexpr[a] replaces v[a]; pexpr gives the pressure, whose inverse EOS is the density */
+    char vexpr[3][LAHAR_EXPR_MAX];
+    char pexpr[LAHAR_EXPR_MAX];
+    /* or from an HDF5 file (case key initial: {file: F.h5}, the path made absolute by the loader;
+     * "" = none): datasets vx, vy (, vz) and/or pressure, one value per particle of the block in
+     * the order of lahar_case_block_lattice */
+    char init_file[1024];
     int nvert;            /* polygon / mesh vertices, world frame (z = 0 in 2D) */
     double (*vert)[3];
     int ntri;             /* mesh triangles (vertex indices, outward orientation not required) */
@@ -132,6 +142,11 @@ typedef struct {
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */
     int shifting_density;  /* 1: the shift changes the density as the continuity equation would (keeps
                               the total volume of a closed box); default 0 (sph_node/sph_fluid.c) */
+    double background_pressure; /* Pa, p_b: default 0. Without transport_velocity it is added to the
+                              EOS pressure in the momentum equation; with it, it drives the transport
+                              velocity only (Adami et al. 2013); sph_node/sph_fluid.h */
+    int transport_velocity; /* 1: transport-velocity formulation (Adami, Hu & Adams 2013), confined
+                              water-only flows without bodies; default 0 */
 } lahar_sph_options;
 
 /* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).

@@ -32,6 +32,8 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     m->shepard_interval = o->shepard_interval;
     m->shifting = o->shifting;
     m->shifting_density = (int8_t)(o->shifting_density != 0);
+    m->background_pressure = o->background_pressure;
+    m->transport_velocity = (int8_t)(o->transport_velocity != 0);
     m->sps = (int8_t)(o->sps != 0);
     m->sps_cs = o->sps_cs;
     m->halo = o->halo;
@@ -64,6 +66,8 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     o->shepard_interval = m->shepard_interval;
     o->shifting = m->shifting;
     o->shifting_density = m->shifting_density != 0;
+    o->background_pressure = m->background_pressure;
+    o->transport_velocity = m->transport_velocity != 0;
     o->sps = m->sps != 0;
     o->sps_cs = m->sps_cs;
     o->halo = m->halo;
@@ -192,6 +196,10 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->source = (char *)a->source;
         b->phase = (int8_t)a->phase;
         b->material = a->material;
+        for (int k = 0; k < 3; k++)
+            b->velocity_expr[k] = (char *)a->vexpr[k];
+        b->pressure_expr = (char *)a->pexpr;
+        b->initial_file = (char *)a->init_file;
         b->nvert = a->nvert;
         b->ntri = a->ntri;
         b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
@@ -356,6 +364,25 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         }
         b->phase = a->phase;
         b->material = a->material;
+        for (int k = 0; k < 3; k++)
+            if (!a->velocity_expr[k] || strlen(a->velocity_expr[k]) >= LAHAR_EXPR_MAX) {
+                snprintf(err, errlen, "malformed scene message (particle block %d: velocity expression)", i);
+                lahar_case_free(c);
+                return -1;
+            } else
+                snprintf(b->vexpr[k], sizeof b->vexpr[k], "%s", a->velocity_expr[k]);
+        if (!a->pressure_expr || strlen(a->pressure_expr) >= LAHAR_EXPR_MAX) {
+            snprintf(err, errlen, "malformed scene message (particle block %d: pressure expression)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        snprintf(b->pexpr, sizeof b->pexpr, "%s", a->pressure_expr);
+        if (!a->initial_file || strlen(a->initial_file) >= sizeof b->init_file) {
+            snprintf(err, errlen, "malformed scene message (particle block %d: initial file)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        snprintf(b->init_file, sizeof b->init_file, "%s", a->initial_file);
         if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
             goto oom;
         b->nvert = a->nvert;

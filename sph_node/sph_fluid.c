@@ -70,9 +70,26 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         for (int a = 0; a < 6; a++)
             f->sps_tau[a] = buf + (size_t)f->p.cap * (size_t)(a + 1);
     }
+    if (p->transport_velocity) { /* v~ - v per particle, and the background-pressure acceleration */
+        double *buf = calloc((size_t)f->p.cap * 3, sizeof(double));
+        if (!buf || sph_particles_alloc_transport(&f->p) != 0) {
+            free(buf);
+            free(f->sps_nut);
+            free(f->prho2);
+            free(f->vol);
+            sph_cells_free(&f->cells);
+            sph_particles_free(&f->p);
+            snprintf(err, (size_t)errlen, "out of memory for the transport velocity of %lld particles", (long long)cap);
+            return -1;
+        }
+        f->tv_bx = buf;
+        f->tv_by = buf + f->p.cap;
+        f->tv_bz = buf + 2 * f->p.cap;
+    }
     if (p->soil) { /* stress arrays only when the scene has soil */
         if (sph_soil_init(&f->soil, &p->soil_mat, p->dim, &f->k, p->dx, &f->p) != 0) {
             free(f->sps_nut);
+            free(f->tv_bx);
             free(f->prho2);
             free(f->vol);
             sph_cells_free(&f->cells);
@@ -137,6 +154,7 @@ void sph_fluid_free(sph_fluid *f)
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
     free(f->sps_nut);
+    free(f->tv_bx);
     free(f->prho2);
     free(f->vol);
     if (f->has_soil)
@@ -152,6 +170,8 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
         return prm->rho0 * prm->c0 * prm->c0 / prm->gamma * (pow(rho / prm->rho0, prm->gamma) - 1.0);
     return prm->c0 * prm->c0 * (rho - prm->rho0); /* 000 eq. 3 */
 }
+
+static inline int prm_tvf(const sph_fluid *f) { return f->prm.transport_velocity != 0; }
 
 /* The pairs (i, j) of water particle i with the water particles j after it in the forward half
  * stencil (SPH_HALF_NEIGHBOUR_CHUNKS_D), each evaluated once and added to both particles: the
@@ -171,6 +191,13 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
                                                                  double *restrict fz)
 {
     const sph_particles *p = &f->p;
+    /* transport velocity (Adami et al. 2013, sph_fluid.h): background-pressure force into
+     * tv_bx.., the extra stress A = rho v (v~ - v) into the pair force */
+    const int tvf = prm_tvf(f);
+    double *const bxa = f->tv_bx, *const bya = f->tv_by, *const bza = f->tv_bz;
+    const double *const tvxa = p->tvx, *const tvya = p->tvy, *const tvza = p->tvz;
+    const double pb = f->prm.background_pressure;
+    double bxi = 0.0, byi = 0.0, bzi = 0.0;
     const sph_cells *c = &f->cells;
     const sph_params *prm = &f->prm;
     const double *const vxa = p->vx, *const vya = p->vy, *const vza = p->vz, *const rhoa = p->rho,
@@ -237,12 +264,35 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
                 if (dim == 3)
                     Fz += mf * (txz * rx + tyz * ry + tzz * rz);
             }
+            if (tvf) {
+                /* 1/rho div A, symmetric: m_i m_j (A_i/rho_i^2 + A_j/rho_j^2) . grad_i W_ij, with
+                 * (A/rho^2 . grad W)_a = v_a ((v~ - v) . grad W) / rho */
+                const double mf = mi * mj * fij;
+                const double si = (tvxa[i] * rx + tvya[i] * ry + (dim == 3 ? tvza[i] * rz : 0.0)) / rhoi;
+                const double sj = (tvxa[j] * rx + tvya[j] * ry + (dim == 3 ? tvza[j] * rz : 0.0)) / rhoj;
+                Fx += mf * (vxi * si + vxa[j] * sj);
+                Fy += mf * (vyi * si + vya[j] * sj);
+                if (dim == 3)
+                    Fz += mf * (vzi * si + vza[j] * sj);
+                /* background pressure: -m_i m_j p_b (1/rho_i^2 + 1/rho_j^2) grad_i W_ij */
+                const double gb = -mi * mj * pb * (1.0 / (rhoi * rhoi) + 1.0 / (rhoj * rhoj)) * fij;
+                bxi += gb * rx, byi += gb * ry;
+                bxa[j] -= gb * rx, bya[j] -= gb * ry;
+                if (dim == 3)
+                    bzi += gb * rz, bza[j] -= gb * rz;
+            }
             fxi += Fx, fyi += Fy;
             fx[j] -= Fx, fy[j] -= Fy;
             if (dim == 3)
                 fzi += Fz, fz[j] -= Fz;
         }
     });
+    if (tvf) {
+        bxa[i] += bxi;
+        bya[i] += byi;
+        if (dim == 3)
+            bza[i] += bzi;
+    }
     drho[i] += drhoi;
     fx[i] += fxi;
     fy[i] += fyi;
@@ -338,6 +388,7 @@ static void fluid_pass(sph_fluid *f)
     const kernel_kind kind = f->k.kind;
     const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
     const int soil = f->has_soil;
+    const int tvf = prm_tvf(f);
     double *const drho = p->drho, *const fx = p->ax, *const fy = p->ay, *const fz = p->az;
     sph_blocks blk;
     sph_cells_blocks(c, &blk);
@@ -347,6 +398,11 @@ static void fluid_pass(sph_fluid *f)
 #pragma omp for schedule(static)
         for (int64_t i = 0; i < n; i++)
             drho[i] = fx[i] = fy[i] = fz[i] = 0.0;
+        if (tvf) {
+#pragma omp for schedule(static)
+            for (int64_t i = 0; i < n; i++)
+                f->tv_bx[i] = f->tv_by[i] = f->tv_bz[i] = 0.0;
+        }
         for (int colour = 0; colour < SPH_BLOCK_COLOURS; colour++) {
             /* the blocks of this colour: every second run along A and B from (pa, pb) */
             const int pa = colour >> 1, pb = colour & 1;
@@ -385,6 +441,15 @@ static void fluid_pass(sph_fluid *f)
             fx[i] = fx[i] * im + gx;
             fy[i] = fy[i] * im + gy;
             fz[i] = fz[i] * im + gz;
+        }
+        if (tvf) {
+#pragma omp for schedule(static)
+            for (int64_t i = 0; i < n; i++) {
+                const double im = 1.0 / m[i];
+                f->tv_bx[i] *= im;
+                f->tv_by[i] *= im;
+                f->tv_bz[i] *= im;
+            }
         }
     }
     f->work_passes++;
@@ -499,18 +564,41 @@ void sph_fluid_shepard(sph_fluid *f)
         p->rho[i] = p->rhoh[i];
 }
 
+/* Summation density of the transport-velocity formulation (Adami et al. 2013, sph_fluid.h):
+ * rho_i = m_i sum_j W_ij (j includes i), into rho and rhoh (the integrator's half-step density;
+ * drho is zeroed after the pass, so the density stays this value through the step). Gather. */
+static void fluid_summation_density(sph_fluid *f)
+{
+    sph_particles *p = &f->p;
+    const sph_cells *c = &f->cells;
+    const int64_t n = p->n;
+    const kernel *k = &f->k;
+    const double s2 = k->support * k->support, w0 = kernel_w(k, 0.0);
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        double sw = w0;
+        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, { sw += kernel_w(k, sqrt(r2)); });
+        p->rho[i] = p->rhoh[i] = p->m[i] * sw;
+    }
+}
+
 /* EOS, SPS and the particle-particle sums: everything of the rates that does not need the bodies. */
 static void fluid_rates_particles(sph_fluid *f)
 {
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const sph_params prm = f->prm;
+    if (prm.transport_velocity)
+        fluid_summation_density(f);
     double *const prho2 = f->prho2, *const vol = f->vol;
+    /* background pressure in the momentum equation (p = p_EOS + p_b), unless the transport
+     * velocity takes it (sph_fluid.h); p.p keeps the EOS pressure */
+    const double pbm = prm.transport_velocity ? 0.0 : prm.background_pressure;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         const double rho = p->rho[i], pr = sph_fluid_pressure(&prm, rho);
         p->p[i] = pr;
-        prho2[i] = pr / (rho * rho);
+        prho2[i] = (pbm > 0.0 ? pr + pbm : pr) / (rho * rho);
         vol[i] = p->m[i] / rho;
     }
     if (prm.sps)
@@ -518,6 +606,8 @@ static void fluid_rates_particles(sph_fluid *f)
     if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
         sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k, f->vol);
     fluid_pass(f);
+    if (prm.transport_velocity) /* the density is the summation of the positions, not integrated */
+        memset(p->drho, 0, (size_t)n * sizeof *p->drho);
     if (f->has_soil) {
         int64_t soil_water = 0;
         f->work_neighbours_soil += sph_soil_momentum(&f->soil, p, &f->cells, &f->k, &soil_water);
@@ -599,7 +689,28 @@ int sph_fluid_step_begin(sph_fluid *f, double dt)
     const double *restrict ax = p->ax, *restrict ay = p->ay, *restrict az = p->az, *restrict drho = p->drho;
     /* kick (half), drift, predict; one loop per dimension so that neither tests d3 per particle
      * (both vectorise); 2D: z, vz and vhz are not touched (they stay 0) */
-    if (d3) {
+    if (f->prm.transport_velocity) {
+        /* Adami et al. 2013: the particles move with the transport velocity
+         * v~ = v(t + dt/2) + dt/2 b(t), b the background-pressure acceleration of the last
+         * evaluation; tv = v~ - v is kept for the extra stress A of the next evaluation */
+        double *restrict tvx = p->tvx, *restrict tvy = p->tvy, *restrict tvz = p->tvz;
+        const double *restrict bx = f->tv_bx, *restrict by = f->tv_by, *restrict bz = f->tv_bz;
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
+        for (int64_t i = 0; i < n; i++) {
+            const double hx = vx[i] + hdt * ax[i], hy = vy[i] + hdt * ay[i], hz = d3 ? vz[i] + hdt * az[i] : 0.0;
+            const double rh = rho[i] + hdt * drho[i];
+            tvx[i] = hdt * bx[i], tvy[i] = hdt * by[i], tvz[i] = d3 ? hdt * bz[i] : 0.0;
+            vhx[i] = hx, vhy[i] = hy, rhoh[i] = rh;
+            x[i] += dt * (hx + tvx[i]), y[i] += dt * (hy + tvy[i]);
+            vx[i] = hx + hdt * ax[i], vy[i] = hy + hdt * ay[i];
+            if (d3) {
+                vhz[i] = hz;
+                z[i] += dt * (hz + tvz[i]);
+                vz[i] = hz + hdt * az[i];
+            }
+            rho[i] = rh + hdt * drho[i];
+        }
+    } else if (d3) {
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
         for (int64_t i = 0; i < n; i++) {
             const double hx = vx[i] + hdt * ax[i], hy = vy[i] + hdt * ay[i], hz = vz[i] + hdt * az[i];

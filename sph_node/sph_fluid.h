@@ -25,6 +25,19 @@
  *   EOS: linear p = c0^2 (rho - rho0) (000 eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
  *     (003 eq. 19). c0 is the constant numerical speed of sound.
  *
+ *   Background pressure p_b (prm.background_pressure, default 0): without the transport velocity
+ *     the momentum equation uses p_i + p_b (p.p and the snapshots keep the EOS pressure); with it,
+ *     p_b enters the transport velocity only (Adami et al. 2013, below).
+ *   Transport velocity (prm.transport_velocity; Adami, Hu & Adams 2013, J. Comput. Phys.
+ *     241:292-307, section 2; fully periodic water-only flows, the loader rejects the rest):
+ *       b_i = -p_b sum_j m_j (1/rho_i^2 + 1/rho_j^2) grad_i W_ij   (the uniform p_b, same symmetric form)
+ *       drift x += dt v~, v~ = v(t + dt/2) + dt/2 b (b of the last evaluation); tv = v~ - v kept
+ *       per particle (permuted by the sort) for
+ *       dv_i/dt += sum_j m_j (A_i/rho_i^2 + A_j/rho_j^2) . grad_i W_ij,  A = rho v (x) (v~ - v)
+ *       (the extra stress of the momentum transported with v~; v = the predicted velocity of the
+ *       evaluation); density by summation rho_i = m_i sum_j W_ij (j includes i; continuity and
+ *       delta-SPH unused, drho = 0). Adami et al. write the pair terms with (V_i^2 + V_j^2): equal
+ *       to these for equal masses. Off: no arrays, the pair loop's branch is never taken.
  *   Shepard filter (003 eq. 5, optional, every N steps): rho_i = sum_j m_j W_ij / sum_j V_j W_ij
  *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
  *     hydrostatic bias that delta-SPH has (003 section 3.3; test_sph_hydrostatic.c).
@@ -79,6 +92,8 @@ typedef struct {
     int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
     int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */
+    double background_pressure; /* p_b, Pa (see "Background pressure" above), 0 = off */
+    int transport_velocity; /* 1: Adami et al. 2013 transport velocity (see above), 0 = off */
     int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
@@ -107,6 +122,9 @@ typedef struct {
     /* per particle, in the sorted order of the last evaluation, filled with the EOS so that the
      * pair loop divides nothing per pair: p_i / rho_i^2 and the volume m_i / rho_i */
     double *prho2, *vol;
+    /* transport velocity only (NULL otherwise): the background-pressure acceleration b of the
+     * last evaluation, in its sorted order (sph_fluid.h "Transport velocity") */
+    double *tv_bx, *tv_by, *tv_bz;
     /* soil (prm.soil only; sph_soil.h): its passes run after the water pass, which then skips soil
      * particles and soil neighbours; sigma is integrated in the same leapfrog as v and rho */
     int has_soil;

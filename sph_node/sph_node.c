@@ -94,9 +94,11 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
     }
     double(*pts)[3] = malloc((size_t)(most > 0 ? most : 1) * sizeof *pts);
     double *rho = malloc((size_t)(most > 0 ? most : 1) * sizeof *rho);
-    if (!pts || !rho) {
+    double(*vel)[3] = malloc((size_t)(most > 0 ? most : 1) * sizeof *vel);
+    if (!pts || !rho || !vel) {
         free(pts);
         free(rho);
+        free(vel);
         return -1;
     }
     const double vol = pow(c->sph_dx, c->dim);
@@ -110,14 +112,28 @@ static int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         const double m = rho_b * vol;
         if (n > 0 && !soil)
             sph_node_block_density(c, (const double(*)[3])pts, n, rho);
+        /* per-particle initial velocity and pressure (case keys velocity: / pressure: as
+         * expressions): the pressure replaces the block's density by its inverse EOS */
+        const lahar_particle_block *pb = &c->blocks[b];
+        if (n > 0 && !rc) {
+            char err[600];
+            int has_p = 0;
+            if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, rho, &has_p, err, sizeof err) != 0) {
+                fprintf(stderr, "lahar-sph: %s\n", err);
+                rc = -1;
+            } else if (has_p)
+                for (int64_t i = 0; i < n; i++)
+                    rho[i] = sph_node_eos_density(c, rho[i]);
+        }
         for (int64_t i = 0; i < n && !rc; i++)
-            rc = sph_particles_add(p, pts[i], c->blocks[b].v, soil ? m : rho[i] * vol, soil ? rho_b : rho[i],
+            rc = sph_particles_add(p, pts[i], vel[i], soil ? m : rho[i] * vol, soil ? rho_b : rho[i],
                                    soil ? SPH_SOIL_PHASE : 0) < 0
                      ? -1
                      : 0;
     }
     free(pts);
     free(rho);
+    free(vel);
     return rc;
 }
 
@@ -178,6 +194,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;
+    prm->background_pressure = o->background_pressure;
+    prm->transport_velocity = o->transport_velocity;
     prm->sps = o->sps;
     prm->sps_cs = o->sps_cs;
     for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */

@@ -56,8 +56,24 @@ int sph_particles_alloc_stress(sph_particles *p)
     return 0;
 }
 
+int sph_particles_alloc_transport(sph_particles *p)
+{
+    if (p->tvx)
+        return 0;
+    p->tvx = calloc((size_t)p->cap, sizeof(double));
+    p->tvy = calloc((size_t)p->cap, sizeof(double));
+    p->tvz = calloc((size_t)p->cap, sizeof(double));
+    if (!p->tvx || !p->tvy || !p->tvz) {
+        free(p->tvx), free(p->tvy), free(p->tvz);
+        p->tvx = p->tvy = p->tvz = NULL;
+        return -1;
+    }
+    return 0;
+}
+
 void sph_particles_free(sph_particles *p)
 {
+    free(p->tvx), free(p->tvy), free(p->tvz);
     for (int k = 0; k < SPH_NSTRESS; k++)
         free(p->sig[k]), free(p->sigh[k]);
     double **a[SPH_NDOUBLE];
@@ -267,12 +283,14 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     for (int64_t i = 0; i < n; i++)
         c->perm[c->count[c->cell_of[i]]++] = i;
     /* permute the particle arrays (gathers, one parallel region) and cell_of into the new order */
-    double **a[SPH_NSORTED + 2 * SPH_NSTRESS];
+    double **a[SPH_NSORTED + 2 * SPH_NSTRESS + 3];
     sorted_doubles(p, a);
     int na = SPH_NSORTED;
     if (p->sig[0]) /* soil stress and its half-step value */
         for (int k = 0; k < SPH_NSTRESS; k++)
             a[na++] = &p->sig[k], a[na++] = &p->sigh[k];
+    if (p->tvx) /* transport velocity offset */
+        a[na++] = &p->tvx, a[na++] = &p->tvy, a[na++] = &p->tvz;
     const int64_t *perm = c->perm;
     int64_t *cell_of = c->cell_of;
     /* each array is gathered into the scratch array, which then takes its place */

@@ -41,6 +41,10 @@ typedef struct {
      * effective stress sigma (xx, xy, xz, yy, yz, zz; Pa, tension positive) and its half-step
      * value of the integrator, permuted by the sort like every other particle array */
     double *sig[SPH_NSTRESS], *sigh[SPH_NSTRESS];
+    /* transport velocity only (NULL until sph_particles_alloc_transport): the transport velocity
+     * minus the momentum velocity, v~ - v, of the last drift (Adami et al. 2013; sph_fluid.h),
+     * permuted by the sort */
+    double *tvx, *tvy, *tvz;
     /* sort scratch */
     double *scratch_d;
     int64_t *scratch_i;
@@ -53,6 +57,9 @@ void sph_particles_free(sph_particles *p);
 /* Allocate the soil stress arrays (sig, sigh) for cap particles, zeroed; no-op when present.
  * Returns 0 or -1 (out of memory; none allocated). */
 int sph_particles_alloc_stress(sph_particles *p);
+/* Allocate the transport-velocity arrays (tvx, tvy, tvz) for cap particles, zeroed; no-op when
+ * present. Returns 0 or -1 (out of memory; none allocated). */
+int sph_particles_alloc_transport(sph_particles *p);
 /* Append one particle at rest density rho with mass m; returns its index, or -1 when full. */
 int64_t sph_particles_add(sph_particles *p, const double x[3], const double v[3], double m, double rho,
                           int32_t phase);
