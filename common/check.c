@@ -734,6 +734,8 @@ static const lahar_check_reference check_references[] = {
      "steady_l2_rel_error", 0.01, lahar_check_poiseuille},
     {"cylinder_array", "periodic square array of cylinders: K = rho g L^2/(mu U_s) vs Sangani & Acrivos 1982",
      "K_rel_error", 0.05, lahar_check_cylinder_array},
+    {"sphere_array", "periodic simple cubic array of spheres: K = rho g L^3/(6 pi mu a U_s) vs Zick & Homsy 1982",
+     "K_rel_error", 0.05, lahar_check_sphere_array},
     {"hydrostatic", "water at rest in a tank: wall force vs rho g h^2/2, pressure vs rho g (h - y)",
      "wall_force_rel_error", 0.01, lahar_check_hydrostatic},
     {"floating_box", "box floating in water: draft vs Archimedes rho_b h/rho_f", "draft_rel_error", 0.02,

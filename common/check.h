@@ -123,6 +123,7 @@ const lahar_check_reference *lahar_check_find(const char *name);
  * cases/README.md). */
 int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_sphere_array(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
@@ -140,6 +141,8 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
  * Acrivos 1982 Table 1, shared/reference/01: ln K interpolated linearly in c between tabulated
  * points, the low-c asymptote below c = 0.05); NAN outside (0, 0.75]. */
 double lahar_check_sangani_acrivos_K(double c);
+/* Zick & Homsy (1982) Table 2, simple cubic array of spheres (dilute series below c = 0.027); NAN outside (0, 0.5236]. */
+double lahar_check_zick_homsy_K(double c);
 
 /* Transient plane Poiseuille flow from rest (Morris et al. 1997 eq. 21, shared/reference/05
  * section 5.1): velocity at distance y from the lower wall of a channel of width H driven by

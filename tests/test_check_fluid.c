@@ -8,6 +8,7 @@
  *    across; velocity x 1.02 -> steady_l2_rel_error 0.02; plate force x 1.03 -> 0.03;
  *  - cylinder_array: c = 0.1 (K = 24.83), uniform velocity giving U_s exactly; U x 1.06 fails;
  *    the table's interpolation and low-c asymptote (7.981 at c = 0.01, shared/reference/01);
+ *  - sphere_array: Zick & Homsy's table, its interpolation and the dilute series (lookup only);
  *  - hydrostatic: 2D tank, h = 0.3 m, p = rho g (h - y), wall forces rho g h^2/2; wall force
  *    x 1.02 and pressure x 1.05 fail; 3D tank of planes (wetted widths per wall), a wall at 0.97
  *    fails;
@@ -355,6 +356,15 @@ static void test_cylinder(const char *base)
     CHECK(fabs(lahar_check_sangani_acrivos_K(0.0499999) / 15.56 - 1.0) < 1e-3,
           "SA asymptote meets the table at 0.05: %g", lahar_check_sangani_acrivos_K(0.0499999));
     CHECK(isnan(lahar_check_sangani_acrivos_K(0.8)), "SA beyond close packing is NAN");
+    /* Zick & Homsy (1982) Table 2, simple cubic (cases/sphere_array_reference.md) */
+    CHECK(fabs(lahar_check_zick_homsy_K(0.064) - 2.810) < 1e-12, "ZH table at 0.064");
+    CHECK(fabs(lahar_check_zick_homsy_K(0.216) - 7.442) < 1e-12, "ZH table at 0.216");
+    CHECK(fabs(lahar_check_zick_homsy_K(0.1705) - sqrt(4.292 * 7.442)) < 1e-9, "ZH ln K interpolation at 0.1705");
+    CHECK(fabs(lahar_check_zick_homsy_K(0.008) - 1.5247) < 1e-4, "ZH dilute series at 0.008: %g (ref 1.5247)",
+          lahar_check_zick_homsy_K(0.008));
+    CHECK(fabs(lahar_check_zick_homsy_K(0.0269999) / 2.008 - 1.0) < 1e-3, "dilute series meets ZH at 0.027: %g",
+          lahar_check_zick_homsy_K(0.0269999));
+    CHECK(isnan(lahar_check_zick_homsy_K(0.53)), "ZH beyond close packing is NAN");
 
     snprintf(dir, sizeof dir, "%s/cylinder_pass", base);
     cylinder_run(dir, 0.1, 1.0);

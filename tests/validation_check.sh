@@ -6,7 +6,8 @@
 # After a passing run, `lahar check --evaluate-only` on OUT/run must write the same check.json.
 # usage: validation_check.sh LAHAR CASE OUT [dx=M] [end=S] [c=SOLID_FRACTION] [threads=N] [paraview=1]
 #   dx=M   sph.dx (particle spacing)             end=S  time.end
-#   c=F    cylinder_array: disc radius r = L sqrt(F / pi), L = 0.2 m (the case's cell)
+#   c=F    cylinder_array: disc radius r = L sqrt(F / pi); sphere_array (a body `name: sphere`):
+#          sphere radius a = L (3 F / (4 pi))^(1/3); L = 0.2 m (the cases' cell)
 #   bound.NAME=V  the case's check: bound of metric NAME becomes V in the copy, for a metric the
 #          solver does not yet meet at the issue's bound: the test then guards what holds
 #          (say why next to the test and in cases/README.md)
@@ -32,9 +33,15 @@ for kv in "$@"; do
             grep -qE "^  dx: *$v( |$)" "$out/case.yaml" ;;
         end) sed -i -E "s/^(time: *\{.*end: *)[^,} ]+/\1$v/" "$out/case.yaml"
              grep -qE "^time: *\{.*end: *$v[,} ]" "$out/case.yaml" ;;
-        c) r=$(awk -v c="$v" 'BEGIN { printf "%.7f", 0.2 * sqrt(c / atan2(0, -1)) }')
-           sed -i -E "s/(name: cylinder,.* radius: *)[^,} ]+/\1$r/" "$out/case.yaml"
-           grep -qE "name: cylinder,.* radius: *$r[,} ]" "$out/case.yaml" ;;
+        c) if grep -qE "name: sphere,.*shape: sphere" "$out/case.yaml"; then
+               r=$(awk -v c="$v" 'BEGIN { printf "%.7f", 0.2 * (3 * c / (4 * atan2(0, -1)))^(1 / 3) }')
+               sed -i -E "s/(name: sphere,.* radius: *)[^,} ]+/\1$r/" "$out/case.yaml"
+               grep -qE "name: sphere,.* radius: *$r[,} ]" "$out/case.yaml"
+           else
+               r=$(awk -v c="$v" 'BEGIN { printf "%.7f", 0.2 * sqrt(c / atan2(0, -1)) }')
+               sed -i -E "s/(name: cylinder,.* radius: *)[^,} ]+/\1$r/" "$out/case.yaml"
+               grep -qE "name: cylinder,.* radius: *$r[,} ]" "$out/case.yaml"
+           fi ;;
         bound.*) m=${k#bound.}
                  sed -i -E "s/^(  metrics: *\{.*$m: *)[^,} ]+/\1$v/" "$out/case.yaml"
                  grep -qE "^  metrics: *\{.*$m: *$v[,} ]" "$out/case.yaml" ;;
