@@ -48,6 +48,6 @@ set_tests_properties(output_check_fluid PROPERTIES LABELS "fast;output" TIMEOUT 
 # and evaluated by `lahar check` against its bounds (steady L2 <= 1 %, plate force <= 1 %).
 # Measured: 0.28 % and 0.12 %, 4 s in Release.
 add_test(NAME check_poiseuille_2d COMMAND lahar check ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml
-  -o ${LAHAR_OUTPUT_TEST_DIR}/check_poiseuille_2d --in-process -q)
+  -o ${LAHAR_OUTPUT_TEST_DIR}/check_poiseuille_2d --in-process -q --overwrite)
 set_tests_properties(check_poiseuille_2d PROPERTIES LABELS "slow;output" TIMEOUT 300
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

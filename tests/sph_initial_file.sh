@@ -21,7 +21,7 @@ PY
 "$py" "$tools/case_override.py" "$out/expr.yaml" "$out/file.yaml" "sph.blocks.0.velocity=~" "sph.blocks.0.pressure=~" \
     "sph.blocks.0.initial={file: $out/tg25.h5}" >/dev/null || exit 2
 for v in expr file; do
-    "$lahar" run "$out/$v.yaml" -o "$out/$v" --in-process -q --threads 1 || exit 1
+    "$lahar" run "$out/$v.yaml" -o "$out/$v" --in-process -q --threads 1 --overwrite || exit 1
 done
 "$py" - "$out/expr/particles.h5" "$out/file/particles.h5" <<'PY'
 import sys, h5py, numpy as np

@@ -11,7 +11,7 @@ lahar=$1 case=$2 out=$3 py=$4
 here=$(dirname "$0")
 sh "$here/validation_check.sh" "$lahar" "$case" "$out/t1" dx=0.02 bound.energy_decay_rel_error=0.10 \
     "velocity_l2_rel_error<=0.20" "density_mean_rel_change<=0.02" || exit 1
-"$lahar" run "$out/t1/case.yaml" -o "$out/t2" --in-process -q --threads 2 || exit 1
+"$lahar" run "$out/t1/case.yaml" -o "$out/t2" --in-process -q --threads 2 --overwrite || exit 1
 "$py" "$here/../tools/h5_compare.py" "$out/t1/run/particles.h5" "$out/t2/particles.h5" --quiet ||
     { echo "validation_taylor_green: particles.h5 differs between 1 and 2 threads"; exit 1; }
 echo "validation_taylor_green: 1 and 2 threads bitwise equal"
