@@ -1597,7 +1597,7 @@ static void read_block_fields(reader *r, rmap *bm, lahar_particle_block *pb)
                       "not both");
             return;
         }
-        snprintf(pb->init_file, sizeof pb->init_file, "%s", full);
+        memcpy(pb->init_file, full, strlen(full) + 1); /* fits: checked above */
     }
     if (pn && !r->failed) {
         key_join(bm->prefix, "pressure", key);
