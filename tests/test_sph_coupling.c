@@ -145,6 +145,8 @@ int main(void)
               "scale %.3g)", f.p.drho[0], scale);
         printf("ghost corner of a sliding lid: continuity rate of a particle at rest %.1e kg/m^3/s\n", f.p.drho[0]);
         sph_fluid_free(&f);
+        lahar_shape_free(&walls[0].shape);
+        lahar_shape_free(&walls[1].shape);
     }
     /* 3. rotating, translating free disc */
     {
