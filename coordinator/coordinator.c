@@ -600,8 +600,9 @@ static void coord_progress(coord *co, int final)
         return;
     co->last_progress = now;
     double wall = now - co->wall0;
-    double rate = wall > 0 ? (double)co->steps / wall : 0.0;
-    double frac = co->c->t_end > 0 ? co->sim_time / co->c->t_end : 1.0;
+    double rate = wall > 0 ? (double)(co->steps - co->k0) / wall : 0.0;
+    double t0 = co->resumed ? co->resume_t : 0.0; /* this invocation's share of the run */
+    double frac = co->c->t_end > t0 ? (co->sim_time - t0) / (co->c->t_end - t0) : 1.0;
     double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
     fprintf(stderr, "\r  t = %.4g / %.4g s   step %lld   %.0f steps/s   ETA %.0f s   ", co->sim_time, co->c->t_end,
             (long long)co->steps, rate, eta);
@@ -971,7 +972,8 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(root, "t_end", co->c->t_end);
     double wall = lahar_now() - co->wall0;
     cJSON_AddNumberToObject(root, "wall_time_s", wall);
-    cJSON_AddNumberToObject(root, "steps_per_s", wall > 0 ? (double)co->steps / wall : 0.0);
+    /* a resumed run: steps counts from t = 0, the rate only this invocation's */
+    cJSON_AddNumberToObject(root, "steps_per_s", wall > 0 ? (double)(co->steps - co->k0) / wall : 0.0);
     /* the wall time split: start-up (nodes started, scene sent, nodes set up), the steps, the end
      * (STOP, nodes' last output and exit, this summary): the steps' share is what a longer run
      * scales */

@@ -46,6 +46,7 @@ typedef struct {
     int32_t *moving_id;
     double (*bx)[3], (*bq)[4], (*bv)[3], (*bw)[3];
     double **px, **pq, **pv, **pw;
+    long long work_body_body0; /* body-body contacts evaluated before a resume (the engine counts from its create) */
 } dem_node;
 
 static void dem_node_free(dem_node *d)
@@ -238,6 +239,12 @@ static int dem_node_state_io(dem_node *d, lahar_ckpt_file *f, int64_t *k, double
     lahar_ckpt_f64(f, "t", t_now, 1);
     lahar_ckpt_int(f, "at_output_time", at_output_time);
     lahar_ckpt_i64(f, "last_snapshot", last_snapshot, 1);
+    /* the work counter of summary.json continues across a resume */
+    const long long now = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
+    int64_t work = now + d->work_body_body0;
+    lahar_ckpt_i64(f, "work_body_body", &work, 1);
+    if (!f->writing && !f->failed)
+        d->work_body_body0 = work - now;
     void *blob = NULL;
     size_t len = 0;
     if (f->writing) {
@@ -372,7 +379,7 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
         st.ncontacts = d->ops->ncontacts(d->engine);
         st.nsubsteps = nsub > 0 ? nsub : 0;
         st.kinetic_energy = d->ops->kinetic_energy(d->engine);
-        st.work_body_body = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
+        st.work_body_body = (d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0) + d->work_body_body0;
         if (step.checkpoint && !st.error) {
             if (dem_node_checkpoint(d, k + 1, step.t_next, at_output_time, last_snapshot, err, sizeof err) == 0)
                 st.checkpointed = 1;

@@ -71,6 +71,9 @@ water)
     grep -q "at its end time already" resume0.txt || fail "resume of a finished run: $(cat resume0.txt)"
     nice -n 10 "$lahar" resume part --time-end 0.2 --threads 1 -q || fail "resume --time-end 0.2"
     same_output full part particles.h5 bodies.h5 forces.h5 contacts.h5 gauges.h5
+    w_full=$(summary full "d['work']['sph_passes'], d['work']['pairs_fluid_fluid'], d['work']['particle_body']")
+    w_part=$(summary part "d['work']['sph_passes'], d['work']['pairs_fluid_fluid'], d['work']['particle_body']")
+    [ "$w_full" = "$w_part" ] || fail "summary.json work: resumed $w_part, uninterrupted $w_full"
     [ "$(summary part "d['steps']")" = "$(summary full "d['steps']")" ] ||
         fail "summary.json: the resumed run counts $(summary part "d['steps']") steps, the uninterrupted one $(summary full "d['steps']")"
     [ "$(summary part "d['resumed_from']['time']")" = 0.1 ] || fail "summary.json resumed_from: $(summary part "d.get('resumed_from')")"
@@ -91,6 +94,10 @@ dem)
     nice -n 10 "$lahar" resume crash --threads 1 -q || fail "resume"
     [ ! -e "$newest.tmp" ] || fail "the stale $newest.tmp was not removed"
     same_output full crash bodies.h5 forces.h5
+    # the work counters of summary.json continue across the resume
+    w_full=$(summary full "d['work']['body_body'], d['dem_substeps'], d['steps']")
+    w_crash=$(summary crash "d['work']['body_body'], d['dem_substeps'], d['steps']")
+    [ "$w_full" = "$w_crash" ] || fail "summary.json work/substeps/steps: resumed $w_crash, uninterrupted $w_full"
     [ "$(ls -d crash/checkpoints/[0-9]*[0-9] | wc -l)" = 3 ] || fail "keep: 3 not honoured: $(ls crash/checkpoints)"
     ;;
 coupled_killed)
