@@ -891,7 +891,7 @@ static int coord_lockstep(coord *co)
             co->status = "error";
             return LAHAR_EXIT_RUN_ERROR;
         }
-        if (stop_after) {
+        if (stop_after && clk.j < clk.nout) { /* (at the end time the run simply finishes) */
             co->status = "stopped";
             co->clean_stop = 1;
             snprintf(co->message, sizeof co->message, "stopped by SIGTERM after the checkpoint of step %lld (t = %.9g "
