@@ -219,10 +219,15 @@ void lahar_ckpt_dir(char *buf, size_t n, const char *outdir, int64_t step, int t
     snprintf(buf, n, "%s/" LAHAR_CKPT_DIR "/%06" PRId64 "%s", outdir, step, tmp ? ".tmp" : "");
 }
 
-int lahar_ckpt_mkdirs(const char *path)
+int lahar_mkdir_p(const char *path)
 {
-    char tmp[1200];
-    snprintf(tmp, sizeof tmp, "%s", path);
+    char tmp[4200];
+    size_t len = strlen(path);
+    if (len >= sizeof tmp) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    memcpy(tmp, path, len + 1);
     for (char *p = tmp + 1; *p; p++)
         if (*p == '/') {
             *p = '\0';

@@ -45,8 +45,8 @@ int64_t lahar_ckpt_length(lahar_ckpt_file *f, const char *name);
 
 /* OUT/checkpoints/NNNNNN or NNNNNN.tmp into buf. */
 void lahar_ckpt_dir(char *buf, size_t n, const char *outdir, int64_t step, int tmp);
-/* mkdir -p. 0 or -1 (errno). */
-int lahar_ckpt_mkdirs(const char *path);
+/* mkdir -p (also for OUT itself). 0 or -1 (errno). */
+int lahar_mkdir_p(const char *path);
 /* fsync a file or directory by path. 0 or -1 (errno). */
 int lahar_ckpt_fsync_path(const char *path);
 

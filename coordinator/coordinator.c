@@ -779,7 +779,7 @@ static int coord_checkpoint(coord *co, int64_t k, lahar_clock *clk, double dt_al
                      lahar_link_role_name(r), (long long)K);
             return -1;
         }
-    if (lahar_ckpt_mkdirs(tmp) != 0) {
+    if (lahar_mkdir_p(tmp) != 0) {
         snprintf(co->message, sizeof co->message, "cannot create %.900s: %s", tmp, strerror(errno));
         return -1;
     }
@@ -1085,20 +1085,6 @@ static void coord_write_summary(coord *co)
 
 /* ---- entry --------------------------------------------------------------------------------- */
 
-static int coord_mkdir_p(const char *path)
-{
-    char tmp[PATH_MAX];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; p++)
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
-                return -1;
-            *p = '/';
-        }
-    return (mkdir(tmp, 0777) != 0 && errno != EEXIST) ? -1 : 0;
-}
-
 /* OUT/.lahar.lock, held (flock) for the whole run: a second run into the same directory is refused
  * with the holder's pid, host, start time and case (the file's text), instead of two runs writing
  * one set of HDF5 files. The lock goes with the process (also when it is killed); the file stays.
@@ -1229,7 +1215,7 @@ static int coord_save_case(const char *outdir, const lahar_case *c)
 {
     char dir[PATH_MAX + 32], path[PATH_MAX + 64], src_dir[PATH_MAX];
     snprintf(dir, sizeof dir, "%s/" LAHAR_CKPT_DIR, outdir);
-    if (lahar_ckpt_mkdirs(dir) != 0) {
+    if (lahar_mkdir_p(dir) != 0) {
         fprintf(stderr, "lahar: cannot create %s: %s\n", dir, strerror(errno));
         return -1;
     }
@@ -1385,7 +1371,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
         return LAHAR_EXIT_SETUP;
     }
-    if (coord_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
+    if (lahar_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
         fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", o->outdir, strerror(errno));
         return LAHAR_EXIT_SETUP;
     }

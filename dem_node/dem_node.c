@@ -282,7 +282,7 @@ static int dem_node_checkpoint(dem_node *d, int64_t state_step, double t, int at
     char dir[1200], path[1300];
     lahar_ckpt_dir(dir, sizeof dir, d->ns.output_dir, state_step, 1);
     snprintf(path, sizeof path, "%s/dem.h5", dir);
-    if (lahar_body_output_sync(d->out) != 0 || lahar_ckpt_mkdirs(dir) != 0) {
+    if (lahar_body_output_sync(d->out) != 0 || lahar_mkdir_p(dir) != 0) {
         snprintf(err, errlen, "cannot write the checkpoint in %s", dir);
         return -1;
     }

@@ -946,7 +946,7 @@ static int sph_node_checkpoint(sph_node *s, int64_t state_step, double t, char *
     lahar_ckpt_dir(dir, sizeof dir, s->ns.output_dir, state_step, 1);
     snprintf(path, sizeof path, "%s/sph.h5", dir);
     if (lahar_body_output_sync(s->bout) != 0 || lahar_gauge_output_sync(s->gauges) != 0 ||
-        lahar_ckpt_mkdirs(dir) != 0) {
+        lahar_mkdir_p(dir) != 0) {
         snprintf(err, errlen, "cannot write the checkpoint in %s", dir);
         return -1;
     }
