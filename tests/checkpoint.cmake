@@ -1,6 +1,6 @@
 # Coordinated checkpoints and `lahar resume` (coordinator/README.md "Checkpoints and resume"): an
 # interrupted or early-ended run, resumed, ends with output bitwise equal to the uninterrupted
-# run's (water, DEM only, coupled with a node killed by SIGKILL, soil, SIGTERM), SIGUSR1 writes a
+# run's (water, DEM only, coupled with the DEM node and then the resumed run's SPH node killed by SIGKILL, soil, SIGTERM), SIGUSR1 writes a
 # checkpoint, and the errors a user can meet exit 2 with a message. Runs use lahar's own private
 # network namespace (label netns) or --in-process.
 # checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR

@@ -103,7 +103,7 @@ dem)
 coupled_killed)
     # debris flow (water, free boulders, record_contacts) as processes: the DEM node is killed
     # with SIGKILL after the first checkpoint; the run ends with exit 3, resume continues from the
-    # last complete checkpoint
+    # last complete checkpoint (and is itself killed and resumed, below)
     override "$cases/debris_2d.yaml" cpl.yaml sph.dx=0.01 time.end=0.4 time.output_interval=0.05 \
         'checkpoint={interval: 0.1}'
     nice -n 10 "$lahar" run cpl.yaml -o full --threads 1 -q || fail "full run"
@@ -118,8 +118,27 @@ coupled_killed)
     rc=$?
     [ "$rc" = 3 ] || fail "the run with a killed node exited $rc, expected 3: $(cat killed.err)"
     echo "killed at t = $(summary killed "d['sim_time']") s; checkpoints: $(ls killed/checkpoints | tr '\n' ' ')"
-    nice -n 10 "$lahar" resume killed --threads 1 -q || fail "resume"
+    # the resumed run loses its SPH node (SIGKILL) after its own first checkpoint, and is resumed again
+    first=$(ls -d killed/checkpoints/[0-9]*[0-9] | tail -1)
+    nice -n 10 "$lahar" resume killed --threads 1 -q 2> killed2.err &
+    pid=$!
+    for i in $(seq 1 3000); do
+        newest=$(ls -d killed/checkpoints/[0-9]*[0-9] 2>/dev/null | tail -1)
+        [ "$newest" != "$first" ] && [ -f "$newest/coord.h5" ] && break
+        kill -0 "$pid" 2>/dev/null || break
+        sleep 0.01
+    done
+    sleep 0.2
+    sph=$(child_pid "$pid" lahar-sph)
+    [ -n "$sph" ] || fail "no lahar-sph child of the resumed run $pid"
+    kill -KILL "$sph"
+    wait "$pid"
+    rc=$?
+    [ "$rc" = 3 ] || fail "the resumed run with a killed node exited $rc, expected 3: $(cat killed2.err)"
+    echo "killed again at t = $(summary killed "d['sim_time']") s; checkpoints: $(ls killed/checkpoints | tr '\n' ' ')"
+    nice -n 10 "$lahar" resume killed --threads 1 -q || fail "second resume"
     same_output full killed particles.h5 bodies.h5 forces.h5 contacts.h5
+    [ "$(summary killed "d['steps']")" = "$(summary full "d['steps']")" ] || fail "steps in summary.json"
     ;;
 soil)
     # granular column collapse (Drucker-Prager soil on fixed DEM walls), resumed in-process from
