@@ -1237,8 +1237,11 @@ static int coord_save_case(const char *outdir, const lahar_case *c)
     if (out && fclose(out) != 0)
         rc = -1;
     snprintf(path, sizeof path, "%s/case_source", dir);
+    char abs[PATH_MAX];
+    if (!realpath(c->path, abs))
+        snprintf(abs, sizeof abs, "%s", c->path);
     out = rc ? NULL : fopen(path, "w");
-    if (!out || fprintf(out, "%s\n%s\n", c->path, src_dir) < 0)
+    if (!out || fprintf(out, "%s\n%s\n", abs, src_dir) < 0)
         rc = -1;
     if (out && fclose(out) != 0)
         rc = -1;
