@@ -624,6 +624,33 @@ static void read_stability(reader *r, yaml_node_t *n, lahar_case *c)
                   "fraction of the first step (0: only time.dt_min), e.g. 1e-3", s->dt_collapse);
 }
 
+/* Coordinated checkpoints (coordinator/README.md "Checkpoints and resume"); none when the
+ * section is absent. */
+static void read_checkpoint(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    static const char *const keys[] = {"interval", "keep", NULL};
+    c->checkpoint_interval = 0.0;
+    c->checkpoint_keep = 2;
+    if (!n)
+        return;
+    rmap m;
+    if (rmap_open(r, n, "checkpoint", &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    c->checkpoint_interval = rmap_num(&m, "interval", 1, 0.0, "0.5");
+    double keep = rmap_num(&m, "keep", 0, 2.0, "2");
+    if (r->failed)
+        return;
+    if (!(c->checkpoint_interval > 0.0))
+        rmap_fail(&m, "interval", "must be > 0 s of simulated time (got %g); a checkpoint is written at the first "
+                  "step ending at or after each multiple of it, e.g. 0.1", c->checkpoint_interval);
+    else if (!(keep >= 1.0 && keep <= 1000.0 && keep == floor(keep)))
+        rmap_fail(&m, "keep", "must be a whole number from 1 to 1000 (got %g); it is how many of the newest "
+                  "checkpoints stay on disk, e.g. 2", keep);
+    else
+        c->checkpoint_keep = (int)keep;
+}
+
 /* --- bodies -------------------------------------------------------------------------------------- */
 
 enum { SH_SPHERE, SH_DISC, SH_BOX, SH_SEGMENT, SH_POLYLINE, SH_POLYGON, SH_POLYHEDRON, SH_PLANE, SH_STL, SH_N };
@@ -2397,7 +2424,7 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
 static void read_case(reader *r, lahar_case *c)
 {
     static const char *const keys[] = {"dimensions", "gravity", "time", "materials", "dem", "bodies", "output",
-                                       "check", "sph", "stability", "probes", NULL};
+                                       "check", "sph", "stability", "probes", "checkpoint", NULL};
     yaml_node_t *root = yaml_document_get_root_node(r->doc);
     if (!root) {
         rd_fail(r, NULL, "", "the case file is empty; a case needs at least dimensions, time and bodies or sph");
@@ -2427,6 +2454,7 @@ static void read_case(reader *r, lahar_case *c)
         read_materials(r, mat, c);
     read_dem(r, rmap_get(&m, "dem"), c);
     read_stability(r, rmap_get(&m, "stability"), c);
+    read_checkpoint(r, rmap_get(&m, "checkpoint"), c);
     if (bodies && !r->failed) {
         int nb = bodies->type == YAML_SEQUENCE_NODE ? seq_len(bodies) : 0;
         int *line = calloc((size_t)(nb ? nb : 1), sizeof *line);
@@ -2448,6 +2476,11 @@ static void read_case(reader *r, lahar_case *c)
 
 int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
 {
+    return lahar_case_load_dir(path, NULL, out, err, errlen);
+}
+
+int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out, char *err, size_t errlen)
+{
     memset(out, 0, sizeof *out);
     if (errlen)
         err[0] = '\0';
@@ -2462,7 +2495,9 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
     r.err = err;
     r.errlen = errlen;
     const char *slash = strrchr(path, '/');
-    if (slash)
+    if (base_dir && base_dir[0])
+        snprintf(r.dir, sizeof r.dir, "%s/", base_dir);
+    else if (slash)
         snprintf(r.dir, sizeof r.dir, "%.*s/", (int)(slash - path), path);
     yaml_parser_t parser;
     yaml_document_t doc;

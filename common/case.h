@@ -21,6 +21,10 @@ int lahar_case_load(const char *path, lahar_case *out);
 
 /* Same, but the message goes to `err` (without a trailing newline) instead of stderr. */
 int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen);
+/* Same, with the files the case references (STL, initial: file) relative to base_dir instead of
+ * the case file's directory (NULL: the case file's): a copy of a case kept elsewhere
+ * (`lahar resume`). */
+int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out, char *err, size_t errlen);
 
 /* Release everything a loaded (or scene-message-built) case owns; the case is zeroed. Safe on a
  * zeroed case. */

@@ -155,6 +155,12 @@ static double out_wall_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* A resumed run (lahar_case.resume): the snapshot count of an existing file and its XDMF sidecar
+ * rebuilt from the snapshots on disk (below). */
+static int out_resume_sidecar(const char *h5path, const char *xmfpath, lahar_xdmf_file *xmf,
+                              const lahar_body_output *bodies, const unsigned *fields, int64_t *nsnap, char *err,
+                              size_t n);
+
 /* ---------------------------------------------------------------- bodies ---------------- */
 
 typedef struct {
@@ -380,6 +386,44 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    if (c->resume) {
+        /* a resumed run appends to the stream as lahar_output_resume_trim left it (cut at the
+         * checkpoint): the rows on disk, and the next forces_interval slot after the last row */
+        fs->file = lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
+        H5Pclose(fapl);
+        if (fs->file < 0) {
+            snprintf(err, n, "%s: cannot reopen the force stream to continue it", path);
+            return -1;
+        }
+        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts};
+        const char *names[] = {"t", "step", "force", "torque", "ncontacts"};
+        for (int k = 0; k < 5; k++)
+            if ((*ids[k] = H5Dopen2(fs->file, names[k], H5P_DEFAULT)) < 0) {
+                snprintf(err, n, "%s: no dataset %s to continue", path, names[k]);
+                return -1;
+            }
+        hid_t sp = H5Dget_space(fs->t);
+        hsize_t rows = 0;
+        H5Sget_simple_extent_dims(sp, &rows, NULL);
+        H5Sclose(sp);
+        fs->rows = (int64_t)rows;
+        if (rows > 0 && fs->interval > 0.0) {
+            double last = 0.0;
+            hsize_t off = rows - 1, one = 1;
+            hid_t fsp = H5Dget_space(fs->t), msp = H5Screate_simple(1, &one, NULL);
+            H5Sselect_hyperslab(fsp, H5S_SELECT_SET, &off, NULL, &one, NULL);
+            H5Dread(fs->t, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, &last);
+            H5Sclose(msp);
+            H5Sclose(fsp);
+            fs->next_slot = (int64_t)floor(last / fs->interval * (1.0 + 1e-12)) + 1;
+        }
+        if (H5Fstart_swmr_write(fs->file) < 0) {
+            snprintf(err, n, "%s: cannot start SWMR writing", path);
+            return -1;
+        }
+        fs->last_flush = out_wall_seconds();
+        return 0;
+    }
     fs->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
     if (fs->file < 0) {
@@ -549,6 +593,20 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     char stale[OUT_PATH_MAX + 16];
     snprintf(stale, sizeof stale, "%s/lahar.xmf", outdir); /* a previous run's, rebuilt at close */
     unlink(stale);
+    if (c->resume) { /* continue bodies.h5 as the checkpoint left it (lahar_output_resume_trim) */
+        char path[OUT_PATH_MAX + 16];
+        snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
+        if (out_resume_sidecar(o->h5path, path, &o->xmf, o, NULL, &o->nsnap, err, n) != 0) {
+            lahar_body_output_close(o);
+            return NULL;
+        }
+        snprintf(path, sizeof path, "%s/forces.h5", outdir);
+        if (c->output_forces && c->nbody > 0 && forces_open(&o->fs, path, c, err, n)) {
+            lahar_body_output_close(o);
+            return NULL;
+        }
+        return o;
+    }
     hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
@@ -725,6 +783,15 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     o->fields = fields & (LAHAR_PFIELD_ALL | LAHAR_PFIELD_STRESS);
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
+    if (c->resume) { /* continue particles.h5 as the checkpoint left it (lahar_output_resume_trim) */
+        char path[OUT_PATH_MAX + 16];
+        snprintf(path, sizeof path, "%s/particles.xmf", outdir);
+        if (out_resume_sidecar(o->h5path, path, &o->xmf, NULL, &o->fields, &o->nsnap, err, n) != 0) {
+            lahar_particle_output_close(o);
+            return NULL;
+        }
+        return o;
+    }
     hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
@@ -936,6 +1003,194 @@ static int64_t out_read_snapshot_list(const char *path, out_snap_entry **list)
     return cnt;
 }
 
+static int out_resume_sidecar(const char *h5path, const char *xmfpath, lahar_xdmf_file *xmf,
+                              const lahar_body_output *bodies, const unsigned *fields, int64_t *nsnap, char *err,
+                              size_t n)
+{
+    if (access(h5path, F_OK) != 0) {
+        snprintf(err, n, "%s: missing; the run to resume has no such file", h5path);
+        return -1;
+    }
+    out_snap_entry *list = NULL;
+    int64_t cnt = out_read_snapshot_list(h5path, &list);
+    char *xml = malloc(OUT_XML_CAP);
+    if (cnt < 0 || !xml) {
+        snprintf(err, n, "%s: cannot read its snapshots to continue it", h5path);
+        free(list), free(xml);
+        return -1;
+    }
+    int rc = lahar_xdmf_open(xmf, xmfpath, err, n);
+    for (int64_t k = 0; k < cnt && !rc; k++) {
+        size_t len = lahar_xdmf_step_begin(xml, OUT_XML_CAP, list[k].step, list[k].t);
+        if (bodies) {
+            lahar_xdmf_bodies xb;
+            out_xdmf_bodies_info(bodies, &xb);
+            if (len < OUT_XML_CAP)
+                len += lahar_xdmf_bodies_grids(xml + len, OUT_XML_CAP - len, &xb, k);
+        } else {
+            lahar_xdmf_particles xp = {"particles.h5", *fields};
+            if (len < OUT_XML_CAP)
+                len += lahar_xdmf_particles_grid(xml + len, OUT_XML_CAP - len, &xp, k, list[k].n);
+        }
+        if (len < OUT_XML_CAP)
+            len += lahar_xdmf_step_end(xml + len, OUT_XML_CAP - len);
+        if (len >= OUT_XML_CAP || lahar_xdmf_append(xmf, xml, len, OUT_XML_CAP)) {
+            snprintf(err, n, "%s: cannot rebuild it", xmfpath);
+            rc = -1;
+        }
+    }
+    *nsnap = cnt;
+    free(list), free(xml);
+    return rc;
+}
+
+/* Cut the snapshots of OUT/<file> (bodies.h5, particles.h5, contacts.h5) after the checkpoint:
+ * groups whose step is > last (>= last when strict), and drop the marks of a stopped run from
+ * the ones kept. 0 (also when the file does not exist) or -1. */
+static int out_trim_snapshots(const char *path, int64_t last, int strict)
+{
+    if (access(path, F_OK) != 0)
+        return 0;
+    out_snap_entry *list = NULL;
+    int64_t cnt = out_read_snapshot_list(path, &list);
+    if (cnt < 0)
+        return -1;
+    hid_t f = out_file_open(path, H5F_ACC_RDWR, 0);
+    int rc = f < 0 ? -1 : 0;
+    for (int64_t k = cnt - 1; k >= 0 && !rc; k--) {
+        char name[48];
+        snprintf(name, sizeof name, "/snapshots/%06" PRId64, list[k].snap);
+        if (list[k].step > last || (strict && list[k].step == last)) {
+            if (H5Ldelete(f, name, H5P_DEFAULT) < 0)
+                rc = -1;
+            continue;
+        }
+        static const char *const marks[] = {"stopped", "instability"};
+        for (int m = 0; m < 2; m++)
+            if (H5Aexists_by_name(f, name, marks[m], H5P_DEFAULT) > 0 &&
+                H5Adelete_by_name(f, name, marks[m], H5P_DEFAULT) < 0)
+                rc = -1;
+    }
+    if (f >= 0 && H5Fclose(f) < 0)
+        rc = -1;
+    free(list);
+    return rc;
+}
+
+/* Cut the 1-D or row-major datasets names[] of group loc to the rows whose `step` is <= last. */
+static int out_trim_rows(hid_t loc, const char *const *names, int nnames, int64_t last)
+{
+    hid_t ds = H5Dopen2(loc, "step", H5P_DEFAULT);
+    if (ds < 0)
+        return -1;
+    hid_t sp = H5Dget_space(ds);
+    hsize_t rows = 0;
+    H5Sget_simple_extent_dims(sp, &rows, NULL);
+    H5Sclose(sp);
+    int64_t *st = malloc((size_t)(rows > 0 ? rows : 1) * sizeof *st);
+    int rc = st ? 0 : -1;
+    if (!rc && rows > 0 && H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, st) < 0)
+        rc = -1;
+    H5Dclose(ds);
+    hsize_t keep = 0;
+    while (!rc && keep < rows && st[keep] <= last)
+        keep++;
+    free(st);
+    for (int k = 0; k < nnames && !rc; k++) {
+        hid_t d = H5Dopen2(loc, names[k], H5P_DEFAULT);
+        if (d < 0) {
+            rc = -1;
+            break;
+        }
+        hid_t dsp = H5Dget_space(d);
+        hsize_t dims[3] = {0, 0, 0};
+        H5Sget_simple_extent_dims(dsp, dims, NULL);
+        H5Sclose(dsp);
+        dims[0] = keep;
+        if (H5Dset_extent(d, dims) < 0)
+            rc = -1;
+        H5Dclose(d);
+    }
+    return rc;
+}
+
+int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_step, char *err, size_t n)
+{
+    char path[OUT_PATH_MAX + 32];
+    static const char *const snapfiles[] = {"particles.h5", "bodies.h5"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", outdir, snapfiles[i]);
+        if (out_trim_snapshots(path, step, !snapshot_at_step) != 0) {
+            snprintf(err, n, "%s: cannot cut it back to the checkpoint (step %" PRId64 ")", path, step);
+            return -1;
+        }
+    }
+    /* contacts.h5 holds the LOADS of the steps that start at an output time: step `step` is the
+     * first one the resumed run takes, so its entry belongs after the checkpoint */
+    snprintf(path, sizeof path, "%s/contacts.h5", outdir);
+    if (out_trim_snapshots(path, step, 1) != 0) {
+        snprintf(err, n, "%s: cannot cut it back to the checkpoint (step %" PRId64 ")", path, step);
+        return -1;
+    }
+    static const char *const streams[] = {"forces.h5", "gauges.h5"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", outdir, streams[i]);
+        if (access(path, F_OK) != 0)
+            continue;
+        if (lahar_output_release_swmr(path) < 0) {
+            snprintf(err, n, "%s: cannot open it", path);
+            return -1;
+        }
+        hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+        H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+        hid_t f = (hid_t)lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
+        H5Pclose(fapl);
+        int rc = f < 0 ? -1 : 0;
+        /* a SWMR writer killed after its last flush leaves chunks past the end of allocation the
+         * superblock records (h5clear --increment does the same): take in what is on disk */
+        if (!rc && H5Fincrement_filesize(f, 0) < 0)
+            rc = -1;
+        if (!rc && i == 0) {
+            static const char *const names[] = {"t", "step", "force", "torque", "ncontacts"};
+            rc = out_trim_rows(f, names, 5, step);
+        } else if (!rc) {
+            hid_t pg = H5Gopen2(f, "probes", H5P_DEFAULT);
+            H5G_info_t info;
+            if (pg < 0 || H5Gget_info(pg, &info) < 0)
+                rc = -1;
+            for (hsize_t k = 0; !rc && k < info.nlinks; k++) {
+                char name[LAHAR_NAME_MAX + 8];
+                if (H5Lget_name_by_idx(pg, ".", H5_INDEX_NAME, H5_ITER_INC, k, name, sizeof name, H5P_DEFAULT) < 0) {
+                    rc = -1;
+                    break;
+                }
+                hid_t g = H5Gopen2(pg, name, H5P_DEFAULT);
+                static const char *const names[] = {"t", "step", "p"};
+                rc = g < 0 ? -1 : out_trim_rows(g, names, 3, step);
+                if (g >= 0)
+                    H5Gclose(g);
+            }
+            if (pg >= 0)
+                H5Gclose(pg);
+        }
+        if (f >= 0 && H5Fclose(f) < 0)
+            rc = -1;
+        if (rc) {
+            snprintf(err, n, "%s: cannot cut it back to the checkpoint (step %" PRId64 ")", path, step);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int lahar_body_output_sync(lahar_body_output *o)
+{
+    if (!o || o->fs.file < 0)
+        return 0;
+    int rc = forces_flush(&o->fs);
+    return H5Fflush(o->fs.file, H5F_SCOPE_GLOBAL) < 0 ? -1 : rc;
+}
+
 static int out_read_attr_int64(hid_t loc, const char *obj, const char *name, int64_t *v)
 {
     *v = 0;
@@ -1101,6 +1356,18 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
                 snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
         }
     snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
+    if (c->resume) { /* continue contacts.h5 as the checkpoint left it */
+        out_snap_entry *list = NULL;
+        int64_t cnt = out_read_snapshot_list(o->h5path, &list);
+        free(list);
+        if (cnt < 0) {
+            snprintf(err, n, "%s: cannot read it to continue it", o->h5path);
+            lahar_contact_output_close(o);
+            return NULL;
+        }
+        o->nsnap = cnt;
+        return o;
+    }
     hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
         snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
@@ -1365,6 +1632,36 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
     snprintf(path, sizeof path, "%s/gauges.h5", outdir);
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    if (c->resume) { /* continue the stream as lahar_output_resume_trim left it */
+        o->file = lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
+        H5Pclose(fapl);
+        int rc = o->file < 0 ? -1 : 0;
+        for (int k = 0; k < o->n && !rc; k++) {
+            gauge_stream *g = &o->g[k];
+            char name[LAHAR_NAME_MAX + 32];
+            hid_t *ids[] = {&g->t, &g->step, &g->p};
+            const char *dn[] = {"t", "step", "p"};
+            for (int d = 0; d < 3 && !rc; d++) {
+                snprintf(name, sizeof name, "probes/%s/%s", c->probes[k].name, dn[d]);
+                if ((*ids[d] = H5Dopen2(o->file, name, H5P_DEFAULT)) < 0)
+                    rc = -1;
+            }
+            if (!rc) {
+                hid_t sp = H5Dget_space(g->t);
+                hsize_t rows = 0;
+                H5Sget_simple_extent_dims(sp, &rows, NULL);
+                H5Sclose(sp);
+                g->rows = (int64_t)rows;
+            }
+        }
+        if (rc || H5Fstart_swmr_write(o->file) < 0) {
+            snprintf(err, n, "%s: cannot reopen the probe streams to continue them", path);
+            lahar_gauge_output_close(o);
+            return NULL;
+        }
+        o->last_flush = out_wall_seconds();
+        return o;
+    }
     o->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
     H5Pclose(fapl);
     if (o->file < 0) {
@@ -1461,6 +1758,14 @@ int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, cons
     if (full || out_wall_seconds() - o->last_flush >= FORCES_FLUSH_SECONDS)
         return gauge_flush(o);
     return 0;
+}
+
+int lahar_gauge_output_sync(lahar_gauge_output *o)
+{
+    if (!o || o->file < 0)
+        return 0;
+    int rc = gauge_flush(o);
+    return H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0 ? -1 : rc;
 }
 
 void lahar_gauge_output_close(lahar_gauge_output *o)

@@ -92,6 +92,18 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
 int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, const double *p, const int *due);
 void lahar_gauge_output_close(lahar_gauge_output *o);
 
+/* Checkpoints (common/checkpoint.h): a writer hands its buffered stream rows to the file before
+ * its node writes a checkpoint, so that rows up to the checkpoint survive a kill. 0 or -1. */
+int lahar_body_output_sync(lahar_body_output *o);
+int lahar_gauge_output_sync(lahar_gauge_output *o);
+/* `lahar resume` before the nodes start: cut the output of OUT back to the checkpoint of `step`
+ * (the state after step - 1): snapshots of particles.h5 and bodies.h5 with a larger step (and
+ * the one at `step` itself unless snapshot_at_step, i.e. unless it was a scheduled output time,
+ * not the final snapshot of a stopped run), contacts.h5 entries from `step` on, rows of
+ * forces.h5 and gauges.h5 after `step`; marks of a stopped run are removed. The writers, opened
+ * with lahar_case.resume set, then continue these files. 0, or -1 with a message. */
+int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_step, char *err, size_t n);
+
 /* Write OUT/lahar.xmf: one temporal collection whose time steps hold the body grids and the
  * particle grid of the snapshots found in OUT/bodies.h5 and OUT/particles.h5 (either may be
  * missing). Safe to call when no writer has the files open, e.g. by the coordinator at the end

@@ -221,6 +221,19 @@ typedef struct {
      * output_forces: 1 = write the per-body force stream (default), 0 = not. */
     unsigned output_fields;
     int output_forces;
+
+    /* checkpoint: section (coordinator/README.md "Checkpoints"): every checkpoint_interval s of
+     * simulated time (0: none) the nodes write their whole state to OUT/checkpoints/NNNNNN/;
+     * the newest checkpoint_keep are kept (default 2). */
+    double checkpoint_interval;
+    int checkpoint_keep;
+
+    /* Not case keys: set by `lahar resume` (and carried by the scene). resume = 1: the run
+     * continues from the checkpoint in resume_dir, the state of step resume_step; the output
+     * files are appended to, not created. */
+    int resume;
+    int64_t resume_step;
+    char resume_dir[1024];
 } lahar_case;
 
 /* Per-body state as exchanged with the other nodes (body_state_t). */

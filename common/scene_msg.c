@@ -94,6 +94,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->forces_interval = c->forces_interval;
     m->output_dir = (char *)output_dir;
     m->case_path = (char *)c->path;
+    m->resume_dir = (char *)(c->resume ? c->resume_dir : "");
+    m->resume_step = c->resume ? c->resume_step : -1;
     m->output_fields = (int32_t)c->output_fields;
     m->output_forces = (int8_t)(c->output_forces != 0);
     m->has_dem = (int8_t)(has_dem != 0);
@@ -248,6 +250,9 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         return -1;
     }
     snprintf(c->path, sizeof c->path, "%s", m->case_path ? m->case_path : "");
+    c->resume = m->resume_dir && m->resume_dir[0] && m->resume_step >= 0;
+    c->resume_step = c->resume ? m->resume_step : 0;
+    snprintf(c->resume_dir, sizeof c->resume_dir, "%s", c->resume ? m->resume_dir : "");
     c->dim = m->dim;
     c->output_fields = (unsigned)m->output_fields;
     c->output_forces = m->output_forces;

@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include "coordinator.h"
 #include <cjson/cJSON.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <libgen.h>
@@ -21,6 +22,8 @@
 #include <time.h>
 #include <unistd.h>
 #include "auth.h"
+#include "case.h"
+#include "checkpoint.h"
 #include "dem_node.h"
 #include "instability.h"
 #include "lahar_hello_t.h"
@@ -66,6 +69,7 @@ typedef struct {
     double dt_proposed, dt_stable, kinetic_energy;
     int ncontacts;
     double starved_s;            /* silence forgiven so far (COORD_NODE_STARVED_MAX) */
+    int checkpointed;            /* STATUS(k).checkpointed of the last step */
     lahar_status_t work;         /* the work_* fields of the last STATUS (cumulative) */
 } coord_node;
 
@@ -95,9 +99,36 @@ typedef struct {
     double stop_wait;       /* s the nodes get to exit after STOP (0: COORD_STOP_WAIT) */
     char auth_key_path[PATH_MAX]; /* authenticated run: the key file (absolute), passed to the nodes */
     uint8_t auth_key[LAHAR_AUTH_KEYBYTES];
+    /* checkpoints (case section checkpoint:; coordinator/README.md "Checkpoints and resume") */
+    int ckpt_on;
+    int ckpt_written;         /* checkpoints written by this invocation */
+    int64_t ckpt_last_step;   /* the newest complete checkpoint (-1: none) */
+    double ckpt_last_t;
+    int clean_stop;           /* stopped after a checkpoint (SIGTERM): STOP says 0, no final snapshots */
+    /* lahar resume: where the lockstep continues */
+    int resumed;
+    int64_t k0;
+    lahar_clock clk0;
+    double dt_allowed0, dt_first0;
+    char resume_dir[PATH_MAX];
+    double resume_t;
+    char resume_run_id[32];   /* the run id of the checkpoint's run */
 } coord;
 
 static volatile sig_atomic_t coord_interrupted;
+static volatile sig_atomic_t coord_term;          /* SIGTERM: with checkpoints, checkpoint then stop */
+static volatile sig_atomic_t coord_ckpt_request;  /* SIGUSR1: a checkpoint after the next step */
+static void coord_on_sigterm(int sig)
+{
+    (void)sig;
+    coord_term = 1;
+    coord_interrupted = 1;
+}
+static void coord_on_sigusr1(int sig)
+{
+    (void)sig;
+    coord_ckpt_request = 1;
+}
 
 /* Silence after which a node is lost (--node-timeout, else COORD_NODE_SILENCE). */
 static double coord_silence(const coord *co)
@@ -547,6 +578,7 @@ static int coord_collect_status(coord *co, int64_t k)
         n->dt_stable = s.dt_stable;
         n->kinetic_energy = s.kinetic_energy;
         n->ncontacts = s.ncontacts;
+        n->checkpointed = s.checkpointed;
         coord_take_work(n, &s);
         if (!err)
             n->last_step = k;
@@ -568,8 +600,9 @@ static void coord_progress(coord *co, int final)
         return;
     co->last_progress = now;
     double wall = now - co->wall0;
-    double rate = wall > 0 ? (double)co->steps / wall : 0.0;
-    double frac = co->c->t_end > 0 ? co->sim_time / co->c->t_end : 1.0;
+    double rate = wall > 0 ? (double)(co->steps - co->k0) / wall : 0.0;
+    double t0 = co->resumed ? co->resume_t : 0.0; /* this invocation's share of the run */
+    double frac = co->c->t_end > t0 ? (co->sim_time - t0) / (co->c->t_end - t0) : 1.0;
     double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
     fprintf(stderr, "\r  t = %.4g / %.4g s   step %lld   %.0f steps/s   ETA %.0f s   ", co->sim_time, co->c->t_end,
             (long long)co->steps, rate, eta);
@@ -620,6 +653,166 @@ static int coord_dt_collapse(coord *co, int64_t k, double dt_allowed, double dt_
     return 1;
 }
 
+/* ---- checkpoints --------------------------------------------------------------------------- */
+
+/* The coordinator's part of a checkpoint (common/checkpoint.h; one function both ways): the step
+ * and time, the clock, the next step's limit and the first step (dt collapse), whether the state
+ * is a scheduled snapshot, and the totals summary.json continues. */
+static int coord_state_io(coord *co, lahar_ckpt_file *f, int64_t *k, lahar_clock *clk, double *dt_allowed,
+                          double *dt_first, int *is_output)
+{
+    lahar_ckpt_i64(f, "step", k, 1);
+    lahar_ckpt_f64(f, "t", &co->sim_time, 1);
+    double cd[4] = {clk->t_end, clk->out_interval, clk->t_base, clk->h};
+    int64_t ci[4] = {clk->nout, clk->j, clk->i, clk->m};
+    lahar_ckpt_f64(f, "clock_t_end_interval_base_h", cd, 4);
+    lahar_ckpt_i64(f, "clock_nout_j_i_m", ci, 4);
+    double dts[2] = {*dt_allowed, *dt_first};
+    lahar_ckpt_f64(f, "dt_allowed_first", dts, 2);
+    lahar_ckpt_int(f, "snapshot_at_step", is_output);
+    lahar_ckpt_i64(f, "steps", &co->steps, 1);
+    int64_t run_id = co->run_id;
+    lahar_ckpt_i64(f, "run_id", &run_id, 1);
+    for (int r = 1; r < LAHAR_NROLES; r++) {
+        coord_node *n = &co->node[r];
+        char name[48];
+        double nf[5] = {n->compute_s, n->wait_s, n->dt_proposed, n->dt_stable, n->kinetic_energy};
+        int64_t ni[4] = {n->substeps, n->last_step, n->ncontacts, n->needed};
+        snprintf(name, sizeof name, "node%d_compute_wait_dtp_dts_ke", r);
+        lahar_ckpt_f64(f, name, nf, 5);
+        snprintf(name, sizeof name, "node%d_substeps_last_contacts_needed", r);
+        lahar_ckpt_i64(f, name, ni, 4);
+        if (!f->writing && !f->failed) {
+            n->compute_s = nf[0], n->wait_s = nf[1], n->dt_proposed = nf[2], n->dt_stable = nf[3];
+            n->kinetic_energy = nf[4];
+            n->substeps = ni[0], n->last_step = ni[1], n->ncontacts = (int)ni[2];
+            if (ni[3] != n->needed) {
+                snprintf(f->err, sizeof f->err, "the checkpoint's run %s a %s, this case %s (another case?)",
+                         ni[3] ? "had" : "had no", lahar_link_role_name(r), n->needed ? "needs one" : "none");
+                f->failed = 1;
+            }
+        }
+    }
+    if (!f->writing && !f->failed) {
+        clk->t_end = cd[0], clk->out_interval = cd[1], clk->t_base = cd[2], clk->h = cd[3];
+        clk->nout = ci[0], clk->j = ci[1], clk->i = ci[2], clk->m = ci[3];
+        *dt_allowed = dts[0], *dt_first = dts[1];
+        snprintf(co->resume_run_id, sizeof co->resume_run_id, "%016llx", (unsigned long long)run_id);
+    }
+    return f->failed ? -1 : 0;
+}
+
+/* Remove a checkpoint directory (its files, then itself). */
+static void coord_rm_ckpt_dir(const char *path)
+{
+    DIR *d = opendir(path);
+    if (d) {
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (e->d_name[0] == '.')
+                continue;
+            char p[4400];
+            snprintf(p, sizeof p, "%.4000s/%.255s", path, e->d_name);
+            unlink(p);
+        }
+        closedir(d);
+    }
+    rmdir(path);
+}
+
+/* The checkpoints in OUT/checkpoints: the step indices of the complete ones (NNNNNN holding
+ * coord.h5), newest first, into steps (up to cap); *.tmp ones (an interrupted checkpoint) are
+ * removed when remove_tmp. Returns the count. */
+static int coord_list_ckpts(const char *outdir, int64_t *steps, int cap, int remove_tmp)
+{
+    char dir[PATH_MAX + 32];
+    snprintf(dir, sizeof dir, "%s/" LAHAR_CKPT_DIR, outdir);
+    DIR *d = opendir(dir);
+    if (!d)
+        return 0;
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        char *end;
+        if (e->d_name[0] < '0' || e->d_name[0] > '9')
+            continue;
+        long long st = strtoll(e->d_name, &end, 10);
+        char path[PATH_MAX + 320];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        if (strcmp(end, ".tmp") == 0) {
+            if (remove_tmp)
+                coord_rm_ckpt_dir(path);
+            continue;
+        }
+        char coordf[PATH_MAX + 340];
+        snprintf(coordf, sizeof coordf, "%s/coord.h5", path);
+        if (*end || access(coordf, R_OK) != 0 || n >= cap)
+            continue;
+        steps[n++] = st;
+    }
+    closedir(d);
+    for (int i = 0; i < n; i++) /* newest first */
+        for (int j = i + 1; j < n; j++)
+            if (steps[j] > steps[i]) {
+                int64_t t = steps[i];
+                steps[i] = steps[j];
+                steps[j] = t;
+            }
+    return n;
+}
+
+/* After STATUS(k) of a step that carried the checkpoint flag (state K = k + 1): every node has
+ * written and synced NNNNNN.tmp/<role>.h5; write coord.h5 there, sync it and the directory,
+ * rename NNNNNN.tmp -> NNNNNN (atomic), sync OUT/checkpoints, and keep the newest
+ * checkpoint.keep. A crash at any moment leaves the previous checkpoint or the new one
+ * complete. 0, or -1 with co->message. */
+static int coord_checkpoint(coord *co, int64_t k, lahar_clock *clk, double dt_allowed, double dt_first, int is_output)
+{
+    int64_t K = k + 1;
+    char tmp[PATH_MAX + 64], fin[PATH_MAX + 64], path[PATH_MAX + 96], dir[PATH_MAX + 32];
+    lahar_ckpt_dir(tmp, sizeof tmp, co->outdir, K, 1);
+    lahar_ckpt_dir(fin, sizeof fin, co->outdir, K, 0);
+    snprintf(dir, sizeof dir, "%s/" LAHAR_CKPT_DIR, co->outdir);
+    for (int r = 1; r < LAHAR_NROLES; r++)
+        if (co->node[r].needed && !co->node[r].checkpointed) {
+            snprintf(co->message, sizeof co->message, "the %s did not write its checkpoint of step %lld",
+                     lahar_link_role_name(r), (long long)K);
+            return -1;
+        }
+    if (lahar_mkdir_p(tmp) != 0) {
+        snprintf(co->message, sizeof co->message, "cannot create %.900s: %s", tmp, strerror(errno));
+        return -1;
+    }
+    snprintf(path, sizeof path, "%s/coord.h5", tmp);
+    lahar_ckpt_file f;
+    int64_t kk = K;
+    if (lahar_ckpt_create(&f, path, "coordinator") == 0)
+        coord_state_io(co, &f, &kk, clk, &dt_allowed, &dt_first, &is_output);
+    if (lahar_ckpt_close(&f) != 0) {
+        snprintf(co->message, sizeof co->message, "%s", f.err);
+        return -1;
+    }
+    if (access(fin, F_OK) == 0) /* a checkpoint of this step from before a resume: replaced */
+        coord_rm_ckpt_dir(fin);
+    if (lahar_ckpt_fsync_path(tmp) != 0 || rename(tmp, fin) != 0 || lahar_ckpt_fsync_path(dir) != 0) {
+        snprintf(co->message, sizeof co->message, "cannot complete the checkpoint %.900s: %s", fin, strerror(errno));
+        return -1;
+    }
+    co->ckpt_written++;
+    co->ckpt_last_step = K;
+    co->ckpt_last_t = co->sim_time;
+    int64_t steps[1024];
+    int n = coord_list_ckpts(co->outdir, steps, 1024, 0);
+    int keep = co->c->checkpoint_keep > 0 ? co->c->checkpoint_keep : 2;
+    for (int i = keep; i < n; i++) {
+        lahar_ckpt_dir(path, sizeof path, co->outdir, steps[i], 0);
+        coord_rm_ckpt_dir(path);
+    }
+    if (n > keep)
+        lahar_ckpt_fsync_path(dir);
+    return 0;
+}
+
 static int coord_lockstep(coord *co)
 {
     const lahar_case *c = co->c;
@@ -629,8 +822,16 @@ static int coord_lockstep(coord *co)
     for (int r = 1; r < LAHAR_NROLES; r++)
         if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed < dt_allowed)
             dt_allowed = co->node[r].dt_proposed;
-    for (int64_t k = 0;; k++) {
-        if (coord_interrupted) {
+    int64_t k0 = 0;
+    if (co->resumed) { /* lahar resume: the clock and limits of the checkpoint */
+        clk = co->clk0;
+        dt_allowed = co->dt_allowed0;
+        dt_first = co->dt_first0;
+        k0 = co->k0;
+    }
+    int stop_after = 0;
+    for (int64_t k = k0;; k++) {
+        if (coord_interrupted && !(coord_term && co->ckpt_on)) {
             co->status = "interrupted";
             snprintf(co->message, sizeof co->message, "interrupted at step %lld (t = %.9g s)", (long long)k, co->sim_time);
             return LAHAR_EXIT_RUN_ERROR;
@@ -646,9 +847,27 @@ static int coord_lockstep(coord *co)
         int write_forces = 1;
         if (c->forces_interval > 0)
             write_forces = k == 0 || floor(t_next / c->forces_interval + 1e-9) > floor(t / c->forces_interval + 1e-9);
+        /* a checkpoint after the first step ending at or after each multiple of the interval
+         * (integers, as write_forces), after the last step, on SIGUSR1, and on SIGTERM (then
+         * the run stops, resumable) */
+        int ckpt = 0;
+        if (co->ckpt_on) {
+            const double ci = c->checkpoint_interval;
+            ckpt = floor(t_next / ci + 1e-9) > floor(t / ci + 1e-9) || (is_output && clk.j + 1 >= clk.nout);
+            if (coord_ckpt_request || coord_term)
+                ckpt = 1;
+            if (coord_term)
+                stop_after = 1;
+            coord_ckpt_request = 0;
+        } else if (coord_ckpt_request) {
+            coord_ckpt_request = 0;
+            fprintf(stderr, "\nlahar: SIGUSR1: this case has no checkpoint: section, so no checkpoint is written\n");
+        }
+        for (int r = 1; r < LAHAR_NROLES; r++)
+            co->node[r].checkpointed = 0;
         lahar_step_t s = {
             .run_id = co->run_id, .step = k, .t = t, .dt = t_next - t, .t_next = t_next,
-            .write_output = (int8_t)is_output, .write_forces = (int8_t)write_forces,
+            .write_output = (int8_t)is_output, .write_forces = (int8_t)write_forces, .checkpoint = (int8_t)ckpt,
         };
         int rc;
         LAHAR_LINK_SEND(rc, co->link, LAHAR_FRAME_T_MSG_STEP, lahar_step_t, k, &s);
@@ -668,6 +887,17 @@ static int coord_lockstep(coord *co)
         for (int r = 1; r < LAHAR_NROLES; r++)
             if (co->node[r].needed && co->node[r].dt_proposed > 0 && co->node[r].dt_proposed < dt_allowed)
                 dt_allowed = co->node[r].dt_proposed;
+        if (ckpt && coord_checkpoint(co, k, &clk, dt_allowed, dt_first, is_output) != 0) {
+            co->status = "error";
+            return LAHAR_EXIT_RUN_ERROR;
+        }
+        if (stop_after && clk.j < clk.nout) { /* (at the end time the run simply finishes) */
+            co->status = "stopped";
+            co->clean_stop = 1;
+            snprintf(co->message, sizeof co->message, "stopped by SIGTERM after the checkpoint of step %lld (t = %.9g "
+                     "s); continue with `lahar resume %.800s`", (long long)(k + 1), co->sim_time, co->outdir);
+            return LAHAR_EXIT_RUN_ERROR;
+        }
         coord_progress(co, 0);
     }
 }
@@ -742,7 +972,8 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(root, "t_end", co->c->t_end);
     double wall = lahar_now() - co->wall0;
     cJSON_AddNumberToObject(root, "wall_time_s", wall);
-    cJSON_AddNumberToObject(root, "steps_per_s", wall > 0 ? (double)co->steps / wall : 0.0);
+    /* a resumed run: steps counts from t = 0, the rate only this invocation's */
+    cJSON_AddNumberToObject(root, "steps_per_s", wall > 0 ? (double)(co->steps - co->k0) / wall : 0.0);
     /* the wall time split: start-up (nodes started, scene sent, nodes set up), the steps, the end
      * (STOP, nodes' last output and exit, this summary): the steps' share is what a longer run
      * scales */
@@ -818,6 +1049,24 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(auth, "frames_replayed", replayed);
     coord_summary_work(co, root);
     coord_summary_instability(co, root);
+    if (co->ckpt_on || co->resumed) {
+        cJSON *ck = cJSON_AddObjectToObject(root, "checkpoints");
+        cJSON_AddNumberToObject(ck, "interval", co->c->checkpoint_interval);
+        cJSON_AddNumberToObject(ck, "keep", co->c->checkpoint_keep);
+        cJSON_AddNumberToObject(ck, "written", co->ckpt_written);
+        cJSON_AddNumberToObject(ck, "last_step", (double)co->ckpt_last_step);
+        if (co->ckpt_last_step >= 0)
+            cJSON_AddNumberToObject(ck, "last_time", co->ckpt_last_t);
+        else
+            cJSON_AddNullToObject(ck, "last_time");
+    }
+    if (co->resumed) {
+        cJSON *r = cJSON_AddObjectToObject(root, "resumed_from");
+        cJSON_AddStringToObject(r, "checkpoint", co->resume_dir);
+        cJSON_AddNumberToObject(r, "step", (double)co->k0);
+        cJSON_AddNumberToObject(r, "time", co->resume_t);
+        cJSON_AddStringToObject(r, "run_id", co->resume_run_id);
+    }
     char *text = cJSON_Print(root);
     char path[PATH_MAX + 32];
     snprintf(path, sizeof path, "%s/summary.json", co->outdir);
@@ -835,20 +1084,6 @@ static void coord_write_summary(coord *co)
 }
 
 /* ---- entry --------------------------------------------------------------------------------- */
-
-static int coord_mkdir_p(const char *path)
-{
-    char tmp[PATH_MAX];
-    snprintf(tmp, sizeof tmp, "%s", path);
-    for (char *p = tmp + 1; *p; p++)
-        if (*p == '/') {
-            *p = '\0';
-            if (mkdir(tmp, 0777) != 0 && errno != EEXIST)
-                return -1;
-            *p = '/';
-        }
-    return (mkdir(tmp, 0777) != 0 && errno != EEXIST) ? -1 : 0;
-}
 
 /* OUT/.lahar.lock, held (flock) for the whole run: a second run into the same directory is refused
  * with the holder's pid, host, start time and case (the file's text), instead of two runs writing
@@ -914,10 +1149,34 @@ static int coord_clear_outdir(const char *outdir, int overwrite)
             nf += (size_t)snprintf(found + nf, sizeof found - nf, "%s%s", nf ? ", " : "", lahar_output_run_files[i]);
         }
     }
+    /* the checkpoints of an earlier run (and the copy of its case) */
+    snprintf(path, sizeof path, "%s/" LAHAR_CKPT_DIR, outdir);
+    DIR *d = opendir(path);
+    if (d && overwrite) {
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (e->d_name[0] == '.')
+                continue;
+            char p[4400];
+            snprintf(p, sizeof p, "%.4000s/%.255s", path, e->d_name);
+            if (unlink(p) != 0)
+                coord_rm_ckpt_dir(p);
+        }
+        closedir(d);
+        if (rmdir(path) != 0) {
+            fprintf(stderr, "lahar: --overwrite: cannot remove %s: %s\n", path, strerror(errno));
+            return -1;
+        }
+    } else if (d) {
+        closedir(d);
+        if (nf < sizeof found)
+            nf += (size_t)snprintf(found + nf, sizeof found - nf, "%s" LAHAR_CKPT_DIR "/", nf ? ", " : "");
+    }
     if (!found[0])
         return 0;
     fprintf(stderr, "lahar: %s holds the output of an earlier run (%s); add --overwrite to replace it (those files "
-                    "are removed first), or choose another -o\n", outdir, found);
+                    "are removed first),%s or choose another -o\n", outdir, found,
+            strstr(found, LAHAR_CKPT_DIR) ? " continue it with `lahar resume OUT`," : "");
     return -1;
 }
 
@@ -949,6 +1208,158 @@ static int coord_dem_needed(const lahar_case *c)
     return 0;
 }
 
+/* A run with checkpoints keeps the case it was started with in OUT/checkpoints: case.yaml (a
+ * byte copy) and case_source (the original path and the directory its relative paths start
+ * from), so that `lahar resume OUT` needs nothing else. 0 or -1 (message on stderr). */
+static int coord_save_case(const char *outdir, const lahar_case *c)
+{
+    char dir[PATH_MAX + 32], path[PATH_MAX + 64], src_dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s/" LAHAR_CKPT_DIR, outdir);
+    if (lahar_mkdir_p(dir) != 0) {
+        fprintf(stderr, "lahar: cannot create %s: %s\n", dir, strerror(errno));
+        return -1;
+    }
+    char tmp[PATH_MAX];
+    snprintf(tmp, sizeof tmp, "%s", c->path);
+    if (!realpath(dirname(tmp), src_dir))
+        snprintf(src_dir, sizeof src_dir, ".");
+    FILE *in = fopen(c->path, "rb");
+    snprintf(path, sizeof path, "%s/case.yaml", dir);
+    FILE *out = in ? fopen(path, "wb") : NULL;
+    int rc = in && out ? 0 : -1;
+    char buf[65536];
+    size_t n;
+    while (!rc && (n = fread(buf, 1, sizeof buf, in)) > 0)
+        if (fwrite(buf, 1, n, out) != n)
+            rc = -1;
+    if (in)
+        fclose(in);
+    if (out && fclose(out) != 0)
+        rc = -1;
+    snprintf(path, sizeof path, "%s/case_source", dir);
+    char abs[PATH_MAX];
+    if (!realpath(c->path, abs))
+        snprintf(abs, sizeof abs, "%s", c->path);
+    out = rc ? NULL : fopen(path, "w");
+    if (!out || fprintf(out, "%s\n%s\n", abs, src_dir) < 0)
+        rc = -1;
+    if (out && fclose(out) != 0)
+        rc = -1;
+    if (rc)
+        fprintf(stderr, "lahar: cannot keep a copy of the case %s in %s: %s\n", c->path, dir, strerror(errno));
+    return rc;
+}
+
+int lahar_coord_resume_case(const char *outdir, lahar_case *c)
+{
+    char path[PATH_MAX + 64], src[PATH_MAX + 64], line1[PATH_MAX], line2[PATH_MAX];
+    snprintf(src, sizeof src, "%s/" LAHAR_CKPT_DIR "/case_source", outdir);
+    FILE *f = fopen(src, "r");
+    if (!f) {
+        fprintf(stderr, "lahar resume: %s has no checkpoints (no %s: the run's case had no checkpoint: section, "
+                        "or this is not a lahar output directory); start it again with `lahar run CASE -o %s "
+                        "--overwrite`\n", outdir, src, outdir);
+        return LAHAR_EXIT_SETUP;
+    }
+    int ok = fgets(line1, sizeof line1, f) && fgets(line2, sizeof line2, f);
+    fclose(f);
+    if (!ok) {
+        fprintf(stderr, "lahar resume: %s is incomplete; start the run again with lahar run --overwrite\n", src);
+        return LAHAR_EXIT_SETUP;
+    }
+    line1[strcspn(line1, "\n")] = '\0';
+    line2[strcspn(line2, "\n")] = '\0';
+    snprintf(path, sizeof path, "%s/" LAHAR_CKPT_DIR "/case.yaml", outdir);
+    char err[2048];
+    if (lahar_case_load_dir(path, line2, c, err, sizeof err) != 0) {
+        fprintf(stderr, "lahar resume: %s (the run's case, kept in %s; its files are read from %s)\n", err, path,
+                line2);
+        return LAHAR_EXIT_SETUP;
+    }
+    snprintf(c->path, sizeof c->path, "%.1023s", line1);
+    return 0;
+}
+
+/* `lahar resume`: the newest complete checkpoint of OUT (stale *.tmp removed), its coordinator
+ * state, the output cut back to it; fills the resume fields of rc. 0, or -1 with a message on
+ * stderr (status 2). 1: nothing to do (the checkpoint is at the end time). */
+static int coord_resume_prepare(coord *co, lahar_case *rc, double t_end)
+{
+    int64_t steps[1024];
+    int n = coord_list_ckpts(co->outdir, steps, 1024, 1);
+    if (n == 0) {
+        fprintf(stderr, "lahar resume: %s has no complete checkpoint (none was written before the run ended); "
+                        "start it again with `lahar run CASE -o %s --overwrite`\n", co->outdir, co->outdir);
+        return -1;
+    }
+    char dir[PATH_MAX + 64], path[PATH_MAX + 96];
+    lahar_ckpt_dir(dir, sizeof dir, co->outdir, steps[0], 0);
+    snprintf(path, sizeof path, "%s/coord.h5", dir);
+    lahar_ckpt_file f;
+    int64_t k = -1;
+    int is_output = 0;
+    if (lahar_ckpt_open(&f, path, "coordinator") == 0)
+        coord_state_io(co, &f, &k, &co->clk0, &co->dt_allowed0, &co->dt_first0, &is_output);
+    if (lahar_ckpt_close(&f) != 0) {
+        fprintf(stderr, "lahar resume: %s\n", f.err);
+        return -1;
+    }
+    if (k != steps[0]) {
+        fprintf(stderr, "lahar resume: %s holds step %lld, not %lld\n", path, (long long)k, (long long)steps[0]);
+        return -1;
+    }
+    co->resume_t = co->sim_time;
+    if (t_end > 0.0) {
+        if (!(t_end > co->resume_t) || t_end < rc->output_interval) {
+            fprintf(stderr, "lahar resume: --time-end %g must be later than the checkpoint (t = %.9g s) and at least "
+                            "output_interval (%g s)\n", t_end, co->resume_t, rc->output_interval);
+            return -1;
+        }
+        rc->t_end = t_end;
+    }
+    if (co->resume_t >= rc->t_end * (1.0 - 1e-12)) {
+        printf("lahar resume: the run in %s is at its end time already (checkpoint of step %lld, t = %.9g s); "
+               "give --time-end T to extend it\n", co->outdir, (long long)k, co->resume_t);
+        return 1;
+    }
+    if (rc->t_end != co->clk0.t_end) {
+        /* a later end: the output times after the checkpoint are those of a run to the new end;
+         * a segment aimed at the old end is planned again from the checkpoint's time */
+        lahar_clock fresh;
+        lahar_clock_init(&fresh, rc->t_end, rc->output_interval);
+        double old_target = lahar_clock_output_time(&co->clk0, co->clk0.j + 1);
+        co->clk0.t_end = fresh.t_end;
+        co->clk0.out_interval = fresh.out_interval;
+        co->clk0.nout = fresh.nout;
+        if (co->clk0.m > 0 && lahar_clock_output_time(&co->clk0, co->clk0.j + 1) != old_target) {
+            co->clk0.t_base = co->resume_t;
+            co->clk0.i = 0;
+            co->clk0.m = 0;
+        }
+    }
+    char err[1024];
+    if (lahar_output_resume_trim(co->outdir, k, is_output, err, sizeof err) != 0) {
+        fprintf(stderr, "lahar resume: %s\n", err);
+        return -1;
+    }
+    co->resumed = 1;
+    co->k0 = k;
+    co->steps = k;
+    co->ckpt_last_step = k;
+    co->ckpt_last_t = co->resume_t;
+    size_t dlen = strlen(dir);
+    if (dlen >= sizeof rc->resume_dir) {
+        fprintf(stderr, "lahar resume: the checkpoint's path %s is longer than %zu characters\n", dir,
+                sizeof rc->resume_dir - 1);
+        return -1;
+    }
+    memcpy(co->resume_dir, dir, dlen + 1);
+    rc->resume = 1;
+    rc->resume_step = k;
+    memcpy(rc->resume_dir, dir, dlen + 1);
+    return 0;
+}
+
 int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
 {
     coord co;
@@ -963,14 +1374,27 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
         return LAHAR_EXIT_SETUP;
     }
-    if (coord_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
+    if (lahar_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
         fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", o->outdir, strerror(errno));
         return LAHAR_EXIT_SETUP;
     }
     int lock_fd = coord_lock_outdir(co.outdir, c->path);
     if (lock_fd < 0)
         return LAHAR_EXIT_SETUP;
-    if (coord_clear_outdir(co.outdir, o->overwrite) != 0) {
+    co.ckpt_last_step = -1;
+    co.ckpt_on = c->checkpoint_interval > 0.0;
+    static lahar_case resumed_case; /* the case with the resume fields (and a later end) */
+    if (o->resume) {
+        resumed_case = *c;
+        int rc = coord_resume_prepare(&co, &resumed_case, o->resume_t_end);
+        if (rc != 0) {
+            close(lock_fd);
+            return rc > 0 ? LAHAR_EXIT_OK : LAHAR_EXIT_SETUP;
+        }
+        c = &resumed_case;
+        co.c = c;
+    } else if (coord_clear_outdir(co.outdir, o->overwrite) != 0 ||
+               (co.ckpt_on && coord_save_case(co.outdir, c) != 0)) {
         close(lock_fd);
         return LAHAR_EXIT_SETUP;
     }
@@ -1024,7 +1448,11 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = coord_on_sigint;
     sigaction(SIGINT, &sa, NULL);
+    if (co.ckpt_on) /* SIGTERM: a checkpoint, then a clean stop (resumable) */
+        sa.sa_handler = coord_on_sigterm;
     sigaction(SIGTERM, &sa, NULL);
+    sa.sa_handler = coord_on_sigusr1;
+    sigaction(SIGUSR1, &sa, NULL);
 
     int status = LAHAR_EXIT_SETUP;
     co.t = lahar_transport_open(co.url, err, sizeof err);
@@ -1089,7 +1517,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         co.status = "finished";
 stop:
     coord_progress(&co, 1);
-    coord_send_stop(&co, status == LAHAR_EXIT_OK ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
+    coord_send_stop(&co, status == LAHAR_EXIT_OK || co.clean_stop ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
                     co.message);
     coord_finish_nodes(&co);
     /* a node that fails on its way out (an output error at close, a sanitizer report) fails the run */

@@ -18,6 +18,8 @@ typedef struct {
     double node_timeout_s; /* a node silent this long is lost, unless it is ours and still computing
                               (default COORD_NODE_SILENCE, 2 s) */
     const char *argv0;     /* for locating lahar-dem / lahar-sph next to lahar */
+    int resume;            /* `lahar resume OUT`: continue the run in outdir from its newest checkpoint */
+    double resume_t_end;   /* > 0: the resumed run ends at this time instead of the case's time.end */
 } lahar_coord_options;
 
 /* Exit statuses of `lahar run`. */
@@ -45,6 +47,11 @@ double lahar_clock_output_time(const lahar_clock *c, int64_t j);
 int lahar_clock_next(lahar_clock *c, double dt_allowed, double *t, double *t_next, int *is_output);
 /* Commit the planned step. */
 void lahar_clock_advance(lahar_clock *c);
+
+/* `lahar resume OUT`: load the case the run in OUT was started with (OUT/checkpoints/case.yaml,
+ * its relative paths resolved against the original case's directory). 0, or 2 with a message
+ * on stderr (no checkpoints, unreadable case). */
+int lahar_coord_resume_case(const char *outdir, lahar_case *c);
 
 /* Run a loaded case (case.h). Returns a LAHAR_EXIT_* status. Call before creating threads (the
  * private network namespace requires a single-threaded process). */

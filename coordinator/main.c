@@ -26,6 +26,9 @@ static void usage(FILE *f)
             "       lahar bench -o OUT [--quick] [options]   run time against error of the validation cases,\n"
             "                                                co-simulation overhead, DEM subcycling: CSV, PNG\n"
             "                                                and OUT/summary.md (`lahar bench --help`)\n"
+            "       lahar resume OUT [--time-end T] [options] continue the run in OUT from its newest\n"
+            "                                                checkpoint (case section checkpoint:), to its\n"
+            "                                                time.end or to T; same options as run\n"
             "       lahar keygen FILE                        a new key for --auth-key (mode 0600)\n"
             "       lahar --help | --version\n\n"
             "Options of run and check:\n"
@@ -52,6 +55,7 @@ static void usage(FILE *f)
             "  -q, --quiet        no progress line and no closing hints\n"
             "  --allow-large      run a case whose estimated memory (`lahar validate` prints it) exceeds\n"
             "                     this machine's; without it such a run is refused (exit 2)\n"
+            "  --time-end T       (resume) end the resumed run at T s instead of the case's time.end\n"
             "  --evaluate-only    (check) do not simulate: evaluate the check: section on the output\n"
             "                     already in OUT (e.g. after changing a bound, or of a run on a cluster)\n\n"
             "By default lahar creates a private network namespace (unshare of user + network namespaces)\n"
@@ -210,8 +214,9 @@ int main(int argc, char **argv)
         return 0;
     }
     int is_run = !strcmp(cmd, "run"), is_check = !strcmp(cmd, "check"), is_validate = !strcmp(cmd, "validate");
-    if (!is_run && !is_check && !is_validate) {
-        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, bench, keygen)\n", cmd);
+    int is_resume = !strcmp(cmd, "resume");
+    if (!is_run && !is_check && !is_validate && !is_resume) {
+        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, resume, bench, keygen)\n", cmd);
         usage(stderr);
         return 2;
     }
@@ -224,7 +229,7 @@ int main(int argc, char **argv)
         {"quiet", no_argument, NULL, 'q'},        {"help", no_argument, NULL, 'h'},
         {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
         {"node-timeout", required_argument, NULL, 'T'}, {"overwrite", no_argument, NULL, 'O'},
-        {"auth-key", required_argument, NULL, 'K'},
+        {"auth-key", required_argument, NULL, 'K'}, {"time-end", required_argument, NULL, 'E'},
         {NULL, 0, NULL, 0},
     };
     optind = 2;
@@ -248,6 +253,15 @@ int main(int argc, char **argv)
         case 'L': allow_large = 1; break;
         case 'O': o.overwrite = 1; break;
         case 'K': o.auth_key_path = optarg; break;
+        case 'E':
+            if (!is_resume) {
+                fprintf(stderr, "lahar %s: --time-end belongs to `lahar resume` (the case's time.end sets a run's end)\n",
+                        cmd);
+                return 2;
+            }
+            if (parse_seconds_option(cmd, "--time-end", optarg, 0.0, 1e12, &o.resume_t_end) != 0)
+                return 2;
+            break;
         case 'T':
             if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, &o.node_timeout_s) != 0)
                 return 2;
@@ -255,6 +269,26 @@ int main(int argc, char **argv)
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
+    }
+    if (is_resume) {
+        /* lahar resume OUT: the case the run was started with, kept in OUT/checkpoints */
+        if (optind != argc - 1 || o.outdir) {
+            fprintf(stderr, "lahar resume: expected exactly one output directory (lahar resume OUT [options])\n");
+            return 2;
+        }
+        o.outdir = argv[optind];
+        o.resume = 1;
+        if (o.in_process && (o.no_spawn || o.lcm_url)) {
+            fprintf(stderr, "lahar resume: --in-process runs without network; it excludes --no-spawn and --lcm-url\n");
+            return 2;
+        }
+        lahar_case rc;
+        int st = lahar_coord_resume_case(o.outdir, &rc);
+        if (st != 0)
+            return st;
+        st = check_dem_engine(&rc) != 0 ? LAHAR_EXIT_BAD_INPUT : lahar_coord_run(&rc, &o);
+        lahar_case_free(&rc);
+        return st;
     }
     if (optind != argc - 1) {
         fprintf(stderr, "lahar %s: expected exactly one case file\n", cmd);

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "checkpoint.h"
 #include "dem_engine.h"
 #include "instability.h"
 #include "node_cli.h"
@@ -45,6 +46,7 @@ typedef struct {
     int32_t *moving_id;
     double (*bx)[3], (*bq)[4], (*bv)[3], (*bw)[3];
     double **px, **pq, **pv, **pw;
+    long long work_body_body0; /* body-body contacts evaluated before a resume (the engine counts from its create) */
 } dem_node;
 
 static void dem_node_free(dem_node *d)
@@ -227,7 +229,78 @@ static void dem_node_final_snapshot(dem_node *d, const lahar_link_msg *stop, int
     lahar_output_mark_last_snapshot(d->ns.output_dir, "bodies.h5", "stopped", why);
 }
 
-static int dem_node_loop(dem_node *d)
+/* The node's whole state for a checkpoint (common/checkpoint.h; one function both ways): the
+ * engine's restart blob (bodies and contact history, dem_engine.h) and the loop's own state.
+ * Returns 0, or -1 with the message in f->err. */
+static int dem_node_state_io(dem_node *d, lahar_ckpt_file *f, int64_t *k, double *t_now, int *at_output_time,
+                             int64_t *last_snapshot)
+{
+    lahar_ckpt_i64(f, "step", k, 1);
+    lahar_ckpt_f64(f, "t", t_now, 1);
+    lahar_ckpt_int(f, "at_output_time", at_output_time);
+    lahar_ckpt_i64(f, "last_snapshot", last_snapshot, 1);
+    /* the work counter of summary.json continues across a resume */
+    const long long now = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
+    int64_t work = now + d->work_body_body0;
+    lahar_ckpt_i64(f, "work_body_body", &work, 1);
+    if (!f->writing && !f->failed)
+        d->work_body_body0 = work - now;
+    void *blob = NULL;
+    size_t len = 0;
+    if (f->writing) {
+        FILE *m = open_memstream((char **)&blob, &len);
+        int rc = m ? d->ops->write_restart(d->engine, m) : -1;
+        if (m && fclose(m) != 0)
+            rc = -1;
+        if (rc != 0) {
+            free(blob);
+            snprintf(f->err, sizeof f->err, "the DEM engine %s cannot write its restart data", d->ops->name);
+            f->failed = 1;
+            return -1;
+        }
+        lahar_ckpt_blob(f, "engine_restart", &blob, &len);
+    } else {
+        lahar_ckpt_blob(f, "engine_restart", &blob, &len);
+        FILE *m = !f->failed ? fmemopen(blob, len, "rb") : NULL;
+        if (!f->failed && (!m || d->ops->read_restart(d->engine, m) != 0)) {
+            snprintf(f->err, sizeof f->err, "the DEM engine %s cannot read the checkpoint's restart data (another "
+                     "engine, case or build?)", d->ops->name);
+            f->failed = 1;
+        }
+        if (m)
+            fclose(m);
+    }
+    free(blob);
+    return f->failed ? -1 : 0;
+}
+
+/* Step k done (the state of step index k + 1 at t_next): flush the force stream and write
+ * OUT/checkpoints/NNNNNN.tmp/dem.h5, synced. 0, or -1 with a message in err. */
+static int dem_node_checkpoint(dem_node *d, int64_t state_step, double t, int at_output_time, int64_t last_snapshot,
+                               char *err, size_t errlen)
+{
+    char dir[1200], path[1300];
+    lahar_ckpt_dir(dir, sizeof dir, d->ns.output_dir, state_step, 1);
+    snprintf(path, sizeof path, "%s/dem.h5", dir);
+    if (lahar_body_output_sync(d->out) != 0 || lahar_mkdir_p(dir) != 0) {
+        snprintf(err, errlen, "cannot write the checkpoint in %s", dir);
+        return -1;
+    }
+    lahar_ckpt_file f;
+    int64_t k = state_step;
+    double tt = t;
+    int ao = at_output_time;
+    int64_t ls = last_snapshot;
+    if (lahar_ckpt_create(&f, path, "dem") == 0)
+        dem_node_state_io(d, &f, &k, &tt, &ao, &ls);
+    if (lahar_ckpt_close(&f) != 0) {
+        snprintf(err, errlen, "%s", f.err);
+        return -1;
+    }
+    return 0;
+}
+
+static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int64_t last_snapshot0)
 {
     char err[2048];
     lahar_link_msg msg;
@@ -235,10 +308,10 @@ static int dem_node_loop(dem_node *d)
     int moving = 0;
     for (int i = 0; i < d->ns.scene.nbody; i++)
         moving += d->ns.scene.bodies[i].motion != LAHAR_MOTION_FIXED;
-    int at_output_time = 1; /* t_0 */
-    int64_t last_snapshot = 0;
-    double t_now = 0.0; /* time of the state: the end of the last step taken */
-    for (int64_t k = 0;; k++) {
+    int at_output_time = at_output0; /* t_0: 1 */
+    int64_t last_snapshot = last_snapshot0;
+    double t_now = t0; /* time of the state: the end of the last step taken */
+    for (int64_t k = k0;; k++) {
         double wait0 = lahar_link_wait_seconds(d->link);
         lahar_step_t step;
         int rc = lahar_node_wait_step(d->link, "lahar-dem", k, &msg, &step);
@@ -306,7 +379,13 @@ static int dem_node_loop(dem_node *d)
         st.ncontacts = d->ops->ncontacts(d->engine);
         st.nsubsteps = nsub > 0 ? nsub : 0;
         st.kinetic_energy = d->ops->kinetic_energy(d->engine);
-        st.work_body_body = d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0;
+        st.work_body_body = (d->ops->contacts_evaluated ? d->ops->contacts_evaluated(d->engine) : 0) + d->work_body_body0;
+        if (step.checkpoint && !st.error) {
+            if (dem_node_checkpoint(d, k + 1, step.t_next, at_output_time, last_snapshot, err, sizeof err) == 0)
+                st.checkpointed = 1;
+            else
+                st.error = 1;
+        }
         lahar_node_send_status(d->link, ROLE, k, &st, err);
         if (st.error) {
             fprintf(stderr, "lahar-dem: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
@@ -349,6 +428,9 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     }
     /* Ready = STATUS(-1); an error here (unknown engine, unwritable output) stops the run. */
     lahar_status_t st = {0};
+    int64_t k0 = 0, last_snapshot0 = 0;
+    double t0 = 0.0;
+    int at_output0 = 1;
     err[0] = '\0';
     d.ops = lahar_dem_engine_find(d.ns.scene.dem_engine);
     if (!d.ops)
@@ -362,7 +444,19 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     else if (d.ns.has_sph && !(d.contacts = lahar_contact_output_open(d.ns.output_dir, &d.ns.scene, err, sizeof err)) &&
              err[0])
         ;
-    else {
+    else if (d.ns.scene.resume) {
+        /* lahar resume: the state of the checkpoint instead of the initial one */
+        char path[1300];
+        snprintf(path, sizeof path, "%s/dem.h5", d.ns.scene.resume_dir);
+        lahar_ckpt_file f;
+        if (lahar_ckpt_open(&f, path, "dem") == 0)
+            dem_node_state_io(&d, &f, &k0, &t0, &at_output0, &last_snapshot0);
+        if (lahar_ckpt_close(&f) != 0)
+            snprintf(err, sizeof err, "%s", f.err);
+        else if (k0 != d.ns.scene.resume_step)
+            snprintf(err, sizeof err, "%s holds step %lld, the coordinator resumes step %lld", path, (long long)k0,
+                     (long long)d.ns.scene.resume_step);
+    } else {
         dem_node_get_states(&d);
         if (lahar_body_output_snapshot(d.out, 0, 0.0, d.states) != 0)
             snprintf(err, sizeof err, "cannot write the first snapshot in %s", d.ns.output_dir);
@@ -380,7 +474,7 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
         status = 1;
         goto done;
     }
-    status = dem_node_loop(&d);
+    status = dem_node_loop(&d, k0, t0, at_output0, last_snapshot0);
 done:
     lahar_link_heartbeat_stop(d.link);
     dem_node_free(&d);

@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "checkpoint.h"
 #include "instability.h"
 #include "lahar_body_state_t.h"
 #include "lahar_loads_t.h"
@@ -518,6 +519,8 @@ static int sph_node_fixed_open(sph_node *s, char *err, size_t errlen)
     if (!(s->cout = lahar_contact_output_open(s->ns.output_dir, c, err, errlen)) && err[0])
         return -1;
     s->at_output_time = 1; /* t_0 */
+    if (c->resume) /* the snapshot of t = 0 is on disk; the checkpoint has the rest */
+        return 0;
     if (sph_node_fixed_snapshot(s, 0, 0.0) != 0) {
         snprintf(err, errlen, "cannot write the first body snapshot in %s", s->ns.output_dir);
         return -1;
@@ -804,6 +807,8 @@ static int sph_node_probes_open(sph_node *s, char *err, size_t errlen)
     }
     if (!(s->gauges = lahar_gauge_output_open(s->ns.output_dir, c, err, errlen)))
         return -1;
+    if (c->resume) /* the sample of t = 0 is on disk */
+        return 0;
     sph_probes_sample(&s->probes, &s->f, c, s->nbody > 0 ? s->states : NULL, 0.0);
     if (lahar_gauge_output_write(s->gauges, 0, 0.0, s->probes.value, s->probes.due) != 0) {
         snprintf(err, errlen, "cannot write gauges.h5 in %s", s->ns.output_dir);
@@ -822,13 +827,148 @@ static int sph_node_probes_sample(sph_node *s, int64_t k, double t)
     return lahar_gauge_output_write(s->gauges, k + 1, t, s->probes.value, s->probes.due);
 }
 
-static int sph_node_loop(sph_node *s)
+/* ---- checkpoints (common/checkpoint.h) -------------------------------------------------------
+ * Everything step k + 1 reads of the state after step k, in the particles' current (sorted)
+ * order: the particle arrays (incl. the rates of the last evaluation, which the first kick of
+ * the next step uses, and the soil's stress and stress rate), the solver's counters (step: the
+ * Shepard filter's period), the transport velocity's b, the coupling's forces and contact points
+ * of the last evaluation (LOADS of the next step) and the soil-DEM friction springs, the body
+ * states the coupling uses, the probes' sampling slots and this node's own counters. Buffers
+ * that every evaluation refills before reading (cells, EOS terms, SPS stress, soil pass
+ * scratch) are not stored. One function both ways: 0, or -1 with the message in f->err. */
+_Static_assert(sizeof(int) == sizeof(int32_t), "soil_hist_body is stored as int32");
+
+static void sph_node_io_f64(lahar_ckpt_file *f, const char *name, double *a, int64_t n)
+{
+    if (a)
+        lahar_ckpt_f64(f, name, a, n);
+}
+
+static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double *t_now)
+{
+    sph_fluid *fl = &s->f;
+    sph_particles *p = &fl->p;
+    lahar_ckpt_i64(f, "step", k, 1);
+    lahar_ckpt_f64(f, "t", t_now, 1);
+    int64_t n = p->n;
+    lahar_ckpt_i64(f, "n", &n, 1);
+    if (!f->writing && !f->failed && n != p->n) {
+        snprintf(f->err, sizeof f->err, "the checkpoint holds %lld particles, this case fills %lld (another case?)",
+                 (long long)n, (long long)p->n);
+        f->failed = 1;
+    }
+    static const char *const names[] = {"x", "y", "z", "vx", "vy", "vz", "rho", "p", "m", "ax", "ay", "az", "drho",
+                                        "vhx", "vhy", "vhz", "rhoh", "tvx", "tvy", "tvz"};
+    double *arrays[] = {p->x, p->y, p->z, p->vx, p->vy, p->vz, p->rho, p->p, p->m, p->ax, p->ay, p->az, p->drho,
+                        p->vhx, p->vhy, p->vhz, p->rhoh, p->tvx, p->tvy, p->tvz};
+    for (size_t a = 0; a < sizeof names / sizeof names[0]; a++)
+        sph_node_io_f64(f, names[a], arrays[a], n);
+    lahar_ckpt_i32(f, "phase", p->phase, n);
+    lahar_ckpt_i64(f, "id", p->id, n);
+    char name[32];
+    for (int a = 0; a < SPH_NSTRESS; a++) {
+        snprintf(name, sizeof name, "sig%d", a);
+        sph_node_io_f64(f, name, p->sig[a], n);
+        snprintf(name, sizeof name, "sigh%d", a);
+        sph_node_io_f64(f, name, p->sigh[a], n);
+        if (fl->has_soil) {
+            snprintf(name, sizeof name, "dsig%d", a);
+            sph_node_io_f64(f, name, fl->soil.dsig[a], n);
+        }
+    }
+    sph_node_io_f64(f, "tv_bx", fl->tv_bx, n);
+    sph_node_io_f64(f, "tv_by", fl->tv_by, n);
+    sph_node_io_f64(f, "tv_bz", fl->tv_bz, n);
+    lahar_ckpt_f64(f, "fluid_t", &fl->t, 1);
+    lahar_ckpt_i64(f, "fluid_step", &fl->step, 1);
+    lahar_ckpt_f64(f, "vmax", &fl->vmax, 1);
+    lahar_ckpt_f64(f, "amax", &fl->amax, 1);
+    lahar_ckpt_f64(f, "nut_max", &fl->nut_max, 1);
+    lahar_ckpt_i64(f, "crossings", &fl->crossings, 1);
+    int64_t work[] = {fl->work_passes, fl->work_neighbours_fluid, fl->work_neighbours_soil,
+                      fl->work_neighbours_fluid_soil, s->work_particle_body, s->work_output_derived, s->last_snapshot};
+    lahar_ckpt_i64(f, "counters", work, 7);
+    if (!f->writing && !f->failed) {
+        fl->work_passes = work[0], fl->work_neighbours_fluid = work[1], fl->work_neighbours_soil = work[2];
+        fl->work_neighbours_fluid_soil = work[3], s->work_particle_body = work[4], s->work_output_derived = work[5];
+        s->last_snapshot = work[6];
+    }
+    lahar_ckpt_int(f, "at_output_time", &s->at_output_time);
+    lahar_ckpt_f64(f, "kinetic_energy", &s->kinetic_energy, 1);
+    if (s->nbody > 0)
+        lahar_ckpt_f64(f, "body_states", (double *)s->states, (int64_t)s->nbody * 13);
+    if (fl->has_bodies) {
+        sph_coupling *c = &fl->cpl;
+        lahar_ckpt_f64(f, "cpl_force", (double *)c->force, (int64_t)c->nbody * 3);
+        lahar_ckpt_f64(f, "cpl_torque", (double *)c->torque, (int64_t)c->nbody * 3);
+        lahar_ckpt_i64(f, "cpl_body_start", c->body_start, c->nbody + 1);
+        lahar_ckpt_f64(f, "cpl_kn", &c->kn, 1);
+        int64_t nc = c->ncontacts;
+        lahar_ckpt_i64(f, "cpl_ncontacts", &nc, 1);
+        if (!f->writing && !f->failed && nc > c->contacts_cap) {
+            sph_contact *m = realloc(c->contacts, (size_t)nc * sizeof *m);
+            if (!m) {
+                snprintf(f->err, sizeof f->err, "out of memory for %lld contacts", (long long)nc);
+                f->failed = 1;
+            } else {
+                c->contacts = m;
+                c->contacts_cap = nc;
+            }
+        }
+        if (!f->failed) {
+            c->ncontacts = nc;
+            /* sph_contact is doubles and an int64: stored as the bytes of the array */
+            void *blob = c->contacts;
+            size_t len = (size_t)nc * sizeof *c->contacts;
+            if (f->writing) {
+                lahar_ckpt_blob(f, "cpl_contacts", &blob, &len);
+            } else {
+                lahar_ckpt_u8(f, "cpl_contacts", blob, (int64_t)len);
+            }
+        }
+        if (c->soil_hist_body) {
+            const int64_t nh = c->pcap * SPH_COUPLING_MAX_PER_PARTICLE;
+            lahar_ckpt_i32(f, "cpl_soil_hist_body", (int32_t *)c->soil_hist_body, nh);
+            lahar_ckpt_f64(f, "cpl_soil_hist_d", (double *)c->soil_hist_d, nh * 3);
+        }
+        c->near_valid = 0;
+    }
+    if (s->probes.n > 0)
+        lahar_ckpt_i64(f, "probe_next_slot", s->probes.next_slot, s->probes.n);
+    return f->failed ? -1 : 0;
+}
+
+/* Step k done (the state of step index k + 1 at t): flush the streams and write
+ * OUT/checkpoints/NNNNNN.tmp/sph.h5, synced. 0, or -1 with a message in err. */
+static int sph_node_checkpoint(sph_node *s, int64_t state_step, double t, char *err, size_t errlen)
+{
+    char dir[1200], path[1300];
+    lahar_ckpt_dir(dir, sizeof dir, s->ns.output_dir, state_step, 1);
+    snprintf(path, sizeof path, "%s/sph.h5", dir);
+    if (lahar_body_output_sync(s->bout) != 0 || lahar_gauge_output_sync(s->gauges) != 0 ||
+        lahar_mkdir_p(dir) != 0) {
+        snprintf(err, errlen, "cannot write the checkpoint in %s", dir);
+        return -1;
+    }
+    lahar_ckpt_file f;
+    int64_t k = state_step;
+    double tt = t;
+    if (lahar_ckpt_create(&f, path, "sph") == 0)
+        sph_node_state_io(s, &f, &k, &tt);
+    if (lahar_ckpt_close(&f) != 0) {
+        snprintf(err, errlen, "%s", f.err);
+        return -1;
+    }
+    return 0;
+}
+
+static int sph_node_loop(sph_node *s, int64_t k0, double t0)
 {
     char err[2048];
     lahar_link_msg msg;
     const int has_dem = s->ns.has_dem && s->nbody > 0;
-    double t_now = 0.0; /* time of the state: the end of the last step taken */
-    for (int64_t k = 0;; k++) {
+    double t_now = t0; /* time of the state: the end of the last step taken */
+    for (int64_t k = k0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
         lahar_step_t step;
         int rc = lahar_node_wait_step(s->link, "lahar-sph", k, &msg, &step);
@@ -933,6 +1073,12 @@ static int sph_node_loop(sph_node *s)
             s->kinetic_energy = sph_node_kinetic_energy(&s->f.p);
         st.kinetic_energy = s->kinetic_energy;
         sph_node_work(s, &st);
+        if (step.checkpoint && !st.error) {
+            if (sph_node_checkpoint(s, k + 1, step.t_next, err, sizeof err) == 0)
+                st.checkpointed = 1;
+            else
+                st.error = 1;
+        }
         compute += lahar_now() - c0;
         st.compute_s = compute;
         st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
@@ -1038,17 +1184,31 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     for (int i = 0; i < c->nbody; i++)
         s.nmoving += c->bodies[i].motion != LAHAR_MOTION_FIXED;
     lahar_status_t st = {0};
+    int64_t k0 = 0;
+    double t0 = 0.0;
     err[0] = '\0';
     if (sph_node_setup(&s, err, sizeof err) != 0)
         ;
     else if (!(s.out = lahar_particle_output_open(s.ns.output_dir, c, c->output_fields, err, sizeof err)))
         ;
-    else if (sph_node_snapshot(&s, 0, 0.0) != 0)
+    else if (!c->resume && sph_node_snapshot(&s, 0, 0.0) != 0)
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
     else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
         /* the message is in err */
     } else if (sph_node_probes_open(&s, err, sizeof err) != 0) {
         /* the message is in err */
+    } else if (c->resume) {
+        /* lahar resume: the state of the checkpoint replaces the initial one set up above */
+        char path[1300];
+        snprintf(path, sizeof path, "%s/sph.h5", c->resume_dir);
+        lahar_ckpt_file f;
+        if (lahar_ckpt_open(&f, path, "sph") == 0)
+            sph_node_state_io(&s, &f, &k0, &t0);
+        if (lahar_ckpt_close(&f) != 0)
+            snprintf(err, sizeof err, "%s", f.err);
+        else if (k0 != c->resume_step)
+            snprintf(err, sizeof err, "%s holds step %lld, the coordinator resumes step %lld", path, (long long)k0,
+                     (long long)c->resume_step);
     }
     char desc[256];
     if (s.fluid_ready)
@@ -1069,7 +1229,7 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         status = 1;
         goto done;
     }
-    status = sph_node_loop(&s);
+    status = sph_node_loop(&s, k0, t0);
 done:
     lahar_link_heartbeat_stop(s.link);
     sph_node_free(&s);
