@@ -1892,13 +1892,15 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
  * sph_coupling.h). Layer l holds the lattice's share of its shell R + l dx .. R + (l + 1) dx,
  * round(volume / dx^D) points (4 pi / 3 ((R + (l+1) dx)^3 - (R + l dx)^3) / dx^3 in 3D,
  * pi ((R + (l+1) dx)^2 - (R + l dx)^2) / dx^2 = 2 pi r_l / dx in 2D; the outermost layer also the
- * lattice's own excess in the zone's ball, below), spread evenly: a spherical Fibonacci lattice in 3D (z_i = 1 - (2 i + 1) / n, azimuth i times
- * the golden angle pi (3 - sqrt 5); Gonzalez 2010, Math. Geosci. 42:49), equal angles in 2D (every
- * other layer turned by half a step). A lattice cut by a curved surface instead leaves the first row
- * at any distance from 0 to ~dx from it, denser or sparser than a row; the near-wall model sees the
- * difference (cases/README.md, "Sphere array"). Body-fitted particle layers around curved bodies are
- * the usual SPH start (e.g. Marrone et al. 2011, Comput. Methods Appl. Mech. Engrg. 200:1526, around
- * a cylinder). Points are wrapped into the period on periodic axes and kept when inside the block
+ * lattice's own excess in the zone's ball, below), spread evenly: a spherical Fibonacci lattice in
+ * 3D (z_i = 1 - (2 i + 1) / n, azimuth i times the golden angle pi (3 - sqrt 5); Gonzalez 2010,
+ * Math. Geosci. 42:49), equal angles in 2D (every other layer turned by half a step). A lattice cut
+ * by a curved surface instead leaves the first row at any distance from 0 to ~dx from it, denser
+ * or sparser than a row; the near-wall model sees the difference (cases/README.md, "Sphere
+ * array"). Initial particle positions that conform to the body surface are what particle-packing
+ * methods aim at for the same reason (Colagrossi, Bouscasse, Antuono & Marrone 2012, Comput. Phys.
+ * Commun. 183:1641); concentric layers are the direct form of that for a sphere or disc. Points are
+ * wrapped into the period on periodic axes and kept when inside the block
  * and outside every body (free bodies' halos as for the lattice). Continues the count `count`. */
 static int64_t case_block_layers(const lahar_case *c, int block, case_lattice_cut *k, int64_t count, int64_t most,
                                  double (*out)[3], int64_t cap)
