@@ -1811,13 +1811,82 @@ typedef struct {
     const lahar_case *c;
     double *reach;
     double eps;
+    double zone;  /* sph.body_layers > 0: the lattice leaves out the points within zone = body_layers dx
+                     of a round body's surface (case_block_layers fills them); else 0 */
 } case_lattice_cut;
+
+/* 1 for a body whose core is one point (a sphere in 3D, a disc in 2D). */
+static int case_round_body(const lahar_body *bd)
+{
+    return bd->shape.nv == 1 && bd->shape.ne == 0 && bd->shape.nf == 0 && bd->shape.radius > 0.0;
+}
+
+/* The first round body of the case, or -1. */
+static int case_first_round_body(const lahar_case *c)
+{
+    for (int m = 0; m < c->nbody; m++)
+        if (case_round_body(&c->bodies[m]))
+            return m;
+    return -1;
+}
+
+/* x - y with the nearest periodic image on the fluid's periodic axes. */
+static vec3 case_periodic_sub(const lahar_case *c, const double x[3], vec3 y)
+{
+    double v[3] = {x[0] - y.x, x[1] - y.y, x[2] - y.z};
+    for (int a = 0; a < c->dim; a++)
+        if (c->sph.periodic[a]) {
+            double L = c->sph.hi[a] - c->sph.lo[a];
+            v[a] -= L * floor(v[a] / L + 0.5);
+        }
+    return v3(v[0], v[1], c->dim == 2 ? 0.0 : v[2]);
+}
+
+/* sph.body_layers: the layers of a round body must stay clear of every other round body's layers
+ * and of its own periodic images (each point of the zones is filled once). */
+static void case_check_body_layers(rmap *m, const lahar_case *c)
+{
+    const double zone = c->sph.body_layers * c->sph_dx;
+    for (int i = 0; i < c->nbody; i++) {
+        const lahar_body *bi = &c->bodies[i];
+        if (!case_round_body(bi))
+            continue;
+        vec3 xi = geom_world_vertex(&bi->shape, bi->x, bi->q, 0);
+        for (int a = 0; a < c->dim; a++)
+            if (c->sph.periodic[a] && 2.0 * (bi->shape.radius + zone) > c->sph.hi[a] - c->sph.lo[a]) {
+                rmap_fail(m, "body_layers", "the %d layers around body '%s' (radius %g m + %g m) overlap its periodic "
+                          "image along %c (period %g m); lower body_layers or dx", c->sph.body_layers, bi->name,
+                          bi->shape.radius, zone, "xyz"[a], c->sph.hi[a] - c->sph.lo[a]);
+                return;
+            }
+        for (int j = 0; j < i; j++) {
+            const lahar_body *bj = &c->bodies[j];
+            if (!case_round_body(bj))
+                continue;
+            double xj[3];
+            v3_store(geom_world_vertex(&bj->shape, bj->x, bj->q, 0), xj);
+            if (v3_norm(case_periodic_sub(c, xj, xi)) < bi->shape.radius + bj->shape.radius + 2.0 * zone) {
+                rmap_fail(m, "body_layers", "the %d layers around bodies '%s' and '%s' overlap (their surfaces are "
+                          "closer than 2 x %g m); lower body_layers or dx", c->sph.body_layers, bj->name, bi->name,
+                          zone);
+                return;
+            }
+        }
+    }
+}
 
 /* 0 if x lies in a body's solid; else 1, with x moved out of any free body's halo it starts in. */
 static int case_lattice_outside_bodies(double x[3], void *ctx)
 {
     const case_lattice_cut *k = ctx;
     const double tol = 1e-6 * k->c->sph_dx;
+    for (int m = 0; m < k->c->nbody && k->zone > 0.0; m++) {
+        const lahar_body *bd = &k->c->bodies[m];
+        if (case_round_body(bd) &&
+            v3_norm(case_periodic_sub(k->c, x, geom_world_vertex(&bd->shape, bd->x, bd->q, 0))) <
+                bd->shape.radius + k->zone - tol)
+            return 0; /* within the layers of sph.body_layers (case_block_layers) */
+    }
     for (int m = 0; m < k->c->nbody; m++) {
         const lahar_body *bd = &k->c->bodies[m];
         double d2 = 0;
@@ -1843,12 +1912,92 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
     return 1;
 }
 
+/* sph.body_layers = N > 0: after the lattice points (which leave out the zone within N dx of every
+ * round body's surface), the points of that zone on N layers concentric with each round body, at
+ * r_l = R + (l + 1/2) dx, l = 0 .. N - 1, like the rows of fluid a flat wall sees in the lattice (the
+ * first at the halo eps = dx/2, paper 000 eq. 14, and at the depths of the coupling's ghost layers,
+ * sph_coupling.h). Layer l holds the lattice's share of its shell R + l dx .. R + (l + 1) dx,
+ * round(volume / dx^D) points (4 pi / 3 ((R + (l+1) dx)^3 - (R + l dx)^3) / dx^3 in 3D,
+ * pi ((R + (l+1) dx)^2 - (R + l dx)^2) / dx^2 = 2 pi r_l / dx in 2D; the outermost layer also the
+ * lattice's own excess in the zone's ball, below), spread evenly: a spherical Fibonacci lattice in
+ * 3D (z_i = 1 - (2 i + 1) / n, azimuth i times the golden angle pi (3 - sqrt 5); Gonzalez 2010,
+ * Math. Geosci. 42:49), equal angles in 2D (every other layer turned by half a step). A lattice cut
+ * by a curved surface instead leaves the first row at any distance from 0 to ~dx from it, denser
+ * or sparser than a row; the near-wall model sees the difference (cases/README.md, "Sphere
+ * array"). Initial particle positions that conform to the body surface are what particle-packing
+ * methods aim at for the same reason (Colagrossi, Bouscasse, Antuono & Marrone 2012, Comput. Phys.
+ * Commun. 183:1641); concentric layers are the direct form of that for a sphere or disc. Points are
+ * wrapped into the period on periodic axes and kept when inside the block
+ * and outside every body (free bodies' halos as for the lattice). Continues the count `count`. */
+static int64_t case_block_layers(const lahar_case *c, int block, case_lattice_cut *k, int64_t count, int64_t most,
+                                 double (*out)[3], int64_t cap)
+{
+    const double dx = c->sph_dx, golden = M_PI * (3.0 - sqrt(5.0));
+    for (int m = 0; m < c->nbody; m++) {
+        const lahar_body *bd = &c->bodies[m];
+        if (!case_round_body(bd))
+            continue;
+        const vec3 xc = geom_world_vertex(&bd->shape, bd->x, bd->q, 0);
+        const double R = bd->shape.radius, rz = R + c->sph.body_layers * dx;
+        /* the lattice beyond the zone holds as many points as the lattice's ball of radius rz leaves
+         * out, B, not the ball's volume V_b / dx^D: the outermost layer takes the difference B - V_b,
+         * so that the layers and the lattice together hold the fluid's volume / dx^D as the plain
+         * lattice would (B counted on the block's lattice lo + (i + 1/2) dx continued beyond it) */
+        const double *blo = c->blocks[block].lo;
+        int64_t inball = 0;
+        int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+        for (int a = 0; a < c->dim; a++) {
+            double xa = v3_get(xc, a);
+            lo[a] = (int)floor((xa - rz - blo[a]) / dx - 0.5), hi[a] = (int)ceil((xa + rz - blo[a]) / dx - 0.5);
+        }
+        for (int i = lo[0]; i <= hi[0]; i++)
+            for (int j = lo[1]; j <= hi[1]; j++)
+                for (int q = lo[2]; q <= hi[2]; q++) {
+                    double ex = blo[0] + (i + 0.5) * dx - xc.x, ey = blo[1] + (j + 0.5) * dx - xc.y;
+                    double ez = c->dim == 3 ? blo[2] + (q + 0.5) * dx - xc.z : 0.0;
+                    inball += ex * ex + ey * ey + ez * ez < rz * rz;
+                }
+        const double vball = c->dim == 3 ? 4.0 * M_PI / 3.0 * rz * rz * rz / (dx * dx * dx) : M_PI * rz * rz / (dx * dx);
+        for (int l = 0; l < c->sph.body_layers; l++) {
+            const double r = R + (l + 0.5) * dx, r0 = R + l * dx, r1 = r0 + dx;
+            double vol = c->dim == 3 ? 4.0 * M_PI / 3.0 * (r1 * r1 * r1 - r0 * r0 * r0) / (dx * dx * dx)
+                                     : M_PI * (r1 * r1 - r0 * r0) / (dx * dx);
+            if (l == c->sph.body_layers - 1)
+                vol += (double)inball - vball;
+            const int64_t n = vol > 0.0 ? llround(vol) : 0;
+            for (int64_t i = 0; i < n; i++) {
+                double x[3];
+                if (c->dim == 3) {
+                    double z = 1.0 - (2.0 * (double)i + 1.0) / (double)n, s = sqrt(fmax(0.0, 1.0 - z * z));
+                    double ph = golden * (double)i;
+                    x[0] = xc.x + r * s * cos(ph), x[1] = xc.y + r * s * sin(ph), x[2] = xc.z + r * z;
+                } else {
+                    double ph = 2.0 * M_PI * ((double)i + 0.5 * (l % 2)) / (double)n;
+                    x[0] = xc.x + r * cos(ph), x[1] = xc.y + r * sin(ph), x[2] = 0.0;
+                }
+                for (int a = 0; a < c->dim; a++)
+                    if (c->sph.periodic[a]) {
+                        double L = c->sph.hi[a] - c->sph.lo[a];
+                        x[a] -= L * floor((x[a] - c->sph.lo[a]) / L);
+                    }
+                if (!lahar_particle_block_contains(&c->blocks[block], c->dim, x) || !case_lattice_outside_bodies(x, k))
+                    continue;
+                if (out && count < cap)
+                    memcpy(out[count], x, sizeof x);
+                if (++count == most)
+                    return count;
+            }
+        }
+    }
+    return count;
+}
+
 /* As lahar_case_block_lattice; first_only: stop at the first particle (the loader only needs to
  * know a block is not empty). */
 static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap, int first_only)
 {
     /* the halo is dx/2 (the only value sph.halo accepts) */
-    case_lattice_cut k = {c, malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof(double)), 0.5 * c->sph_dx};
+    case_lattice_cut k = {c, malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof(double)), 0.5 * c->sph_dx, 0.0};
     if (!k.reach)
         return -1;
     for (int m = 0; m < c->nbody; m++) {
@@ -1858,8 +2007,13 @@ static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[
             k.reach[m] = fmax(k.reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
         k.reach[m] += bd->shape.radius + k.eps;
     }
+    k.zone = c->sph.body_layers * c->sph_dx;
     int64_t count = lahar_particle_block_lattice_keep(&c->blocks[block], c->dim, c->sph_dx, case_lattice_outside_bodies,
                                                       &k, first_only ? 1 : -1, out, cap);
+    if (k.zone > 0.0 && !(first_only && count > 0)) {
+        k.zone = 0.0; /* the layers themselves: only the bodies' solids (and free bodies' halos) cut them */
+        count = case_block_layers(c, block, &k, count, first_only ? 1 : -1, out, cap);
+    }
     free(k.reach);
     return count;
 }
@@ -1918,7 +2072,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
                                        "initial_pressure", "wall_pressure", "penalty_stiffness", "soil_wall_stress", "shifting", "shifting_density", "background_pressure",
-                                       "transport_velocity", "blocks", NULL};
+                                       "transport_velocity", "body_layers", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
@@ -1965,6 +2119,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     o->sps = rmap_bool(&m, "sps", 0);
     o->shifting_density = rmap_bool(&m, "shifting_density", 0);
     o->transport_velocity = rmap_bool(&m, "transport_velocity", 0);
+    double layers = rmap_num(&m, "body_layers", 0, 0.0, "3");
     o->sps_cs = rmap_num(&m, "sps_cs", 0, 0.12, "0.12");
     o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
     o->kappa = rmap_num(&m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
@@ -2013,6 +2168,12 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     else if (!(o->shifting >= 0 && o->shifting <= 0.5))
         rmap_fail(&m, "shifting", "must be in [0, 0.5] (got %g); 0.01 is usual, 0 = off (particle shifting: "
                   "confined flows only, lahar detects no free surface)", o->shifting);
+    else if (!(layers >= 0 && layers <= 8 && layers == floor(layers)))
+        rmap_fail(&m, "body_layers", "must be a whole number in [0, 8] (got %g); 0 = the plain lattice, 2-3 usual",
+                  layers);
+    else if (layers > 0 && case_first_round_body(c) < 0)
+        rmap_fail(&m, "body_layers", "places particles on layers around sphere (3D) or disc (2D) bodies, but the case "
+                  "has none; remove the key");
     else if (!(o->sps_cs > 0 && o->sps_cs < 1))
         rmap_fail(&m, "sps_cs", "must be in (0, 1) (got %g); 0.12 is usual", o->sps_cs);
     else if (o->shifting_density && !(o->shifting > 0.0))
@@ -2045,6 +2206,11 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
             return;
         }
     o->shepard_interval = (int)shep;
+    o->body_layers = (int)layers;
+    if (o->body_layers > 0)
+        case_check_body_layers(&m, c);
+    if (r->failed)
+        return;
     for (int a = 0; a < dim && !r->failed; a++) {
         if (!o->periodic[a])
             continue;

@@ -147,6 +147,9 @@ typedef struct {
                               velocity only (Adami et al. 2013); sph_node/sph_fluid.h */
     int transport_velocity; /* 1: transport-velocity formulation (Adami, Hu & Adams 2013), confined
                               water-only flows without bodies; default 0 */
+    int body_layers;       /* N > 0: the particles within N dx of every sphere (3D) or disc (2D) body's
+                              surface are placed on N layers concentric with it at (k + 1/2) dx
+                              instead of the lattice (lahar_case_block_lattice); default 0 */
 } lahar_sph_options;
 
 /* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).

@@ -34,6 +34,7 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     m->shifting_density = (int8_t)(o->shifting_density != 0);
     m->background_pressure = o->background_pressure;
     m->transport_velocity = (int8_t)(o->transport_velocity != 0);
+    m->body_layers = (int8_t)o->body_layers;
     m->sps = (int8_t)(o->sps != 0);
     m->sps_cs = o->sps_cs;
     m->halo = o->halo;
@@ -68,6 +69,7 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     o->shifting_density = m->shifting_density != 0;
     o->background_pressure = m->background_pressure;
     o->transport_velocity = m->transport_velocity != 0;
+    o->body_layers = m->body_layers;
     o->sps = m->sps != 0;
     o->sps_cs = m->sps_cs;
     o->halo = m->halo;

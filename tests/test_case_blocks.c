@@ -13,7 +13,11 @@
  *    boundary-shell bound A sqrt(3) dx;
  *  - cut-out: a water box around a fixed disc, a free 2D box turned by 30 degrees and a 3D
  *    sphere loses exactly the lattice points an independent distance test puts inside them;
- *  - every sph: default is the documented value (c0 = 10 sqrt(2 g H) computed independently).
+ *  - every sph: default is the documented value (c0 = 10 sqrt(2 g H) computed independently);
+ *  - sph.body_layers: around a sphere in a periodic cube (3D) and a disc in a closed box (2D) the
+ *    points within N dx of the surface lie on the layers R + (l + 1/2) dx to 1e-9 dx, the inner
+ *    layers hold round(shell volume / dx^D) points, no two points of the first layer are closer
+ *    than 0.7 dx, and the fill holds the fluid's volume / dx^D to within the layers' rounding.
  * usage: test_case_blocks TMP_DIR */
 #include <math.h>
 #include <stdint.h>
@@ -402,6 +406,95 @@ static void test_defaults(const char *tmp)
     lahar_case_free(&c);
 }
 
+/* sph.body_layers (common/case.c case_block_layers): layers on the surface of a round body. */
+static void layers_check(const char *tmp, const char *name, int dim, const char *yaml, double R, const double ctr[3],
+                         double L, int nl, double dx, double fluid_cells, int periodic)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.yaml", tmp, name);
+    write_file(path, yaml);
+    lahar_case c;
+    if (lahar_case_load(path, &c) != 0) {
+        CHECK(0, "%s: case does not load", name);
+        return;
+    }
+    int64_t n = lahar_case_block_lattice(&c, 0, NULL, 0);
+    double (*pt)[3] = malloc((size_t)(n > 0 ? n : 1) * sizeof *pt);
+    CHECK(pt && lahar_case_block_lattice(&c, 0, pt, n) == n, "%s: the fill writes as many points as it counts", name);
+    int64_t count[8] = {0}, off = 0, near = 0;
+    double mind = INFINITY, d0 = INFINITY;
+    for (int64_t i = 0; pt && i < n; i++) {
+        double e2 = 0.0;
+        for (int a = 0; a < dim; a++) {
+            double e = pt[i][a] - ctr[a];
+            if (periodic)
+                e -= L * floor(e / L + 0.5);
+            e2 += e * e;
+        }
+        double d = (sqrt(e2) - R) / dx;
+        mind = fmin(mind, d);
+        if (d >= nl - 1e-6)
+            continue;
+        near++;
+        int l = (int)floor(d);
+        if (l < 0 || l >= nl || fabs(d - (l + 0.5)) > 1e-9)
+            off++;
+        else
+            count[l]++;
+    }
+    /* the closest pair on the first layer */
+    for (int64_t i = 0; pt && i < n; i++)
+        for (int64_t j = i + 1; j < n; j++) {
+            double e2i = 0.0, e2j = 0.0, r2 = 0.0;
+            for (int a = 0; a < dim; a++) {
+                double ei = pt[i][a] - ctr[a], ej = pt[j][a] - ctr[a], eij = pt[i][a] - pt[j][a];
+                if (periodic)
+                    ei -= L * floor(ei / L + 0.5), ej -= L * floor(ej / L + 0.5), eij -= L * floor(eij / L + 0.5);
+                e2i += ei * ei, e2j += ej * ej, r2 += eij * eij;
+            }
+            if (sqrt(e2i) - R < dx && sqrt(e2j) - R < dx)
+                d0 = fmin(d0, sqrt(r2) / dx);
+        }
+    CHECK(off == 0, "%s: %lld of %lld points within %d dx of the surface are off the layers", name, (long long)off,
+          (long long)near, nl);
+    CHECK(mind > 0.5 - 1e-9, "%s: a point %.3g dx from the surface (the first layer is at dx/2)", name, mind);
+    for (int l = 0; l + 1 < nl; l++) {
+        double r0 = R + l * dx, r1 = r0 + dx;
+        double vol = dim == 3 ? 4.0 * M_PI / 3.0 * (pow(r1, 3) - pow(r0, 3)) / pow(dx, 3) : M_PI * (r1 * r1 - r0 * r0) / (dx * dx);
+        CHECK(count[l] == llround(vol), "%s: layer %d holds %lld points, expected round(%.3f)", name, l,
+              (long long)count[l], vol);
+    }
+    CHECK(d0 > 0.7, "%s: two points of the first layer %.3g dx apart (< 0.7 dx)", name, d0);
+    CHECK(fabs((double)n - fluid_cells) <= 0.5 * nl + 0.5, "%s: %lld points for a fluid of %.2f dx^%d", name,
+          (long long)n, fluid_cells, dim);
+    printf("%s: %lld points (fluid volume %.2f dx^%d), first layer %lld points, closest pair %.3f dx\n", name,
+           (long long)n, fluid_cells, dim, (long long)count[0], d0);
+    free(pt);
+    lahar_case_free(&c);
+}
+
+static void test_body_layers(const char *tmp)
+{
+    const double a = 0.0620350, dx = 0.0125, L = 0.2, ctr[3] = {0.1, 0.1, 0.1};
+    layers_check(tmp, "layers3d", 3,
+                 "dimensions: 3\ntime: {end: 1}\n"
+                 "materials: {rock: {density: 2650, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
+                 "bodies:\n  - {name: sphere, shape: sphere, motion: fixed, material: rock, radius: 0.0620350, "
+                 "position: [0.1, 0.1, 0.1]}\n"
+                 "sph:\n  dx: 0.0125\n  c0: 0.2\n  body_layers: 3\n  periodic: {x: [0, 0.2], y: [0, 0.2], z: [0, 0.2]}\n"
+                 "  blocks:\n    - {name: water, box: {lo: [0, 0, 0], hi: [0.2, 0.2, 0.2]}}\n",
+                 a, ctr, L, 3, dx, (L * L * L - 4.0 * M_PI / 3.0 * a * a * a) / (dx * dx * dx), 1);
+    const double c2[3] = {0.2013, 0.0991, 0.0}, R2 = 0.0377, dx2 = 0.004;
+    layers_check(tmp, "layers2d", 2,
+                 "dimensions: 2\ntime: {end: 1}\n"
+                 "materials: {rock: {density: 2650, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
+                 "bodies:\n  - {name: disc, shape: disc, motion: fixed, material: rock, radius: 0.0377, "
+                 "position: [0.2013, 0.0991]}\n"
+                 "sph:\n  dx: 0.004\n  c0: 1\n  body_layers: 2\n"
+                 "  blocks:\n    - {name: water, box: {lo: [0, 0], hi: [0.4, 0.2]}}\n",
+                 R2, c2, 0.0, 2, dx2, (0.4 * 0.2 - M_PI * R2 * R2) / (dx2 * dx2), 0);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -412,6 +505,7 @@ int main(int argc, char **argv)
     test_polygons();
     test_meshes(argv[1]);
     test_cutout(argv[1]);
+    test_body_layers(argv[1]);
     printf("%d checks, %d failures\n", checks, failures);
     return failures ? 1 : 0;
 }

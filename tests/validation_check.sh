@@ -4,8 +4,9 @@
 # exits with its status (0 = every metric within its bound). The main cases stay the single source
 # of the set-up; only the resolution, the duration and the cylinder radius change.
 # After a passing run, `lahar check --evaluate-only` on OUT/run must write the same check.json.
-# usage: validation_check.sh LAHAR CASE OUT [dx=M] [end=S] [c=SOLID_FRACTION] [threads=N] [paraview=1]
+# usage: validation_check.sh LAHAR CASE OUT [dx=M] [end=S] [layers=N] [c=SOLID_FRACTION] [threads=N] [paraview=1]
 #   dx=M   sph.dx (particle spacing)             end=S  time.end
+#   layers=N  sph.body_layers (the case must set the key; particle layers fitted to a sphere or disc)
 #   c=F    cylinder_array: disc radius r = L sqrt(F / pi); sphere_array (a body `name: sphere`):
 #          sphere radius a = L (3 F / (4 pi))^(1/3); L = 0.2 m (the cases' cell)
 #   bound.NAME=V  the case's check: bound of metric NAME becomes V in the copy, for a metric the
@@ -17,7 +18,7 @@
 #   paraview=1  also: OUT/run/lahar.xmf shows particles and bodies together and every *.xmf
 #          names datasets that exist with their declared shapes (tests/test_output_xdmf.py)
 set -u
-[ $# -ge 3 ] || { echo "usage: $0 LAHAR CASE OUT [dx=M] [end=S] [c=F] [threads=N] [paraview=1]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: $0 LAHAR CASE OUT [dx=M] [end=S] [layers=N] [c=F] [threads=N] [paraview=1]" >&2; exit 2; }
 lahar=$1 case=$2 out=$3
 shift 3
 mkdir -p "$out" || exit 2
@@ -31,6 +32,8 @@ for kv in "$@"; do
     case $k in
         dx) sed -i -E "s/^(  dx: *)[^ #]+/\1$v/" "$out/case.yaml"
             grep -qE "^  dx: *$v( |$)" "$out/case.yaml" ;;
+        layers) sed -i -E "s/^(  body_layers: *)[^ #]+/\1$v/" "$out/case.yaml"
+                grep -qE "^  body_layers: *$v( |$)" "$out/case.yaml" ;;
         end) sed -i -E "s/^(time: *\{.*end: *)[^,} ]+/\1$v/" "$out/case.yaml"
              grep -qE "^time: *\{.*end: *$v[,} ]" "$out/case.yaml" ;;
         c) if grep -qE "name: sphere,.*shape: sphere" "$out/case.yaml"; then
