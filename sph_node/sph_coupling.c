@@ -197,7 +197,11 @@ int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const do
         c->soil_g[a] = gravity[a];
     if (mode != SPH_WALL_PRESSURE_GHOST)
         return 0;
-    if (ghost_tables(c, dx) != 0) {
+    if (!c->soil_lw)
+        c->soil_lw = calloc((size_t)c->pcap, sizeof *c->soil_lw);
+    if (!c->soil_lw_on)
+        c->soil_lw_on = calloc((size_t)c->pcap, 1);
+    if (!c->soil_lw || !c->soil_lw_on || ghost_tables(c, dx) != 0) {
         c->soil_pressure = SPH_WALL_PRESSURE_PENALTY;
         return -1;
     }
@@ -326,8 +330,9 @@ static vec3 sym_mul(const double s[SPH_NSTRESS], vec3 u)
 /* The soil ghosts' acceleration (sph_coupling_set_soil_wall) on a soil particle of stress si,
  * reference stress sbar and density rho at distance d from a flat wall of normal n. */
 static vec3 ghost_soil_accel(const sph_coupling *c, const double si[SPH_NSTRESS], const double sbar[SPH_NSTRESS],
-                             double rho, double d, vec3 n)
+                             double rho, double d, vec3 n, vec3 *A)
 {
+    *A = v3(0, 0, 0);
     const int nzw = 2 * GHOST_NT + 1;
     int i, j;
     double fi, fj, K[5], S[SPH_NSTRESS];
@@ -354,6 +359,7 @@ static vec3 ghost_soil_accel(const sph_coupling *c, const double si[SPH_NSTRESS]
      * does not vanish there, against a one-sided ghost region: a spurious push along the wall
      * that made a collapsing column unstable. */
     double s_nn = v3_dot(n, sym_mul(S, n)), gn = v3_dot(g, n), ge = v3_dot(g, e);
+    *A = v3_axpy(K[1], e, v3_scale(n, K[0]));
     return v3_scale(n, -K[0] * s_nn / rho + K[2] * gn + K[3] * ge);
 }
 
@@ -536,6 +542,8 @@ void sph_coupling_free(sph_coupling *c)
     free(c->soil_hist_d);
     free(c->wtab);
     free(c->qtab);
+    free(c->soil_lw);
+    free(c->soil_lw_on);
     memset(c, 0, sizeof *c);
 }
 
@@ -682,6 +690,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
         double gd[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
         double sbar[SPH_NSTRESS] = {0.0}, sown[SPH_NSTRESS] = {0.0}; /* soil ghosts (sph_coupling_set_soil_wall) */
+        double lw[9] = {0.0}; /* their share of the velocity gradient */
         int have_sbar = 0;
         vec3 gu[SPH_COUPLING_MAX_PER_PARTICLE];
         const uint32_t near = near_valid ? c->near[i] : ~0u;
@@ -786,8 +795,16 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                             sown[a] = p->sig[a][i];
                         have_sbar = 1;
                     }
-                    fg = v3_scale(ghost_soil_accel(c, sown, sbar, p->rho[i], dv, nrm), p->m[i]);
+                    vec3 A;
+                    fg = v3_scale(ghost_soil_accel(c, sown, sbar, p->rho[i], dv, nrm, &A), p->m[i]);
                     fgn = fmax(v3_dot(fg, nrm), 0.0);
+                    /* L_ab += sum_g V_g (v_g - v_i)_a (grad_i W_ig)_b with the ghosts' normal
+                     * velocity the wall's (free slip: their tangential velocity the particle's),
+                     * v_g - v_i = -(u_rel.n) n, grad_i W_ig = -F r_g: (u_rel.n) n_a A_b */
+                    const double un = v3_dot(urel, nrm), na[3] = {nrm.x, nrm.y, nrm.z}, ab[3] = {A.x, A.y, A.z};
+                    for (int a = 0; a < 3; a++)
+                        for (int bb = 0; bb < 3; bb++)
+                            lw[a * 3 + bb] += un * na[a] * ab[bb];
                 }
                 const double fn_tot = (delta > 0.0 ? kn * delta : 0.0) + fgn;
                 if (soil && fn_tot > 0.0) {
@@ -838,6 +855,11 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 ftot = v3_add(ftot, fc);
             }
         c->slot_n[i] = ns;
+        if (c->soil_lw_on) {
+            c->soil_lw_on[i] = (unsigned char)have_sbar;
+            if (have_sbar)
+                memcpy(c->soil_lw[i], lw, sizeof lw);
+        }
         if (soil) { /* the springs of the pairs in contact now; the others are released */
             const int64_t base = p->id[i] * SPH_COUPLING_MAX_PER_PARTICLE;
             for (int s = 0; s < SPH_COUPLING_MAX_PER_PARTICLE; s++) {

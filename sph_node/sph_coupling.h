@@ -114,6 +114,9 @@ typedef struct {
     const sph_cells *cells;      /* GHOST: the fluid's cells (borrowed), for the ghosts' pressure */
     sph_wall_pressure soil_pressure; /* sph_coupling_set_soil_wall; default penalty + spring only */
     double soil_g[3];            /* the soil's gravity (its ghost stress extrapolation) */
+    double (*soil_lw)[9];        /* soil GHOST: per particle, the ghosts' share of the velocity
+                                    gradient (L_ab at 3a + b) of the last evaluation */
+    unsigned char *soil_lw_on;   /* 1 where soil_lw is set (the particle had ghosts) */
     /* per-particle slots of the parallel pass */
     int64_t pcap;
     int *slot_n;
@@ -210,16 +213,26 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  * compressive (the water's cut with p = -sigmabar_nn). Without them, the one-sided kernel of the
  * rows on a floor makes the stress divergence carry the weight with too large a stress: the
  * soil row resting on a DEM floor reads ~20 % high in sigma_v (cases/soil_geostatic_2d.yaml).
- * The soil's continuity and velocity gradient take no ghost terms (in a layer at rest the stress
- * is set by equilibrium, i.e. by the divergence), and the concave-corner correction of the water
- * is not applied to the soil. Limitation: for soil at rest only. A collapsing column
- * (cases/granular_column_a1_2d.yaml with it, dx 10 and 5 mm) blows up within 0.1-0.3 s; the
- * first particle thrown out is at the toe (x = 0.097 m, 0.41 m/s up after 0.02 s), then stresses
- * of -40 kPa (10 x the column's weight) appear inside. The cause is not established; suspected:
- * the ghosts stand under the whole floor within the support, also beside the toe, with the
- * Shepard stress of the column. Not the cure (each tried at dx 10 mm, still unstable): the
- * friction cap without the ghosts' push; 2 sigmabar instead of sigma_i + sigmabar (no own-stress
- * feedback); ghosts on the floor only (none on the side wall).
+ * The ghosts also take part in the soil's velocity gradient (Adami, Hu & Adams 2012: the wall's
+ * velocity for the ghosts in the continuity and velocity-gradient sums; Bui et al. 2008 section
+ * 4.2: boundary particles in the strain-rate sum), free slip: the ghosts move with the wall along
+ * n and with the particle along the wall, v_g - v_i = -(u_rel.n) n, so that
+ *   L_ab += sum_g V_g (v_g - v_i)_a (grad_i W_ig)_b = (u_rel.n) n_a A_b
+ * with A the ghost table's vector of the stress term (sph_soil_wall_gradient redoes the stress
+ * rate of the particle with it after this pass). Without this term a collapsing column blew up
+ * within 0.1 s: a particle of the floor row at the toe, its neighbours missing to the right and
+ * above-right but the ghosts standing under it to the right as well, is pushed up by its own
+ * compressive stress; moving up, its one-sided velocity gradient (neighbours above only) reads a
+ * compression (L_yy = -0.45 u/dx on a lattice), which raises that stress and the push: a positive
+ * feedback (sigma_yy -1.3 kPa to -21 kPa in 0.01 s at dx 10 mm, 0.4 m/s up). With the ghosts'
+ * share a particle displaced alone reads no strain (tests/test_sph_soil.c), and the columns come
+ * to rest inside the run-out band (cases/README.md, "Soil"). A field v_n = G y vanishing on the
+ * wall reads 0.73 G in the first row (the ghosts move with the wall, they do not extrapolate the
+ * field; the mirrored velocity 2 v_w - v_i, tried, would read about 0.96 G but leaves the a = 1
+ * column moving: E_k end / peak 0.055 at dx 10 mm, 0.031 at 5 mm). The soil's continuity takes no
+ * ghost term (tried, -rho_i (u_rel.n) A.n: L_99 -3 % and +2 % at a = 1, dx 10 and 5 mm, -8 % at
+ * a = 2, dx 10 mm, no change at rest: not kept), and the concave-corner correction of the water
+ * is not applied to the soil (the quadrant behind floor and wall counts twice).
  * Returns 0 or -1 (out of memory). */
 int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx);
 

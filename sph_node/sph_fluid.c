@@ -139,7 +139,8 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
         double gs[3];
         for (int a = 0; a < 3; a++)
             gs[a] = f->prm.periodic[a] ? 0.0 : f->prm.soil_mat.gravity[a];
-        if (sph_coupling_set_soil_wall(&f->cpl, f->prm.soil_wall_stress, gs, f->prm.dx) != 0) {
+        if (sph_coupling_set_soil_wall(&f->cpl, f->prm.soil_wall_stress, gs, f->prm.dx) != 0 ||
+            (f->prm.soil_wall_stress == SPH_WALL_PRESSURE_GHOST && sph_soil_keep_gradient(&f->soil) != 0)) {
             sph_coupling_free(&f->cpl);
             return -1;
         }
@@ -644,6 +645,12 @@ static int64_t fluid_rates_bodies(sph_fluid *f, const lahar_body_state *states, 
         cross = sph_coupling_apply(&f->cpl, p, states, dt);
         if (cross < 0)
             return -1;
+        if (f->has_soil && f->cpl.soil_lw_on) { /* the soil ghosts' share of the velocity gradient */
+#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
+            for (int64_t i = 0; i < n; i++)
+                if (f->cpl.soil_lw_on[i] && p->phase[i] == SPH_SOIL_PHASE)
+                    sph_soil_wall_gradient(&f->soil, p, i, f->cpl.soil_lw[i]);
+        }
     }
     double vmax2 = 0.0, amax2 = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : vmax2, amax2) if (n >= SPH_OMP_MIN_LIGHT)

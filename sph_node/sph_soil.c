@@ -59,6 +59,8 @@ void sph_soil_free(sph_soil *s)
         free(s->dsig[a]), free(s->rart[a]), free(s->sig_rho2[a]);
     free(s->tensile);
     free(s->nb_n), free(s->nb_j);
+    for (int a = 0; a < 9; a++)
+        free(s->grad[a]);
     memset(s, 0, sizeof *s);
 }
 
@@ -130,34 +132,9 @@ static void soil_artificial_stress(const double sig[SPH_NSTRESS], double rho, do
             out[SYM[i][j]] = v[i][0] * r[0] * v[j][0] + v[i][1] * r[1] * v[j][1] + v[i][2] * r[2] * v[j][2];
 }
 
-static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
-                                 const double *vol, int record, int64_t i)
+/* The stress rate of soil particle i (000 eq. 6-7) from its velocity gradient L into s->dsig. */
+static void soil_stress_rate(sph_soil *s, const sph_particles *p, int64_t i, const double L[3][3])
 {
-    const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
-    const kernel_kind kind = k->kind;
-    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
-    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
-    double L[3][3] = {{0.0}}; /* L[a][b] = d v_a / d x_b */
-    int32_t *const list = record ? s->nb_j + (size_t)i * (size_t)s->nb_stride : NULL;
-    const int stride = s->nb_stride;
-    int nlist = 0;
-    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
-        if (p->phase[j] != SPH_SOIL_PHASE)
-            continue;
-        if (record) {
-            if (nlist < stride)
-                list[nlist] = (int32_t)j;
-            nlist++;
-        }
-        double r = sqrt(r2);
-        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
-        double w = vol[j] * fij;
-        double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
-        double xr[3] = {rx, ry, rz};
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++)
-                L[a][b] += w * dv[a] * xr[b];
-    });
     double sig[3][3], eps[3][3], spin[3][3];
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) {
@@ -193,6 +170,58 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
             double pl = lam > 0.0 ? lam * ((a == b ? 3.0 * K * aps : 0.0) + G / rj2 * dev[a][b]) : 0.0;
             s->dsig[SYM[a][b]][i] = jau + el - pl; /* 000 eq. 6 */
         }
+}
+
+int sph_soil_keep_gradient(sph_soil *s)
+{
+    for (int a = 0; a < 9; a++)
+        if (!s->grad[a] && !(s->grad[a] = calloc((size_t)s->cap, sizeof(double))))
+            return -1;
+    return 0;
+}
+
+void sph_soil_wall_gradient(sph_soil *s, const sph_particles *p, int64_t i, const double Lw[9])
+{
+    double L[3][3];
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            L[a][b] = s->grad[a * 3 + b][i] + Lw[a * 3 + b];
+    soil_stress_rate(s, p, i, (const double(*)[3])L);
+}
+
+static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
+                                 const double *vol, int record, int64_t i)
+{
+    const double inv_h = k->inv_h, dnorm = k->dnorm, s2 = k->support * k->support;
+    const kernel_kind kind = k->kind;
+    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
+    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
+    double L[3][3] = {{0.0}}; /* L[a][b] = d v_a / d x_b */
+    int32_t *const list = record ? s->nb_j + (size_t)i * (size_t)s->nb_stride : NULL;
+    const int stride = s->nb_stride;
+    int nlist = 0;
+    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
+        if (p->phase[j] != SPH_SOIL_PHASE)
+            continue;
+        if (record) {
+            if (nlist < stride)
+                list[nlist] = (int32_t)j;
+            nlist++;
+        }
+        double r = sqrt(r2);
+        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
+        double w = vol[j] * fij;
+        double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
+        double xr[3] = {rx, ry, rz};
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                L[a][b] += w * dv[a] * xr[b];
+    });
+    if (s->grad[0]) /* kept for the wall's share (sph_soil_wall_gradient) */
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                s->grad[a * 3 + b][i] = L[a][b];
+    soil_stress_rate(s, p, i, (const double(*)[3])L);
     double own[SPH_NSTRESS];
     for (int a = 0; a < SPH_NSTRESS; a++)
         own[a] = p->sig[a][i];
@@ -208,7 +237,7 @@ static void soil_stress_particle(sph_soil *s, sph_particles *p, const sph_cells 
     s->tensile[i] = tensile;
     if (record)
         s->nb_n[i] = nlist <= stride ? nlist : -1;
-    p->p[i] = -m;
+    p->p[i] = -(own[0] + own[3] + own[5]) / 3.0;
 }
 
 /* Pass 2 may reuse pass 1's soil neighbours when it needs no others (no seepage: water

@@ -92,6 +92,8 @@ typedef struct {
     unsigned char *tensile;        /* 1 where R_i != 0 (a principal stress in tension): the pairs
                                     * where neither particle has one skip f_ij^n */
     double seep;                   /* rho_w g / k_h (kg/(m^3 s)), 0 without seepage (k_h = 0) */
+    double *grad[9];               /* sph_soil_keep_gradient only (else NULL): the soil neighbours'
+                                    * velocity gradient L_ab (index 3a + b) of the last pass 1 */
 } sph_soil;
 
 /* Derived constants (G, K, c_s, alpha_phi, k_c, alpha_psi) of a material. */
@@ -112,6 +114,14 @@ void sph_soil_stress_rates(sph_soil *s, sph_particles *p, const sph_cells *c, co
  * *water_neighbours (0 without seepage). */
 int64_t sph_soil_momentum(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k,
                           int64_t *water_neighbours);
+
+/* Keep each particle's velocity gradient of pass 1 (9 doubles per particle) so that
+ * sph_soil_wall_gradient can add a wall's share to it. Returns 0 or -1 (out of memory). */
+int sph_soil_keep_gradient(sph_soil *s);
+/* After pass 1 (sph_soil_keep_gradient on): the stress rate of soil particle i again, from its
+ * neighbours' velocity gradient plus Lw (index 3a + b), the share of the ghost layers of a wall
+ * (sph_coupling.h, sph_coupling_set_soil_wall). */
+void sph_soil_wall_gradient(sph_soil *s, const sph_particles *p, int64_t i, const double Lw[9]);
 
 /* Tension cracking and the return to the yield surface (Bui 2008 section 3.3) of one stress
  * (xx, xy, xz, yy, yz, zz), in place. */

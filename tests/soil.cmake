@@ -19,8 +19,9 @@ set_tests_properties(soil_geostatic_2d PROPERTIES LABELS "validation;slow;soil" 
 
 # The soil's ghost-layer wall stress (sph.soil_wall_stress: ghost, sph_coupling_set_soil_wall):
 # the row resting on the floor within 5 % of rho g z (the penalty wall alone: +23 % in 2D, +18 %
-# in 3D), every row deeper than H/4 within 5 % in 2D (the 3D layer keeps a +-13 % row-by-row mode
-# of the start-up, cases/README.md), the 2-row bins, K0 and the creep as in soil_geostatic_2d.
+# in 3D), every row deeper than H/4 within 7 % in 2D (the row-by-row mode of the start-up, +-3.4 %
+# about the mean in 2D, +-13 % in 3D, cases/README.md), the 2-row bins, K0 and the creep as in
+# soil_geostatic_2d.
 add_test(NAME soil_geostatic_ghost_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_geostatic_ghost_2d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/geostatic_ghost_2d)
@@ -70,4 +71,13 @@ add_test(NAME soil_granular_column_a2_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_column_a2_2d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_column_a2_2d dx=0.01)
 set_tests_properties(soil_granular_column_a1_2d soil_granular_column_a2_2d PROPERTIES LABELS "validation;slow;soil"
+  TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+# The a = 1 column with the soil's ghost wall stress (sph.soil_wall_stress: ghost), at the case's
+# dx 5 mm: comes to rest (E_k end / peak < 0.01) with L_99 inside the band, no particle through the
+# floor or wall. Without the ghosts' share of the velocity gradient (sph_coupling.h) it blows up
+# within 0.1 s (particles thrown out, E_k growing). About 10 s of CPU on 1 thread.
+add_test(NAME soil_granular_column_a1_ghost_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_column_a1_ghost_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_column_a1_ghost_2d)
+set_tests_properties(soil_granular_column_a1_ghost_2d PROPERTIES LABELS "validation;slow;soil"
   TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

@@ -20,7 +20,12 @@
  *     swaps the particles; leaving the halo releases it (a new contact starts from dt u again).
  *  8. pass 2 over pass 1's neighbour list (sph_soil.nb_j) gives the same bits as the cell walk
  *     (the fallback of a particle whose list overflowed), with stresses in tension at some
- *     particles so the artificial stress takes part. */
+ *     particles so the artificial stress takes part.
+ *  9. the soil ghosts' share of the velocity gradient (sph.soil_wall_stress: ghost): a floor-row
+ *     particle moving alone off the floor has L_yy = 0 within 5 % of its neighbours' share (the
+ *     one-sided compression that made a collapsing column blow up); a field v_y = G y vanishing on
+ *     the floor reads L_yy within 30 % of G in the floor row (0.73 G: the ghosts move with the wall,
+ *     they do not extrapolate the field; 0.51 G without them). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -370,6 +375,96 @@ static void test_list_equals_walk(void)
     sph_fluid_free(&f);
 }
 
+/* A soil lattice nx x ny on a fixed plate (swept top surface y = 0, rows at (j + 1/2) dx) with the
+ * ghost wall stress, velocity v_y = vel(x, y), zero stress; rates evaluated. Returns the index of
+ * the floor-row particle in column nx / 2. */
+static int64_t soil_on_plate(sph_fluid *f, lahar_body *plate, int nx, int ny, double (*vel)(double, double))
+{
+    memset(plate, 0, sizeof *plate);
+    double half[2] = {1.0, 0.02}, t[3] = {0.5 * nx * DX, -0.03, 0.0};
+    lahar_shape_make_box2d(&plate->shape, half, 0.01);
+    lahar_shape_transform(&plate->shape, NULL, t, 1.0);
+    plate->motion = LAHAR_MOTION_FIXED;
+    plate->convex = 1;
+    plate->q[0] = 1.0;
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = DX;
+    prm.rho0 = 1000.0;
+    prm.c0 = 10.0;
+    prm.soil = 1;
+    prm.soil_mat = sand(30.0, 0.0);
+    prm.soil_wall_stress = SPH_WALL_PRESSURE_GHOST;
+    char err[256];
+    if (sph_fluid_init(f, &prm, (int64_t)nx * ny, err, sizeof err) != 0) {
+        CHECK(0, "init: %s", err);
+        return -1;
+    }
+    for (int i = 0; i < nx; i++)
+        for (int j = 0; j < ny; j++) {
+            double x[3] = {(i + 0.5) * DX, (j + 0.5) * DX, 0.0}, v[3] = {0.0, vel(x[0], x[1]), 0.0};
+            sph_particles_add(&f->p, x, v, RHO * DX * DX, RHO, SPH_SOIL_PHASE);
+        }
+    if (sph_fluid_attach_bodies(f, 1, plate) != 0) {
+        CHECK(0, "attach the plate");
+        return -1;
+    }
+    sph_cells_sort(&f->cells, &f->p);
+    sph_fluid_rates(f, NULL, 1e-5);
+    const int64_t id = (int64_t)(nx / 2) * ny; /* column nx / 2, row 0 */
+    for (int64_t i = 0; i < f->p.n; i++)
+        if (f->p.id[i] == id)
+            return i;
+    return -1;
+}
+
+static double vel_lin(double x, double y) /* G y with G = 1/s, zero on the floor */
+{
+    (void)x;
+    return y;
+}
+static const double U_ALONE = 0.01;
+static double vel_alone(double x, double y)
+{
+    return fabs(x - 5.5 * DX) < 0.1 * DX && y < DX ? U_ALONE : 0.0;
+}
+
+/* 9. the soil ghosts' share of the velocity gradient (sph_coupling_set_soil_wall): a floor-row
+ * particle moving alone away from the floor, its neighbours and the floor at rest, is a particle
+ * displaced, not a strain: with the ghosts standing still with the floor its L_yy is 0 (its
+ * neighbours alone give -0.4 u/dx: the compression that, growing its own stress, pushed it further
+ * off the floor, the blow-up of a collapsing column). Measured through the elastic stress rate
+ * (zero stress: dsigma_yy = (K + 4G/3) L_yy). */
+static void test_wall_gradient(void)
+{
+    sph_fluid f;
+    lahar_body plate;
+    int64_t i = soil_on_plate(&f, &plate, 11, 6, vel_alone);
+    if (i >= 0) {
+        const sph_soil *s = &f.soil;
+        double lyy = s->dsig[3][i] / (s->K + 4.0 / 3.0 * s->G), lyy_nb = s->grad[4][i];
+        CHECK(f.cpl.soil_lw_on[i], "the floor-row particle has ghosts");
+        CHECK(lyy_nb < -0.2 * U_ALONE / DX, "premise: the neighbours alone see a compression (L_yy %g 1/s)", lyy_nb);
+        CHECK(fabs(lyy) < 0.05 * fabs(lyy_nb), "lone particle off the floor: L_yy %g 1/s with the ghosts, %g without",
+              lyy, lyy_nb);
+        printf("wall gradient: lone particle L_yy %.3g 1/s with the ghosts, %.3g without (u/dx = %g)\n", lyy, lyy_nb,
+               U_ALONE / DX);
+    }
+    sph_fluid_free(&f);
+    lahar_shape_free(&plate.shape);
+    i = soil_on_plate(&f, &plate, 11, 6, vel_lin);
+    if (i >= 0) {
+        const sph_soil *s = &f.soil;
+        double lyy = s->dsig[3][i] / (s->K + 4.0 / 3.0 * s->G), lyy_nb = s->grad[4][i];
+        CHECK(fabs(lyy - 1.0) < 0.3 && lyy > lyy_nb, "v_y = G y (G = 1/s) on the floor row: L_yy %g with the ghosts, %g without",
+              lyy, lyy_nb);
+        printf("wall gradient: v_y = G y, floor row L_yy %.3g G with the ghosts, %.3g G without\n", lyy, lyy_nb);
+    }
+    sph_fluid_free(&f);
+    lahar_shape_free(&plate.shape);
+}
+
 int main(void)
 {
     test_return();
@@ -379,6 +474,7 @@ int main(void)
     test_seepage();
     test_friction();
     test_list_equals_walk();
+    test_wall_gradient();
     if (failures)
         fprintf(stderr, "%d check(s) failed\n", failures);
     return failures != 0;
