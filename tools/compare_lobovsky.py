@@ -217,10 +217,9 @@ def main():
             t, p = run_p[n]
             ax.plot(te, exp_p[n], "k", lw=1.2, label="Lobovsky 2014, peak event 5")
             ax.plot(t, p, lw=0.7, label="lahar, dx %g mm" % (1e3 * dx))
-            if True:
-                w = max(1, int(round(tau / np.median(np.diff(t)))))
-                ax.plot(t, np.convolve(p, np.ones(w) / w, mode="same"), lw=1.0,
-                        label="lahar, %g ms running mean" % a.window)
+            w = max(1, int(round(tau / np.median(np.diff(t)))))
+            ax.plot(t, np.convolve(p, np.ones(w) / w, mode="same"), lw=1.0,
+                    label="lahar, %g ms running mean" % a.window)
             ax.set_xlim(2.2, min(7.0, t[-1]))
             ax.set_ylabel("p/ρgH, " + n)
             ax.grid(alpha=0.3)
