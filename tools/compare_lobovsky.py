@@ -4,7 +4,7 @@
   tools/compare_lobovsky.py OUT [--window MS] [-o FILE.png] [--json FILE] [--check]
                                 [--rise-tol F] [--peak-band LO HI] [--level-tol F]
 
-Reads OUT/gauges.h5 (probes sensor1..sensor4) and OUT/particles.h5 (snapshots: water levels) and
+Reads OUT/gauges.h5 (pressure probes sensor1..sensor4, level gauges H1..H4) and
 the experiment in docs/references-data/ (lobovsky_2014_pressure.csv: Fig. 18, peak event 5;
 lobovsky_2014_levels.csv: Fig. 16, runs ETSIN 01 and 02). All in the paper's units: t* = t
 sqrt(g/H), p/(rho g H), h/H, H = 0.3 m.
@@ -18,13 +18,13 @@ Metrics (printed, and written to --json):
               Peregrine 1995, J. Fluid Mech. 297:193: the impulse of an impact is set by the
               incompressible flow; the peak of a pulse shorter than tau is not)
   levels      per gauge H1-H4 (x = 0.300, 0.865, 1.114, 1.3625 m), the mean |h_run - h_exp| / H
-              over the run's snapshots with t* <= min(run end, --level-tmax, default 5.5: before
-              the bore reflected from the wall reaches H4), against the experiment's mean
+              over the run's level-gauge samples with t* <= min(run end, --level-tmax, default 5.5:
+              before the bore reflected from the wall reaches H4), against the experiment's mean
               of its runs; beside it the difference between the two experimental runs (their
-              repeat spread) where both exist. h_run = (sum of the volumes m/rho of the water
-              particles, each weighted by a cubic B-spline of x - x_g of width 4 dx and integral 1):
-              the depth of water over the gauge, spray counted at its volume, not its height. For H2-H4 also the arrival of the front, the
-              first t* with h >= 0.05 H (run: snapshot times, 10 ms apart = 0.057 t*), reported only.
+              repeat spread) where both exist. h_run: the case's level gauges (kind: level, 1 kHz;
+              the highest point of the vertical line where the water's kernel fraction is 1/2,
+              sph_node/sph_probes.h). For H2-H4 also the arrival of the front, the first t* with
+              h >= 0.05 H, reported only.
 With --check: exit 1 unless |rise - 2.446| / 2.446 <= --rise-tol (default 0.05), every sensor 1-3
 sensor in --sensors (default sensor1 sensor2) peak_mean / experiment within --peak-band (default
 0.5 2) and every gauge's level difference <= --level-tol (default 0.05 H). The PNG shows pressure and levels against the experiment."""
@@ -52,14 +52,6 @@ SENSORS = ["sensor1", "sensor2", "sensor3", "sensor4"]
 RISE_LEVEL = 0.5  # rho g H
 PEAK_SPAN = 0.3  # t* after the rise in which peaks are sought (52 ms: the sensor 2, 3 maxima)
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "references-data")
-
-
-def bspline(r, dx):
-    """Cubic B-spline (M4) of width 4 dx, integral 1: its translates by dx sum to 1/dx, so a
-    lattice of spacing dx is weighted exactly (Schoenberg 1946)."""
-    q = np.abs(r) / dx
-    w = np.where(q < 1.0, 2.0 / 3.0 - q * q + 0.5 * q ** 3, np.where(q < 2.0, (2.0 - q) ** 3 / 6.0, 0.0))
-    return w / dx
 
 
 def read_csv(name):
@@ -143,34 +135,30 @@ def main():
         s["ratio"] = s["peak"] / s["peak_exp"]
         s["ratio_mean"] = s["peak_mean"] / s["peak_mean_exp"]
 
-    # levels: depth of water over each gauge from the snapshots
-    hs = {}
-    with h5py.File(os.path.join(a.out, "particles.h5"), "r") as f:
-        snaps = f["snapshots"]
-        ts = []
+    # levels: the level gauges H1-H4 of the case (kind: level, gauges.h5)
+    hs, tls = {}, {}
+    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         for g, _ in GAUGES:
-            hs[g] = []
-        for k in sorted(snaps.keys()):
-            s = snaps[k]
-            x = s["x"][:]
-            vol = RHO * dx * dx / s["density"][:]  # mass rho0 dx^2 per particle (2D)
-            ts.append(float(s.attrs["time"]) / TS)
-            for g, xg in GAUGES:
-                hs[g].append(np.sum(vol * bspline(x - xg, dx)) / H)
-        tl = np.array(ts)
+            if g not in f["probes"] or "h" not in f["probes"][g]:
+                sys.stderr.write("compare_lobovsky: %s/gauges.h5 has no level gauge %s (kind: level); run "
+                                 "cases/dam_break_lobovsky_2d.yaml as it is\n" % (a.out, g))
+                return 2
+            tls[g] = f["probes"][g]["t"][:] / TS
+            hs[g] = f["probes"][g]["h"][:] / H
     m["levels"] = {}
-    tmax = min(tl[-1], a.level_tmax)
     for g, _ in GAUGES:
+        tl = tls[g]
+        tmax = min(tl[-1], a.level_tmax)
         runs = [c for c in lh if c.startswith(g + "_")]
         cols = [le[:, lh.index(c)] for c in runs]
         mean_exp = np.mean(cols, axis=0)
         sel = tl <= tmax
         he = np.interp(tl[sel], le[:, 0], mean_exp)
-        hr = np.array(hs[g])[sel]
+        hr = hs[g][sel]
         d = {"mean_abs_diff": float(np.mean(np.abs(hr - he))), "t_star_max": float(tmax)}
         # arrival of the front: first h/H >= 0.05 (H1 stands in the column: skipped)
         if g != "H1":
-            i_r, i_e = np.flatnonzero(np.array(hs[g]) >= 0.05), np.flatnonzero(mean_exp >= 0.05)
+            i_r, i_e = np.flatnonzero(hs[g] >= 0.05), np.flatnonzero(mean_exp >= 0.05)
             if len(i_r) and len(i_e):
                 d["arrival"], d["arrival_exp"] = float(tl[i_r[0]]), float(le[i_e[0], 0])
                 d["arrival_rel"] = (d["arrival"] - d["arrival_exp"]) / d["arrival_exp"]
@@ -231,8 +219,8 @@ def main():
             for c in [c for c in lh if c.startswith(g + "_")]:
                 ax.plot(le[:, 0], le[:, lh.index(c)], "k" if c.endswith("run1") else "0.5", lw=1.0,
                         label="Lobovsky 2014, " + ("ETSIN 01" if c.endswith("run1") else "ETSIN 02"))
-            ax.plot(tl, hs[g], ".", ms=3, label="lahar")
-            ax.set_xlim(0, min(7.0, tl[-1]))
+            ax.plot(tls[g], hs[g], lw=0.8, label="lahar, level gauge")
+            ax.set_xlim(0, min(7.0, tls[g][-1]))
             ax.set_ylabel("h/H, %s (x = %g m)" % (g, xg))
             ax.grid(alpha=0.3)
             if k == 0:
