@@ -2188,11 +2188,22 @@ static void case_domain_box(const lahar_case *c, double lo[3], double hi[3])
         lo[a] = hi[a] = 0.0;
 }
 
-/* The floor under a level gauge at the horizontal position x (x[dim - 1] ignored): going up from
- * the bottom of the domain box lo..hi along the vertical (the last axis), the point where the line
- * leaves the solid it starts in (steps of dx/16, then bisection to 1e-6 dx); lo itself when the
- * line starts outside every body. Returns the floor, or NAN when the line stays inside body *hit
- * up to hi (then *hit is its index). */
+/* 1 if the world point q lies in any body's solid. */
+static int case_in_solid(const lahar_case *c, const double q[3], int *hit)
+{
+    for (int b = 0; b < c->nbody; b++)
+        if (lahar_body_contains(&c->bodies[b], c->dim, q)) {
+            *hit = b;
+            return 1;
+        }
+    return 0;
+}
+
+/* The floor under a level gauge at the horizontal position x (x[dim - 1] ignored): going up the
+ * vertical (the last axis) from the bottom of the domain box lo..hi in steps of dx/16, the first
+ * solid the line meets, and the point where the line leaves it (the union of the bodies; refined
+ * by bisection to 1e-6 dx); lo when the line meets no solid. Returns the floor, or NAN when the
+ * line stays inside body *hit up to hi. */
 static double case_level_floor(const lahar_case *c, const double x[3], double lo, double hi, double dx, int *hit)
 {
     const int v = c->dim - 1;
@@ -2200,28 +2211,24 @@ static double case_level_floor(const lahar_case *c, const double x[3], double lo
     const double step = dx / 16.0;
     *hit = -1;
     double z = lo + 0.5 * step, zin = lo;
+    int met = 0;
     for (;; z += step) {
         if (z > hi)
-            return NAN;
+            return met ? NAN : lo;
         q[v] = z;
-        int in = -1;
-        for (int b = 0; b < c->nbody && in < 0; b++)
-            if (lahar_body_contains(&c->bodies[b], c->dim, q))
-                in = b;
-        if (in < 0)
+        int in = case_in_solid(c, q, hit);
+        if (in) {
+            met = 1;
+            zin = z;
+        } else if (met) {
             break;
-        *hit = in;
-        zin = z;
+        }
     }
-    if (*hit < 0)
-        return lo;
     double a = zin, b = z; /* a inside, b outside */
+    int dummy;
     while (b - a > 1e-6 * dx) {
         q[v] = 0.5 * (a + b);
-        int in = 0;
-        for (int k = 0; k < c->nbody && !in; k++)
-            in = lahar_body_contains(&c->bodies[k], c->dim, q);
-        if (in)
+        if (case_in_solid(c, q, &dummy))
             a = q[v];
         else
             b = q[v];

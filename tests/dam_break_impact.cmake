@@ -1,8 +1,8 @@
 # Wall impact pressure of a dam break against experiments. Lobovsky et al. 2014,
 # H = 300 mm (cases/dam_break_lobovsky_2d.yaml at dx = 10 mm, 1 s, one thread; 9 s of CPU, 20-45 s
 # on the loaded 2-core machine): impact time at sensor 1 within 5 %, the 10 ms mean peak pressure of
-# sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 within 0.05 H (mean over
-# t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
+# sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 (the case's level gauges)
+# within 0.05 H (mean over t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
 # measured values: cases/README.md "Lobovsky dam break".
 if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
   set(LAHAR_OUTPUT_PYTHON python3)

@@ -9,7 +9,8 @@ then tools/compare_lobovsky.py --check against docs/references-data/lobovsky_201
   - the largest 10 ms mean pressure of sensors 1 and 2 within [0.5, 2] x the experiment's
     (peak event 5: 2.47 and 1.90 rho g H; a stated tolerance: the repeat spread of the peaks is not
     available, docs/references-data/lobovsky_2014.md);
-  - water levels H1-H4: mean |h - h_exp| <= 0.05 H over t* <= 5.5.
+  - water levels H1-H4 (the case's level gauges, gauges.h5): mean |h - h_exp| <= 0.05 H over
+    t* <= 5.5.
 Measured at dx 10 mm: cases/README.md "Lobovsky dam break". Writes OUT/lobovsky.json and
 OUT/lobovsky.png."""
 import os

@@ -3,8 +3,8 @@
 
   tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE]
 
-Reads OUT/gauges.h5 (probes P1..P8 on the obstacle), OUT/particles.h5 (snapshots: water levels)
-and docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m). Metrics
+Reads OUT/gauges.h5 (probes P1..P8 on the obstacle, level gauges H1..H4) and
+docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m). Metrics
 (printed, and written to --json, default OUT/spheric2.json):
   impact     t of the first sample of P1 at or above 1 kPa, run and experiment (0.394 s), relative
              difference
@@ -12,8 +12,8 @@ and docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in
              within 0.2 s of P1's impact
   levels     H1-H4 at (x, y) = (1.488, 0.5), (0.992, 0.5), (0.496, 0.5), (2.638, 0.5) m: the time
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
-             h_run = sum of the volumes m/rho of the water particles, each weighted by the
-             product of cubic B-splines (width 4 dx, integral 1) of x - x_g and y - y_g
+             h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
+             the floor, where the water's kernel fraction falls to 1/2, sph_node/sph_probes.h)
 The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment."""
 import argparse
 import json
@@ -37,13 +37,6 @@ IMPACT_PA = 1000.0
 SPAN = 0.2
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "references-data",
                     "kleefsman_2005_test2.csv")
-
-
-def bspline(r, dx):
-    """Cubic B-spline (M4) of width 4 dx, integral 1 (translates by dx sum to 1/dx)."""
-    q = np.abs(r) / dx
-    w = np.where(q < 1.0, 2.0 / 3.0 - q * q + 0.5 * q ** 3, np.where(q < 2.0, (2.0 - q) ** 3 / 6.0, 0.0))
-    return w / dx
 
 
 def first_at_or_above(t, p, level):
@@ -91,24 +84,23 @@ def main():
         sel, sele = (t >= ti_run) & (t <= ti_run + SPAN), (te >= ti_exp) & (te <= ti_exp + SPAN)
         m["peaks"][n] = {"peak": float(p[sel].max()), "peak_exp": float(pe[sele].max()),
                          "peak_mean": window_peak(t, p, ti_run, tau), "peak_mean_exp": window_peak(te, pe, ti_exp, tau)}
-    tl, hs = [], {g: [] for g, _, _ in GAUGES}
-    with h5py.File(os.path.join(a.out, "particles.h5"), "r") as f:
-        for k in sorted(f["snapshots"].keys()):
-            s = f["snapshots"][k]
-            x, y = s["x"][:], s["y"][:]
-            vol = 1000.0 * dx ** 3 / s["density"][:]
-            tl.append(float(s.attrs["time"]))
-            for g, xg, yg in GAUGES:
-                hs[g].append(np.sum(vol * bspline(x - xg, dx) * bspline(y - yg, dx)))
-    tl = np.array(tl)
+    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
+        missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
+        if missing:
+            sys.stderr.write("compare_spheric2: %s/gauges.h5 has no level gauge %s (kind: level); run "
+                             "cases/dam_break_obstacle_3d.yaml as it is\n" % (a.out, ", ".join(missing)))
+            return 2
+        tls = {g: f["probes"][g]["t"][:] for g, _, _ in GAUGES}
+        hs = {g: f["probes"][g]["h"][:] for g, _, _ in GAUGES}
+    tl = tls["H1"]
     m["levels"] = {}
     for g, _, _ in GAUGES:
         he = e[:, head.index(g)]
-        hr = np.array(hs[g])
-        arr_run = next((tl[i] for i in range(len(tl)) if abs(hr[i] - hr[0]) >= 0.02), float("nan"))
+        hr, tg = hs[g], tls[g]
+        arr_run = next((tg[i] for i in range(len(tg)) if abs(hr[i] - hr[0]) >= 0.02), float("nan"))
         arr_exp = next((te[i] for i in range(len(te)) if abs(he[i] - he[0]) >= 0.02), float("nan"))
         m["levels"][g] = {"change_run": float(arr_run), "change_exp": float(arr_exp),
-                          "mean_abs_diff_m": float(np.mean(np.abs(hr - np.interp(tl, te, he))))}
+                          "mean_abs_diff_m": float(np.mean(np.abs(hr - np.interp(tg, te, he))))}
     print("first impact on P1 (>= 1 kPa): t = %.4f s (experiment %.4f s, %+.1f %%)" % (
         ti_run, ti_exp, 100 * m["impact"]["rel"]))
     for n, s in m["peaks"].items():
@@ -134,7 +126,7 @@ def main():
     for k, (g, xg, yg) in enumerate(GAUGES):
         ax = axes[k, 1]
         ax.plot(te, e[:, head.index(g)], "k", lw=1.0, label="experiment")
-        ax.plot(tl, hs[g], ".", ms=3, label="lahar")
+        ax.plot(tls[g], hs[g], lw=0.8, label="lahar, level gauge")
         ax.set_ylabel("%s (x = %g m), m" % (g, xg))
         ax.grid(alpha=0.3)
         if k == 0:
