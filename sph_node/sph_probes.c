@@ -238,6 +238,8 @@ double sph_probes_level(const sph_fluid *f, const double foot[3], int npt, doubl
                 if (rh2 >= S2)
                     continue;
                 const double half = sqrt(S2 - rh2), vj = p->m[j] / p->rho[j];
+                if (!(xj[v] + half >= z0 && xj[v] - half <= ztop)) /* beyond the line (an edge cell) */
+                    continue;
                 int i0 = (int)ceil((xj[v] - half - z0) / step), i1 = (int)floor((xj[v] + half - z0) / step);
                 if (i0 < 0)
                     i0 = 0;
@@ -249,6 +251,8 @@ double sph_probes_level(const sph_fluid *f, const double foot[3], int npt, doubl
                         phi[i] += vj * kernel_w(k, sqrt(r2));
                 }
                 /* its mirror image below the floor (z0 - (zj - z0)): the half space the floor cuts off */
+                if (xj[v] < z0) /* a particle below the floor has no image */
+                    continue;
                 const double zm = 2.0 * z0 - xj[v];
                 int m1 = (int)floor((zm + half - z0) / step);
                 if (m1 > npt - 1)
