@@ -2352,9 +2352,11 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
-/* probes: [{name, position, body, size, rate}, ...] (lahar_probe, common/scene.h). A fluid probe
- * must lie in the box of the bodies and blocks and outside every body; a body probe within sph.dx
- * of the body's swept surface (it is projected onto it, and the outward normal stored). */
+/* probes: [{name, kind, position, body, size, rate}, ...] (lahar_probe, common/scene.h). A fluid
+ * probe must lie in the box of the bodies and blocks and outside every body; a body probe within
+ * sph.dx of the body's swept surface (it is projected onto it, and the outward normal stored). A
+ * level gauge (kind: level) gives the horizontal position only, inside the box; gravity must act
+ * along the last axis (down); its floor is found below (case_level_floor). */
 static void case_domain_box(const lahar_case *c, double lo[3], double hi[3])
 {
     for (int a = 0; a < 3; a++)
@@ -2379,9 +2381,112 @@ static void case_domain_box(const lahar_case *c, double lo[3], double hi[3])
         lo[a] = hi[a] = 0.0;
 }
 
+/* 1 if the world point q lies in any body's solid. */
+static int case_in_solid(const lahar_case *c, const double q[3], int *hit)
+{
+    for (int b = 0; b < c->nbody; b++)
+        if (lahar_body_contains(&c->bodies[b], c->dim, q)) {
+            *hit = b;
+            return 1;
+        }
+    return 0;
+}
+
+/* The floor under a level gauge at the horizontal position x (x[dim - 1] ignored): going up the
+ * vertical (the last axis) from the bottom of the domain box lo..hi in steps of dx/16, the first
+ * solid the line meets, and the point where the line leaves it (the union of the bodies; refined
+ * by bisection to 1e-6 dx); lo when the line meets no solid. Returns the floor, or NAN when the
+ * line stays inside body *hit up to hi. */
+static double case_level_floor(const lahar_case *c, const double x[3], double lo, double hi, double dx, int *hit)
+{
+    const int v = c->dim - 1;
+    double q[3] = {x[0], x[1], x[2]};
+    const double step = dx / 16.0;
+    *hit = -1;
+    double z = lo + 0.5 * step, zin = lo;
+    int met = 0;
+    for (;; z += step) {
+        if (z > hi)
+            return met ? NAN : lo;
+        q[v] = z;
+        int in = case_in_solid(c, q, hit);
+        if (in) {
+            met = 1;
+            zin = z;
+        } else if (met) {
+            break;
+        }
+    }
+    double a = zin, b = z; /* a inside, b outside */
+    int dummy;
+    while (b - a > 1e-6 * dx) {
+        q[v] = 0.5 * (a + b);
+        if (case_in_solid(c, q, &dummy))
+            a = q[v];
+        else
+            b = q[v];
+    }
+    *hit = -1;
+    return b;
+}
+
+/* A level gauge (kind: level) of probes: at its horizontal position. */
+static void read_level_gauge(reader *r, rmap *pm, const lahar_case *c, lahar_probe *pr, const double lo[3],
+                             const double hi[3])
+{
+    const int dim = c->dim, v = dim - 1;
+    const double dx = c->sph_dx;
+    static const char *const axes[] = {"x", "y", "z"};
+    if (rmap_get(pm, "body") || rmap_get(pm, "size")) {
+        rmap_fail(pm, rmap_get(pm, "body") ? "body" : "size", "is a key of pressure sensors on a body; a level gauge "
+                  "(kind: level) is a vertical line through the water: remove it");
+        return;
+    }
+    int vertical = c->gravity[v] < 0.0;
+    for (int a = 0; a < v; a++)
+        vertical &= c->gravity[a] == 0.0;
+    if (!vertical) {
+        if (dim == 3)
+            rmap_fail(pm, "kind", "level gauges measure along the vertical z and need gravity [0, 0, -g] (got [%g, %g, "
+                      "%g]); use pressure probes in this case", c->gravity[0], c->gravity[1], c->gravity[2]);
+        else
+            rmap_fail(pm, "kind", "level gauges measure along the vertical y and need gravity [0, -g] (got [%g, %g]); "
+                      "use pressure probes in this case", c->gravity[0], c->gravity[1]);
+        return;
+    }
+    pr->body = -1;
+    pr->size = 0.0;
+    pr->rate = rmap_num(pm, "rate", 0, 0.0, "1000");
+    if (!rmap_vec(pm, "position", v, pr->x, 1, dim == 3 ? "[0.5, 0.3] (x, y of the vertical line)"
+                                                           : "[0.5] (x of the vertical line)"))
+        return;
+    if (!(pr->rate >= 0.0) || !isfinite(pr->rate)) {
+        rmap_fail(pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)", pr->rate);
+        return;
+    }
+    for (int a = 0; a < v; a++)
+        if (!(pr->x[a] >= lo[a] && pr->x[a] <= hi[a])) {
+            rmap_fail(pm, "position", "lies outside the domain (the box of the bodies and blocks, %s in [%g, %g]; got "
+                      "%s = %g); a level gauge's position is the horizontal place of its vertical line",
+                      axes[a], lo[a], hi[a], axes[a], pr->x[a]);
+            return;
+        }
+    int hit;
+    double fl = case_level_floor(c, pr->x, lo[v], hi[v], dx, &hit);
+    if (isnan(fl)) {
+        rmap_fail(pm, "position", "the vertical line there lies inside body '%s' up to the top of the domain (%s = "
+                  "%g); move the gauge over the water", c->bodies[hit].name, axes[v], hi[v]);
+        return;
+    }
+    pr->x[v] = fl;
+    pr->top = hi[v] + dx;
+    (void)r;
+}
+
 static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const pkeys[] = {"name", "position", "body", "size", "rate", NULL};
+    static const char *const pkeys[] = {"name", "kind", "position", "body", "size", "rate", NULL};
+    static const char *const kinds[] = {"pressure", "level", NULL};
     if (!n || r->failed)
         return;
     if (n->type != YAML_SEQUENCE_NODE) {
@@ -2389,7 +2494,7 @@ static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     }
     if (c->nblock == 0) {
-        rd_fail(r, n, "probes", "pressure probes read the SPH fluid, but the case has no sph: blocks; remove probes "
+        rd_fail(r, n, "probes", "probes read the SPH fluid, but the case has no sph: blocks; remove probes "
                 "or add an sph section");
         return;
     }
@@ -2419,6 +2524,15 @@ static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
         for (int j = 0; j < i && !r->failed; j++)
             if (strcmp(c->probes[j].name, pr->name) == 0)
                 rmap_fail(&pm, "name", "'%s' is already the name of probes[%d]; probe names must be unique", pr->name, j);
+        pr->kind = rmap_enum(&pm, "kind", kinds, 0, LAHAR_PROBE_PRESSURE);
+        if (r->failed)
+            return;
+        if (pr->kind == LAHAR_PROBE_LEVEL) {
+            read_level_gauge(r, &pm, c, pr, lo, hi);
+            if (r->failed)
+                return;
+            continue;
+        }
         rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[0.5, 0.0, 0.01]" : "[0.5, 0.01]");
         pr->size = rmap_num(&pm, "size", 0, 0.0, "0.009");
         pr->rate = rmap_num(&pm, "rate", 0, 0.0, "20000");

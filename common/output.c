@@ -1677,11 +1677,14 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
         H5Gclose(h);
     rc |= out_attr_string(o->file, "units", "SI");
     rc |= out_attr_string(o->file, "description",
-                          "pressure probes (case section probes:): per probe /probes/NAME/t (s), step and p (Pa, "
-                          "gauge: 0 at the free surface). Fluid points: Shepard interpolation of the water "
-                          "particles' pressure (DualSPHysics MeasureTool, dry below sum V W = 0.5: 0). Points on a "
-                          "body: Adami, Hu & Adams 2012 eq. 27 at the surface point (dry below sum V W = 0.1: 0), "
-                          "averaged over the sensor's segment (2D) or disc (3D) of diameter size");
+                          "probes (case section probes:): per probe /probes/NAME/t (s), step and p (Pa, gauge: 0 at "
+                          "the free surface; kind pressure) or h (m; kind level). Fluid points: Shepard "
+                          "interpolation of the water particles' pressure (DualSPHysics MeasureTool, dry below sum "
+                          "V W = 0.5: 0). Points on a body: Adami, Hu & Adams 2012 eq. 27 at the surface point (dry "
+                          "below sum V W = 0.1: 0), averaged over the sensor's segment (2D) or disc (3D) of diameter "
+                          "size. Level gauges: the top of the water column on the floor along the vertical line from "
+                          "position (on the floor) up to top, the first point going up where sum V W (mirrored at "
+                          "the floor) falls to 0.5, above the floor (0: dry)");
     rc |= out_attr_string(o->file, "lahar_version", LAHAR_VERSION);
     hid_t pg = out_group(o->file, "probes");
     if (pg < 0)
@@ -1697,19 +1700,27 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
             rc = -1;
             break;
         }
+        const int level = pr->kind == LAHAR_PROBE_LEVEL;
+        rc |= out_attr_string(gg, "kind", level ? "level" : "pressure");
         rc |= out_attr(gg, "position", H5T_NATIVE_DOUBLE, 3, pr->x);
+        if (level) {
+            rc |= out_attr_double(gg, "floor", pr->x[c->dim - 1]);
+            rc |= out_attr_double(gg, "top", pr->top);
+        }
         rc |= out_attr_string(gg, "body", pr->body >= 0 ? c->bodies[pr->body].name : "");
         if (pr->body >= 0)
             rc |= out_attr(gg, "normal", H5T_NATIVE_DOUBLE, 3, pr->n);
         rc |= out_attr_double(gg, "size", pr->size);
         rc |= out_attr_double(gg, "rate", pr->rate);
-        rc |= out_attr_string(gg, "method", pr->body >= 0 ? "wall: Adami, Hu & Adams 2012 eq. 27"
+        rc |= out_attr_string(gg, "method", level ? "level: first z up from the floor with sum V W = 0.5"
+                                            : pr->body >= 0 ? "wall: Adami, Hu & Adams 2012 eq. 27"
                                                             : "fluid: Shepard interpolation (DualSPHysics MeasureTool)");
         struct {
             hid_t *id;
             const char *name, *units;
             hid_t type;
-        } ds[] = {{&g->t, "t", "s", H5T_IEEE_F64LE}, {&g->step, "step", "", H5T_STD_I64LE}, {&g->p, "p", "Pa", H5T_IEEE_F64LE}};
+        } ds[] = {{&g->t, "t", "s", H5T_IEEE_F64LE}, {&g->step, "step", "", H5T_STD_I64LE},
+                  {&g->p, level ? "h" : "p", level ? "m" : "Pa", H5T_IEEE_F64LE}};
         for (size_t d = 0; d < sizeof ds / sizeof ds[0]; d++) {
             hsize_t dim0 = 0, maxd = H5S_UNLIMITED, ch = GAUGE_BUFFER_ROWS;
             hid_t sp = H5Screate_simple(1, &dim0, &maxd), dcpl = out_dcpl();

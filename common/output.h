@@ -10,7 +10,7 @@
  *   OUT/particles.h5 + OUT/particles.xmf   SPH particles (SoA datasets, fields selectable).
  *   OUT/lahar.xmf   bodies and particles in one XDMF (lahar_output_xdmf_combine).
  *   OUT/contacts.h5 fluid contact points and their forces on the bodies marked record_contacts.
- *   OUT/gauges.h5   pressure probes of the case (probes:), SWMR like forces.h5. */
+ *   OUT/gauges.h5   pressure probes and level gauges of the case (probes:), SWMR like forces.h5. */
 #ifndef LAHAR_OUTPUT_H
 #define LAHAR_OUTPUT_H
 #include <stddef.h>
@@ -81,9 +81,10 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
                                const double (*force)[3], const double (*torque)[3]);
 void lahar_contact_output_close(lahar_contact_output *o);
 
-/* Pressure probes of the case (probes:, OUT/gauges.h5, SWMR like forces.h5: readable while the
- * run appends): per probe /probes/NAME/{t, step, p} with units attributes and the probe's
- * position, body, normal, size, rate and method as attributes of its group. open returns NULL
+/* Probes of the case (probes:, OUT/gauges.h5, SWMR like forces.h5: readable while the run
+ * appends): per probe /probes/NAME/{t, step, p} (pressure, Pa) or {t, step, h} (level gauges, m)
+ * with units attributes and the probe's kind, position, body, normal, size, rate, method (and for
+ * level gauges floor and top) as attributes of its group. open returns NULL
  * with err empty when the case has no probes (nothing is written), NULL with a message on
  * failure. write appends (step, t, p[k]) to every probe k with due[k] set (buffered; flushed
  * every 1024 rows or 0.5 s of wall time and at close). o NULL: no-op. */

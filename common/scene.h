@@ -152,14 +152,22 @@ typedef struct {
                               instead of the lattice (lahar_case_block_lattice); default 0 */
 } lahar_sph_options;
 
-/* A pressure probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).
+/* A probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).
+ * kind LAHAR_PROBE_LEVEL: a water-level gauge, the vertical line (the last axis, along gravity)
+ * from x (the floor under the gauge: x[dim - 1] = floor) up to `top`; it reads the height of the
+ * free surface above the floor (sph_probes.h). The other fields are for pressure probes:
  * body < 0: a point in the fluid, pressure by Shepard interpolation of the water particles.
  * body >= 0: a point on that body's swept surface (the loader projects x onto it and stores the
  * outward normal n), pressure by Adami, Hu & Adams 2012 eq. 27 at the surface point; with size > 0
  * the mean over a segment (2D) or disc (3D) of that diameter on the surface. */
+enum { LAHAR_PROBE_PRESSURE = 0, LAHAR_PROBE_LEVEL = 1 };
+
 typedef struct {
     char name[LAHAR_NAME_MAX];
-    double x[3];           /* world point at the scene pose (on the surface when body >= 0) */
+    int kind;              /* LAHAR_PROBE_PRESSURE (default) or LAHAR_PROBE_LEVEL */
+    double x[3];           /* world point at the scene pose (on the surface when body >= 0; level
+                              gauges: the foot of the line on the floor) */
+    double top;            /* level gauges: vertical coordinate of the line's top (m) */
     double n[3];           /* body probes: outward surface normal at x (world, scene pose) */
     int body;              /* index into lahar_case.bodies, or -1 */
     double size;           /* sensor diameter, m (0: the point) */

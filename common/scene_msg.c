@@ -126,6 +126,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         const lahar_probe *a = &c->probes[i];
         lahar_probe_t *b = &m->probes[i];
         b->name = (char *)a->name;
+        b->kind = (int8_t)a->kind;
+        b->top = a->top;
         memcpy(b->x, a->x, sizeof b->x);
         memcpy(b->n, a->n, sizeof b->n);
         b->body = a->body;
@@ -410,12 +412,16 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
     for (int i = 0; i < m->nprobe; i++) {
         const lahar_probe_t *a = &m->probes[i];
         lahar_probe *b = &c->probes[i];
-        if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0)) {
+        if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
+            (a->kind != LAHAR_PROBE_PRESSURE && a->kind != LAHAR_PROBE_LEVEL) ||
+            (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
             snprintf(err, errlen, "malformed scene message (probe %d)", i);
             lahar_case_free(c);
             return -1;
         }
         scene_copy_name(b->name, a->name);
+        b->kind = a->kind;
+        b->top = a->top;
         memcpy(b->x, a->x, sizeof b->x);
         memcpy(b->n, a->n, sizeof b->n);
         b->body = a->body;

@@ -1,4 +1,4 @@
-/* Pressure probes (sph_probes.h). */
+/* Pressure probes and level gauges (sph_probes.h). */
 #include "sph_probes.h"
 
 #include <math.h>
@@ -9,6 +9,7 @@
 #include "vec.h"
 
 #define SPH_PROBE_DRY_FLUID 0.5 /* DualSPHysics MeasureTool kclimit */
+#define SPH_PROBE_LEVEL_POINTS 8 /* line points per dx */
 #define SPH_PROBE_DRY_WALL 0.1  /* wetted: ~1/2 on a flat wall, ~1/4 in a 90 degree corner */
 
 /* Points of a sensor of diameter size about x with normal n (world, scene pose), at most dx/4
@@ -86,8 +87,23 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
     pr->due = calloc((size_t)n, sizeof *pr->due);
     pr->xl = malloc((size_t)n * SPH_PROBE_MAX_POINTS * sizeof *pr->xl);
     pr->nl = malloc((size_t)n * SPH_PROBE_MAX_POINTS * sizeof *pr->nl);
+    pr->kind = calloc((size_t)n, sizeof *pr->kind);
+    pr->l0 = calloc((size_t)n + 1, sizeof *pr->l0);
+    pr->lstep = calloc((size_t)n, sizeof *pr->lstep);
+    /* level gauges: points dx / SPH_PROBE_LEVEL_POINTS apart from the floor to the top */
+    int64_t nlp = 0;
+    const double lstep = c->sph_dx / SPH_PROBE_LEVEL_POINTS;
+    for (int k = 0; k < n && pr->l0; k++) {
+        const lahar_probe *p = &c->probes[k];
+        pr->l0[k] = (int)nlp;
+        if (p->kind == LAHAR_PROBE_LEVEL)
+            nlp += (int64_t)ceil((p->top - p->x[c->dim - 1]) / lstep) + 1;
+    }
+    if (pr->l0 && nlp < INT32_MAX)
+        pr->l0[n] = (int)nlp;
+    pr->lphi = nlp < INT32_MAX ? malloc((size_t)(nlp > 0 ? nlp : 1) * sizeof *pr->lphi) : NULL;
     if (!tx || !tn || !pr->pt0 || !pr->body || !pr->rate || !pr->next_slot || !pr->value || !pr->due || !pr->xl ||
-        !pr->nl) {
+        !pr->nl || !pr->kind || !pr->l0 || !pr->lstep || !pr->lphi) {
         free(tx), free(tn);
         sph_probes_free(pr);
         return -1;
@@ -99,6 +115,8 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
         pr->pt0[k] = m;
         pr->body[k] = p->body;
         pr->rate[k] = p->rate;
+        pr->kind[k] = p->kind;
+        pr->lstep[k] = lstep;
         if (p->body < 0) {
             memcpy(pr->xl[m], p->x, sizeof pr->xl[m]);
             memset(pr->nl[m], 0, sizeof pr->nl[m]);
@@ -124,7 +142,7 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
 void sph_probes_free(sph_probes *pr)
 {
     free(pr->pt0), free(pr->body), free(pr->rate), free(pr->next_slot), free(pr->value), free(pr->due);
-    free(pr->xl), free(pr->nl);
+    free(pr->xl), free(pr->nl), free(pr->kind), free(pr->l0), free(pr->lphi), free(pr->lstep);
     memset(pr, 0, sizeof *pr);
 }
 
@@ -187,6 +205,74 @@ double sph_probes_point(const sph_fluid *f, const double x[3], int wall)
     return svw >= SPH_PROBE_DRY_FLUID ? spw / svw : 0.0;
 }
 
+double sph_probes_level(const sph_fluid *f, const double foot[3], int npt, double step, double *phi)
+{
+    const sph_cells *cl = &f->cells;
+    const sph_particles *p = &f->p;
+    const kernel *k = &f->k;
+    const int dim = cl->dim, v = dim - 1;
+    const double S = k->support, S2 = S * S, z0 = foot[v], ztop = z0 + (npt - 1) * step;
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; a++)
+        probe_cell_range(cl, a, foot[a], S, &lo[a], &hi[a]);
+    lo[v] = sph_cells_coord(cl, v, z0 - S);
+    hi[v] = sph_cells_coord(cl, v, ztop + S);
+    for (int i = 0; i < npt; i++)
+        phi[i] = 0.0;
+    for (int cz = lo[2]; cz <= hi[2]; cz++)
+        for (int cy = lo[1]; cy <= hi[1]; cy++) {
+            int64_t row = ((int64_t)cz * cl->nc[1] + cy) * cl->nc[0];
+            for (int64_t j = cl->start[row + lo[0]]; j < cl->start[row + hi[0] + 1]; j++) {
+                if (p->phase[j] != 0)
+                    continue;
+                const double xj[3] = {p->x[j], p->y[j], dim == 3 ? p->z[j] : 0.0};
+                double rh2 = 0.0;
+                for (int a = 0; a < v; a++) {
+                    double r = foot[a] - xj[a];
+                    if (cl->periodic[a]) {
+                        double L = cl->hi[a] - cl->lo[a];
+                        r -= L * floor(r / L + 0.5);
+                    }
+                    rh2 += r * r;
+                }
+                if (rh2 >= S2)
+                    continue;
+                const double half = sqrt(S2 - rh2), vj = p->m[j] / p->rho[j];
+                if (!(xj[v] + half >= z0 && xj[v] - half <= ztop)) /* beyond the line (an edge cell) */
+                    continue;
+                int i0 = (int)ceil((xj[v] - half - z0) / step), i1 = (int)floor((xj[v] + half - z0) / step);
+                if (i0 < 0)
+                    i0 = 0;
+                if (i1 > npt - 1)
+                    i1 = npt - 1;
+                for (int i = i0; i <= i1; i++) {
+                    double dz = z0 + i * step - xj[v], r2 = rh2 + dz * dz;
+                    if (r2 < S2)
+                        phi[i] += vj * kernel_w(k, sqrt(r2));
+                }
+                /* its mirror image below the floor (z0 - (zj - z0)): the half space the floor cuts off */
+                if (xj[v] < z0) /* a particle below the floor has no image */
+                    continue;
+                const double zm = 2.0 * z0 - xj[v];
+                int m1 = (int)floor((zm + half - z0) / step);
+                if (m1 > npt - 1)
+                    m1 = npt - 1;
+                for (int i = 0; i <= m1; i++) {
+                    double dz = z0 + i * step - zm, r2 = rh2 + dz * dz;
+                    if (r2 < S2)
+                        phi[i] += vj * kernel_w(k, sqrt(r2));
+                }
+            }
+        }
+    /* the first crossing of 1/2 going up from the floor: the top of the water column standing on it */
+    if (phi[0] < SPH_PROBE_DRY_FLUID)
+        return 0.0;
+    for (int i = 1; i < npt; i++)
+        if (phi[i] < SPH_PROBE_DRY_FLUID)
+            return (i - 1 + (phi[i - 1] - SPH_PROBE_DRY_FLUID) / (phi[i - 1] - phi[i])) * step;
+    return (npt - 1) * step;
+}
+
 int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, const lahar_body_state *states,
                       double t)
 {
@@ -202,6 +288,11 @@ int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, c
         }
         pr->due[k] = 1;
         ndue++;
+        if (pr->kind[k] == LAHAR_PROBE_LEVEL) {
+            pr->value[k] = sph_probes_level(f, pr->xl[pr->pt0[k]], pr->l0[k + 1] - pr->l0[k], pr->lstep[k],
+                                            pr->lphi + pr->l0[k]);
+            continue;
+        }
         const int b = pr->body[k];
         double sum = 0.0;
         for (int i = pr->pt0[k]; i < pr->pt0[k + 1]; i++) {

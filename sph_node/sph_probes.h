@@ -1,5 +1,19 @@
-/* Pressure probes (case section probes:, lahar_probe in common/scene.h): sampled by the SPH node
- * after each step, written to OUT/gauges.h5 (common/output.h).
+/* Probes (case section probes:, lahar_probe in common/scene.h): pressure probes and water-level
+ * gauges, sampled by the SPH node after each step, written to OUT/gauges.h5 (common/output.h).
+ *
+ * A level gauge (kind: level) reads the height above the floor of the water column standing on the
+ * floor along a vertical line, as a wire (resistance or capacitance) wave gauge does, with the
+ * dry rule of DualSPHysics' MeasureTool (Crespo et al. 2015, Comput. Phys. Commun. 187:204): the
+ * water's kernel fraction phi(z) = sum_j V_j W(x - x_j), V_j = m_j / rho_j, is evaluated at points
+ * dx/8 apart from the floor to the top of the line, each particle within the kernel's support of
+ * the floor also counted at its mirror image below the floor (the half space the floor cuts off,
+ * so phi is ~1 on a wetted floor), and the level is the first z going up from the floor where phi
+ * falls to 1/2 (linear between the points), minus the floor; 0 when phi < 1/2 on the floor. phi
+ * is 1 inside the water and, the kernel being symmetric, 1/2 on the plane surface of a half space,
+ * so a lattice of spacing dx filled to depth h (top particles at h - dx/2) reads h. Jets and
+ * spray above an air gap (a wall jet falling back over the gauge) are not counted. One walk over
+ * the cells of the column within the kernel's support of the line per sample; each particle adds
+ * to the points within its support.
  *
  * A probe in the fluid reads the Shepard interpolation of the water particles' pressure
  *   p(x) = sum_j p_j V_j W(x - x_j) / sum_j V_j W(x - x_j),
@@ -40,7 +54,11 @@ typedef struct {
     int64_t *next_slot;    /* per probe: the next multiple of 1/rate to record */
     double (*xl)[3];       /* per point: body frame (body probes) or world (fluid probes) */
     double (*nl)[3];       /* per point: outward normal in the body frame (body probes) */
-    double *value;         /* per probe: the last sample, Pa */
+    int *kind;             /* per probe: LAHAR_PROBE_PRESSURE or LAHAR_PROBE_LEVEL */
+    int *l0;               /* n + 1: level gauge k's line points are l0[k] .. l0[k + 1] - 1 */
+    double *lphi;          /* per line point: sum_j V_j W (work space of the last sample) */
+    double *lstep;         /* per probe: spacing of its line points (level gauges) */
+    double *value;         /* per probe: the last sample, Pa (pressure) or m (level) */
     int *due;              /* per probe: 1 if sampled by the last sph_probes_sample */
 } sph_probes;
 
@@ -53,6 +71,9 @@ void sph_probes_free(sph_probes *pr);
  * number of probes sampled. The particles must be sorted into f's cells (they are after a step). */
 int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, const lahar_body_state *states,
                       double t);
+/* The level of the water at the vertical line from the world point foot (on the floor) upward:
+ * npt points `step` apart, phi (npt values) the work space. m above foot, 0 when dry. */
+double sph_probes_level(const sph_fluid *f, const double foot[3], int npt, double step, double *phi);
 /* The pressure at one world point: wall = 0 Shepard (fluid probe), 1 Adami eq. 27 (wall point). */
 double sph_probes_point(const sph_fluid *f, const double x[3], int wall);
 

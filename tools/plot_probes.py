@@ -1,11 +1,11 @@
 #!/usr/bin/python3
-"""Plot the pressure probes of a run (OUT/gauges.h5, case section probes:) to a PNG.
+"""Plot the probes of a run (OUT/gauges.h5, case section probes:) to a PNG.
 
   tools/plot_probes.py OUT [--probe NAME ...] [--csv FILE [--csv-label TEXT]] [--scale-p PA]
-                           [--scale-t S] [--t0 S] [--tmax S] [-o FILE.png]
+                           [--scale-h M] [--scale-t S] [--t0 S] [--tmax S] [-o FILE.png]
 
 One panel per probe: p(t) in Pa (or p / scale-p and t / scale-t, e.g. rho g H and sqrt(H/g) for
-dimensionless axes). --csv FILE adds an experiment beside the runs: a CSV (or whitespace)
+dimensionless axes); a level gauge (kind: level) h(t) in m (or h / scale-h, e.g. H). --csv FILE adds an experiment beside the runs: a CSV (or whitespace)
 table whose first column is t and whose next columns are the probes in the order plotted
 (columns named like the probes in a header row are matched by name instead); its values are in
 the same units as the plot (pass them already scaled when --scale-* are given). --t0 shifts the
@@ -49,6 +49,7 @@ def main():
     ap.add_argument("--csv", help="experiment table: t, then one column per probe")
     ap.add_argument("--csv-label", default="experiment")
     ap.add_argument("--scale-p", type=float, default=1.0, help="divide p by this (Pa)")
+    ap.add_argument("--scale-h", type=float, default=1.0, help="divide level gauges' h by this (m)")
     ap.add_argument("--scale-t", type=float, default=1.0, help="divide t by this (s)")
     ap.add_argument("--t0", type=float, default=0.0, help="subtract from the run's t before scaling (s)")
     ap.add_argument("--tmax", type=float, help="last time shown (scaled units)")
@@ -71,7 +72,8 @@ def main():
     for k, (n, ax) in enumerate(zip(want, axes[:, 0])):
         g = f["probes"][n]
         t = (g["t"][:] - a.t0) / a.scale_t
-        p = g["p"][:] / a.scale_p
+        level = "h" in g
+        p = g["h"][:] / a.scale_h if level else g["p"][:] / a.scale_p
         pos = ", ".join(f"{v:g}" for v in g.attrs["position"])
         body = g.attrs.get("body", "")
         body = body.decode() if isinstance(body, bytes) else body
@@ -82,9 +84,13 @@ def main():
             col = header.index(n) if header and n in header else k + 1
             if col < tab.shape[1]:
                 ax.plot(tab[:, 0], tab[:, col], "k", lw=1.2, alpha=0.7, label=a.csv_label)
-        ax.set_title(f"{n}: ({pos}) m" + (f" on {body}" if body else " in the fluid") +
-                     (f", sensor {1000 * size:g} mm" if size > 0 else ""), fontsize=9)
-        ax.set_ylabel("p / " + (f"{a.scale_p:g} Pa" if a.scale_p != 1.0 else "Pa"))
+        if level:
+            ax.set_title(f"{n}: water level on the vertical line from ({pos}) m", fontsize=9)
+            ax.set_ylabel("h / " + (f"{a.scale_h:g} m" if a.scale_h != 1.0 else "m"))
+        else:
+            ax.set_title(f"{n}: ({pos}) m" + (f" on {body}" if body else " in the fluid") +
+                         (f", sensor {1000 * size:g} mm" if size > 0 else ""), fontsize=9)
+            ax.set_ylabel("p / " + (f"{a.scale_p:g} Pa" if a.scale_p != 1.0 else "Pa"))
         ax.grid(alpha=0.3)
         if a.tmax is not None:
             ax.set_xlim(right=a.tmax)

@@ -1,0 +1,13 @@
+# Wall impact pressure of a dam break against experiments. Lobovsky et al. 2014,
+# H = 300 mm (cases/dam_break_lobovsky_2d.yaml at dx = 10 mm, 1 s, one thread; 9 s of CPU, 20-45 s
+# on the loaded 2-core machine): impact time at sensor 1 within 5 %, the 10 ms mean peak pressure of
+# sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 (the case's level gauges)
+# within 0.05 H (mean over t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
+# measured values: cases/README.md "Lobovsky dam break".
+if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
+  set(LAHAR_OUTPUT_PYTHON python3)
+endif()
+add_test(NAME sph_dam_break_lobovsky_2d
+  COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/lobovsky_check.py $<TARGET_FILE:lahar>
+          ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d)
+set_tests_properties(sph_dam_break_lobovsky_2d PROPERTIES LABELS "sph;validation;slow" TIMEOUT 300)

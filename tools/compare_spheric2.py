@@ -1,0 +1,145 @@
+#!/usr/bin/python3
+"""Compare a run of cases/dam_break_obstacle_3d.yaml with SPHERIC Test 2 (Kleefsman et al. 2005).
+
+  tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE]
+
+Reads OUT/gauges.h5 (probes P1..P8 on the obstacle, level gauges H1..H4) and
+docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m). Metrics
+(printed, and written to --json, default OUT/spheric2.json):
+  impact     t of the first sample of P1 at or above 1 kPa, run and experiment (0.394 s), relative
+             difference
+  peak       P1 and P3: the largest sample, and the largest mean over --window ms (default 10),
+             within 0.2 s of P1's impact
+  levels     H1-H4 at (x, y) = (1.488, 0.5), (0.992, 0.5), (0.496, 0.5), (2.638, 0.5) m: the time
+             the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
+             h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
+             the floor, where the water's kernel fraction falls to 1/2, sph_node/sph_probes.h)
+The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment."""
+import argparse
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("h5py", "numpy", "matplotlib", "yaml")
+import h5py  # noqa: E402
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import yaml  # noqa: E402
+
+GAUGES = [("H1", 1.488, 0.5), ("H2", 0.992, 0.5), ("H3", 0.496, 0.5), ("H4", 2.638, 0.5)]
+IMPACT_PA = 1000.0
+SPAN = 0.2
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "references-data",
+                    "kleefsman_2005_test2.csv")
+
+
+def first_at_or_above(t, p, level):
+    i = np.flatnonzero(p >= level)
+    return float(t[i[0]]) if len(i) else float("nan")
+
+
+def window_peak(t, p, t0, tau):
+    c = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
+    best = -np.inf
+    for s in t[(t >= t0 - tau) & (t <= t0 + SPAN)]:
+        if s + tau > t[-1]:
+            break
+        best = max(best, (np.interp(s + tau, t, c) - np.interp(s, t, c)) / tau)
+    return float(best)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out")
+    ap.add_argument("--window", type=float, default=10.0, help="window of the mean peak, ms")
+    ap.add_argument("-o", "--output")
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    tau = a.window * 1e-3
+    with open(os.path.join(a.out, "summary.json")) as fh:
+        case = json.load(fh)["case"]
+    with open(case) as fh:
+        dx = float(yaml.safe_load(fh)["sph"]["dx"])
+    with open(DATA) as fh:
+        lines = [ln for ln in fh if not ln.startswith("#")]
+    head = lines[0].strip().split(",")
+    e = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
+    te = e[:, 0]
+    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
+        run_p = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in ["P1", "P3", "P5", "P7"]}
+    m = {"dx": dx, "window_ms": a.window}
+    ti_run = first_at_or_above(*run_p["P1"], IMPACT_PA)
+    ti_exp = first_at_or_above(te, e[:, head.index("P1")], IMPACT_PA)
+    m["impact"] = {"run": ti_run, "experiment": ti_exp, "rel": (ti_run - ti_exp) / ti_exp}
+    m["peaks"] = {}
+    for n in ["P1", "P3"]:
+        t, p = run_p[n]
+        pe = e[:, head.index(n)]
+        sel, sele = (t >= ti_run) & (t <= ti_run + SPAN), (te >= ti_exp) & (te <= ti_exp + SPAN)
+        m["peaks"][n] = {"peak": float(p[sel].max()), "peak_exp": float(pe[sele].max()),
+                         "peak_mean": window_peak(t, p, ti_run, tau), "peak_mean_exp": window_peak(te, pe, ti_exp, tau)}
+    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
+        missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
+        if missing:
+            sys.stderr.write("compare_spheric2: %s/gauges.h5 has no level gauge %s (kind: level); run "
+                             "cases/dam_break_obstacle_3d.yaml as it is\n" % (a.out, ", ".join(missing)))
+            return 2
+        tls = {g: f["probes"][g]["t"][:] for g, _, _ in GAUGES}
+        hs = {g: f["probes"][g]["h"][:] for g, _, _ in GAUGES}
+    tl = tls["H1"]
+    m["levels"] = {}
+    for g, _, _ in GAUGES:
+        he = e[:, head.index(g)]
+        hr, tg = hs[g], tls[g]
+        arr_run = next((tg[i] for i in range(len(tg)) if abs(hr[i] - hr[0]) >= 0.02), float("nan"))
+        arr_exp = next((te[i] for i in range(len(te)) if abs(he[i] - he[0]) >= 0.02), float("nan"))
+        m["levels"][g] = {"change_run": float(arr_run), "change_exp": float(arr_exp),
+                          "mean_abs_diff_m": float(np.mean(np.abs(hr - np.interp(tg, te, he))))}
+    print("first impact on P1 (>= 1 kPa): t = %.4f s (experiment %.4f s, %+.1f %%)" % (
+        ti_run, ti_exp, 100 * m["impact"]["rel"]))
+    for n, s in m["peaks"].items():
+        print("%s: peak %.0f Pa (exp %.0f), %g ms mean %.0f Pa (exp %.0f)" % (
+            n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"]))
+    for g, d in m["levels"].items():
+        print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
+            g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
+    with open(a.json or os.path.join(a.out, "spheric2.json"), "w") as fh:
+        json.dump(m, fh, indent=1)
+    fig, axes = plt.subplots(4, 2, figsize=(12, 10), sharex=True)
+    for k, n in enumerate(["P1", "P3", "P5", "P7"]):
+        ax = axes[k, 0]
+        ax.plot(te, e[:, head.index(n)] / 1e3, "k", lw=1.0, label="Kleefsman et al. 2005 (SPHERIC Test 2)")
+        t, p = run_p[n]
+        ax.plot(t, p / 1e3, lw=0.7, label="lahar, dx %g mm" % (1e3 * dx))
+        w = max(1, int(round(tau / np.median(np.diff(t)))))
+        ax.plot(t, np.convolve(p, np.ones(w) / w, mode="same") / 1e3, lw=1.0, label="lahar, %g ms running mean" % a.window)
+        ax.set_ylabel(n + ", kPa")
+        ax.grid(alpha=0.3)
+        if k == 0:
+            ax.legend(fontsize=7)
+    for k, (g, xg, yg) in enumerate(GAUGES):
+        ax = axes[k, 1]
+        ax.plot(te, e[:, head.index(g)], "k", lw=1.0, label="experiment")
+        ax.plot(tls[g], hs[g], lw=0.8, label="lahar, level gauge")
+        ax.set_ylabel("%s (x = %g m), m" % (g, xg))
+        ax.grid(alpha=0.3)
+        if k == 0:
+            ax.legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("t (s)")
+        ax.set_xlim(0, tl[-1])
+    fig.tight_layout()
+    png = a.output or os.path.join(a.out, "spheric2.png")
+    fig.savefig(png, dpi=90)
+    print("wrote", png)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
