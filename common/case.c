@@ -2446,16 +2446,11 @@ static void read_case(reader *r, lahar_case *c)
     read_check(r, rmap_get(&m, "check"), c);
 }
 
-int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     if (errlen)
         err[0] = '\0';
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
-        snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
-        return LAHAR_EXIT_BAD_INPUT;
-    }
     reader r;
     memset(&r, 0, sizeof r);
     r.path = path;
@@ -2467,17 +2462,15 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
     yaml_parser_t parser;
     yaml_document_t doc;
     if (!yaml_parser_initialize(&parser)) {
-        fclose(fp);
         snprintf(err, errlen, "%s: cannot initialise the YAML parser", path);
         return LAHAR_EXIT_BAD_INPUT;
     }
-    yaml_parser_set_input_file(&parser, fp);
+    yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
     if (!yaml_parser_load(&parser, &doc)) {
         snprintf(err, errlen, "%s:%d: YAML syntax error: %s%s%s (column %d); fix the YAML syntax", path,
                  (int)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown problem",
                  parser.context ? " " : "", parser.context ? parser.context : "", (int)parser.problem_mark.column + 1);
         yaml_parser_delete(&parser);
-        fclose(fp);
         return LAHAR_EXIT_BAD_INPUT;
     }
     r.doc = &doc;
@@ -2485,12 +2478,54 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
     read_case(&r, out);
     yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
-    fclose(fp);
     if (r.failed) {
         lahar_case_free(out);
         return LAHAR_EXIT_BAD_INPUT;
     }
     return 0;
+}
+
+int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (errlen)
+        err[0] = '\0';
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    /* the whole file into memory (case files are small), then the one loader */
+    char *data = NULL;
+    size_t size = 0, cap = 0;
+    for (;;) {
+        if (size == cap) {
+            size_t ncap = cap ? 2 * cap : 16384;
+            char *p = realloc(data, ncap);
+            if (!p) {
+                free(data);
+                fclose(fp);
+                snprintf(err, errlen, "%s: out of memory reading the case file", path);
+                return LAHAR_EXIT_BAD_INPUT;
+            }
+            data = p;
+            cap = ncap;
+        }
+        size_t n = fread(data + size, 1, cap - size, fp);
+        size += n;
+        if (n == 0)
+            break;
+    }
+    int rd_err = ferror(fp);
+    fclose(fp);
+    if (rd_err) {
+        free(data);
+        snprintf(err, errlen, "%s: cannot read the case file; check the path", path);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    int rc = lahar_case_load_mem(path, data, size, out, err, errlen);
+    free(data);
+    return rc;
 }
 
 int lahar_case_load(const char *path, lahar_case *out)

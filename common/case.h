@@ -21,6 +21,10 @@ int lahar_case_load(const char *path, lahar_case *out);
 
 /* Same, but the message goes to `err` (without a trailing newline) instead of stderr. */
 int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen);
+/* The same from the bytes of a case file in memory: `path` names it in messages and is where
+ * relative paths in it (STL meshes, initial files) start from. lahar_case_load_err reads the file
+ * and calls this. */
+int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen);
 
 /* Release everything a loaded (or scene-message-built) case owns; the case is zeroed. Safe on a
  * zeroed case. */
