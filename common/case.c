@@ -1872,6 +1872,12 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
                 return;
             }
         }
+        double size = lahar_particle_block_lattice_size(b, dim, dx);
+        if (!(size <= LAHAR_LATTICE_MAX)) {
+            rd_fail(r, bn, key, "'%s' spans %g lattice points at dx = %g (more than %g, beyond any machine); check "
+                    "its extent and sph.dx", b->name, size, dx, LAHAR_LATTICE_MAX);
+            return;
+        }
         int64_t np = case_block_lattice(c, i, NULL, 0, 1);
         if (np < 0) {
             rd_fail(r, bn, key, "out of memory");
