@@ -2053,6 +2053,12 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
                 return;
             }
         }
+        double size = lahar_particle_block_lattice_size(b, dim, dx);
+        if (!(size <= LAHAR_LATTICE_MAX)) {
+            rd_fail(r, bn, key, "'%s' spans %g lattice points at dx = %g (more than %g, beyond any machine); check "
+                    "its extent and sph.dx", b->name, size, dx, LAHAR_LATTICE_MAX);
+            return;
+        }
         int64_t np = case_block_lattice(c, i, NULL, 0, 1);
         if (np < 0) {
             rd_fail(r, bn, key, "out of memory");
@@ -2754,7 +2760,7 @@ static void read_case(reader *r, lahar_case *c)
     read_check(r, rmap_get(&m, "check"), c);
 }
 
-int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen)
 {
     return lahar_case_load_dir(path, NULL, out, err, errlen);
 }
@@ -2764,11 +2770,6 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
     memset(out, 0, sizeof *out);
     if (errlen)
         err[0] = '\0';
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
-        snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
-        return LAHAR_EXIT_BAD_INPUT;
-    }
     reader r;
     memset(&r, 0, sizeof r);
     r.path = path;
@@ -2782,17 +2783,15 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
     yaml_parser_t parser;
     yaml_document_t doc;
     if (!yaml_parser_initialize(&parser)) {
-        fclose(fp);
         snprintf(err, errlen, "%s: cannot initialise the YAML parser", path);
         return LAHAR_EXIT_BAD_INPUT;
     }
-    yaml_parser_set_input_file(&parser, fp);
+    yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
     if (!yaml_parser_load(&parser, &doc)) {
         snprintf(err, errlen, "%s:%d: YAML syntax error: %s%s%s (column %d); fix the YAML syntax", path,
                  (int)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown problem",
                  parser.context ? " " : "", parser.context ? parser.context : "", (int)parser.problem_mark.column + 1);
         yaml_parser_delete(&parser);
-        fclose(fp);
         return LAHAR_EXIT_BAD_INPUT;
     }
     r.doc = &doc;
@@ -2800,12 +2799,54 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
     read_case(&r, out);
     yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
-    fclose(fp);
     if (r.failed) {
         lahar_case_free(out);
         return LAHAR_EXIT_BAD_INPUT;
     }
     return 0;
+}
+
+int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    if (errlen)
+        err[0] = '\0';
+    FILE *fp = fopen(path, "rb");
+    if (!fp) {
+        snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    /* the whole file into memory (case files are small), then the one loader */
+    char *data = NULL;
+    size_t size = 0, cap = 0;
+    for (;;) {
+        if (size == cap) {
+            size_t ncap = cap ? 2 * cap : 16384;
+            char *p = realloc(data, ncap);
+            if (!p) {
+                free(data);
+                fclose(fp);
+                snprintf(err, errlen, "%s: out of memory reading the case file", path);
+                return LAHAR_EXIT_BAD_INPUT;
+            }
+            data = p;
+            cap = ncap;
+        }
+        size_t n = fread(data + size, 1, cap - size, fp);
+        size += n;
+        if (n == 0)
+            break;
+    }
+    int rd_err = ferror(fp);
+    fclose(fp);
+    if (rd_err) {
+        free(data);
+        snprintf(err, errlen, "%s: cannot read the case file; check the path", path);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    int rc = lahar_case_load_mem(path, data, size, out, err, errlen);
+    free(data);
+    return rc;
 }
 
 int lahar_case_load(const char *path, lahar_case *out)

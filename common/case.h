@@ -25,6 +25,10 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
  * the case file's directory (NULL: the case file's): a copy of a case kept elsewhere
  * (`lahar resume`). */
 int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out, char *err, size_t errlen);
+/* The same from the bytes of a case file in memory: `path` names it in messages and is where
+ * relative paths in it (STL meshes, initial files) start from. lahar_case_load_err reads the file
+ * and calls this. */
+int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen);
 
 /* Release everything a loaded (or scene-message-built) case owns; the case is zeroed. Safe on a
  * zeroed case. */

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 #include "auth.h"
+#include "msg_check.h"
 #include "lahar_heartbeat_t.h"
 #include "lahar_nack_t.h"
 
@@ -280,12 +281,15 @@ static void link_send_nack(lahar_link *l, int target, int type, int64_t step)
 
 /* ---- receiving ----------------------------------------------------------------------------- */
 
+/* seq comes off the wire (any int64): max_seq - seq is formed only when it cannot overflow */
 static int link_window_seen(const link_window *w, int64_t seq)
 {
     if (seq > w->max_seq)
         return 0;
+    if (seq <= w->max_seq - LINK_WINDOW)
+        return 1; /* older than the window (max_seq >= 0, so the bound does not overflow) */
     int64_t d = w->max_seq - seq;
-    return d >= LINK_WINDOW || ((w->mask >> d) & 1u);
+    return (int)((w->mask >> d) & 1u);
 }
 
 static void link_window_mark(link_window *w, int64_t seq)
@@ -295,10 +299,8 @@ static void link_window_mark(link_window *w, int64_t seq)
         w->mask = shift >= LINK_WINDOW ? 0 : (w->mask << shift);
         w->max_seq = seq;
         w->mask |= 1u;
-    } else {
-        int64_t d = w->max_seq - seq;
-        if (d < LINK_WINDOW)
-            w->mask |= (uint64_t)1 << d;
+    } else if (seq > w->max_seq - LINK_WINDOW) {
+        w->mask |= (uint64_t)1 << (w->max_seq - seq);
     }
 }
 
@@ -351,7 +353,7 @@ static link_slot *link_slot_for(lahar_link *l, const lahar_frame_t *f)
 static void link_on_nack(lahar_link *l, const uint8_t *data, int size)
 {
     lahar_nack_t n;
-    if (lahar_nack_t_decode(data, 0, size, &n) < 0)
+    if (LAHAR_MSG_DECODE(lahar_nack_t, data, size, &n) < 0)
         return;
     if (n.target == l->role && n.type > 0 && n.type < LAHAR_NMSG)
         link_resend(l, n.type, n.step, n.nmissing > 0 ? n.missing : NULL, n.nmissing, LINK_NACK_FIRST / 2);
@@ -445,7 +447,7 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
     }
     if (f.type == LAHAR_FRAME_T_MSG_HEARTBEAT && f.nframes == 1) {
         lahar_heartbeat_t hb;
-        if (lahar_heartbeat_t_decode(f.payload, 0, f.size, &hb) >= 0) {
+        if (LAHAR_MSG_DECODE(lahar_heartbeat_t, f.payload, f.size, &hb) >= 0) {
             if (hb.step > l->peer_step[f.sender])
                 l->peer_step[f.sender] = hb.step;
             lahar_heartbeat_t_decode_cleanup(&hb);

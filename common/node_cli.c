@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "auth.h"
+#include "msg_check.h"
 #include "netns.h"
 #include "lahar_stop_t.h"
 #include "scene_msg.h"
@@ -108,7 +109,7 @@ int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_
                 LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
         return 3;
     }
-    if (rc != LAHAR_LINK_OK || lahar_step_t_decode(msg->data, 0, msg->size, step) < 0)
+    if (rc != LAHAR_LINK_OK || LAHAR_MSG_DECODE(lahar_step_t, msg->data, msg->size, step) < 0)
         return 1;
     return -1;
 }
@@ -116,7 +117,7 @@ int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_
 int lahar_node_stop_reason(const lahar_link_msg *msg, char *text, size_t n)
 {
     lahar_stop_t st;
-    if (lahar_stop_t_decode(msg->data, 0, msg->size, &st) < 0)
+    if (LAHAR_MSG_DECODE(lahar_stop_t, msg->data, msg->size, &st) < 0)
         return -1;
     int reason = st.reason;
     if (text && n > 0)

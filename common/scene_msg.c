@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "msg_check.h"
 
 static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 {
@@ -253,6 +254,21 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         snprintf(err, errlen, "malformed scene message (counts or dimension)");
         return -1;
     }
+    /* the options travel as small integers: each must name one of its enum's values */
+    const lahar_sph_options_t *so = &m->sph;
+    if (so->eos < 0 || so->eos > LAHAR_SPH_EOS_TAIT || so->wall_viscous < 0 || so->wall_viscous > LAHAR_SPH_WALL_PAPER ||
+        so->initial_pressure < 0 || so->initial_pressure > LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC ||
+        so->wall_pressure < 0 || so->wall_pressure > LAHAR_SPH_WALL_PRESSURE_GHOST || so->penalty_stiffness < 0 ||
+        so->penalty_stiffness > LAHAR_SPH_PENALTY_ACOUSTIC || so->soil_wall_stress < 0 ||
+        so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST) {
+        snprintf(err, errlen, "malformed scene message (sph options)");
+        return -1;
+    }
+    for (int i = 0; i < m->nmaterial; i++)
+        if (m->materials[i].model < LAHAR_CONTACT_LINEAR || m->materials[i].model > LAHAR_CONTACT_SOIL) {
+            snprintf(err, errlen, "malformed scene message (material %d: contact model)", i);
+            return -1;
+        }
     snprintf(c->path, sizeof c->path, "%s", m->case_path ? m->case_path : "");
     c->resume = m->resume_dir && m->resume_dir[0] && m->resume_step >= 0;
     c->resume_step = c->resume ? m->resume_step : 0;
@@ -306,8 +322,24 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         const lahar_body_t *a = &m->bodies[i];
         lahar_body *b = &c->bodies[i];
         lahar_shape *s = &b->shape;
-        if (a->nv < 0 || a->ne < 0 || a->nf < 0 || a->nfv < 0 || a->material < 0 || a->material >= m->nmaterial) {
+        if (a->nv < 0 || a->ne < 0 || a->nf < 0 || a->nfv < 0 || a->material < 0 || a->material >= m->nmaterial ||
+            a->motion < LAHAR_MOTION_FREE || a->motion > LAHAR_MOTION_PRESCRIBED) {
             snprintf(err, errlen, "malformed scene message (body %d)", i);
+            lahar_case_free(c);
+            return -1;
+        }
+        /* the engines index vertices by edge and face entries, and faces by face_start: every
+         * index must lie in its array (face f is face_v[face_start[f] .. face_start[f + 1])) */
+        int bad = 0;
+        for (int k = 0; k < a->ne && !bad; k++)
+            bad = a->e[k][0] < 0 || a->e[k][0] >= a->nv || a->e[k][1] < 0 || a->e[k][1] >= a->nv;
+        for (int f = 0; f < a->nf && !bad; f++)
+            bad = a->face_start[f] < (f ? a->face_start[f - 1] : 0) || a->face_start[f] > a->nfv ||
+                  (int64_t)a->face_nv[f] != (int64_t)(f + 1 < a->nf ? a->face_start[f + 1] : a->nfv) - a->face_start[f];
+        for (int k = 0; k < a->nfv && !bad; k++)
+            bad = a->face_v[k] < 0 || a->face_v[k] >= a->nv;
+        if (bad || (a->nf > 0 && a->face_start[0] != 0) || (a->nf == 0 && a->nfv != 0)) {
+            snprintf(err, errlen, "malformed scene message (body %d: shape indices)", i);
             lahar_case_free(c);
             return -1;
         }
@@ -470,7 +502,7 @@ int lahar_node_join(lahar_link *l, int role, const char *engine, const char *ver
     if (rc != LAHAR_LINK_OK)
         return rc;
     lahar_scene_t sm;
-    if (lahar_scene_t_decode(msg.data, 0, msg.size, &sm) < 0) {
+    if (LAHAR_MSG_DECODE(lahar_scene_t, msg.data, msg.size, &sm) < 0) {
         snprintf(err, errlen, "undecodable scene message");
         return LAHAR_LINK_ERROR;
     }
@@ -597,6 +629,16 @@ int lahar_loads_decode(const void *data, int size, lahar_loads_buf *b)
     int32_t np;
     MSG_DECODE(int32_t, &np, 1);
     if (np < 0 || np > (size - pos) / 8)
+        return -1;
+    /* the points of body i follow those of body i - 1: the counts must add up to ntotal, or a
+     * reader of body i's points (the contact output) would index past point_x */
+    int64_t sum = 0;
+    for (int32_t i = 0; i < n; i++) {
+        if (b->npoints[i] < 0)
+            return -1;
+        sum += b->npoints[i];
+    }
+    if (sum != np)
         return -1;
     cap = b->cap_points;
     c1 = cap;

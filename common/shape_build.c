@@ -1257,16 +1257,34 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
     }
 }
 
+/* Lattice points per axis, as doubles (not finite for a non-finite extent or dx). */
+static void block_lattice_dims(const lahar_particle_block *b, int dim, double dx, double n[3])
+{
+    for (int a = 0; a < 3; a++) {
+        n[a] = (a == 2 && dim == 2) ? 1.0 : floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
+        if (n[a] < 0.0)
+            n[a] = 0.0;
+    }
+}
+
+double lahar_particle_block_lattice_size(const lahar_particle_block *b, int dim, double dx)
+{
+    double n[3];
+    block_lattice_dims(b, dim, dx, n);
+    double size = n[0] * n[1] * n[2];
+    return size == size ? size : INFINITY; /* NaN (an extent of inf / inf) counts as too large */
+}
+
 int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
                                           int (*keep)(double x[3], void *ctx), void *ctx, int64_t most,
                                           double (*out)[3], int64_t cap)
 {
-    int64_t n[3];
-    for (int a = 0; a < 3; a++) {
-        n[a] = (a == 2 && dim == 2) ? 1 : (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
-        if (n[a] < 0)
-            n[a] = 0;
-    }
+    double nd[3];
+    block_lattice_dims(b, dim, dx, nd);
+    /* a lattice no run could hold (or whose indices would not fit int64): refused, not walked */
+    if (!(lahar_particle_block_lattice_size(b, dim, dx) <= LAHAR_LATTICE_MAX))
+        return -1;
+    int64_t n[3] = {(int64_t)nd[0], (int64_t)nd[1], (int64_t)nd[2]};
     int64_t count = 0;
     for (int64_t i = 0; i < n[0]; i++)
         for (int64_t j = 0; j < n[1]; j++)

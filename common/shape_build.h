@@ -103,10 +103,17 @@ int lahar_particle_block_contains(const lahar_particle_block *b, int dim, const 
 int64_t lahar_particle_block_lattice(const lahar_particle_block *b, int dim, double dx, double (*out)[3], int64_t cap);
 /* As lahar_particle_block_lattice, keeping only the points for which keep(x, ctx) is non-zero
  * (keep may be NULL; it may move the point it keeps: the moved x is written) and stopping after
- * `most` points (-1: no limit). */
+ * `most` points (-1: no limit). Both return -1 when the block's lattice has more than
+ * LAHAR_LATTICE_MAX points (lahar_particle_block_lattice_size). */
 int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim, double dx,
                                           int (*keep)(double x[3], void *ctx), void *ctx, int64_t most,
                                           double (*out)[3], int64_t cap);
+
+/* Points of the lattice of b's bounding box [lo, hi] at spacing dx (inside the block or not), as a
+ * double: +inf when an extent or dx is not finite. The case loader refuses a block above
+ * LAHAR_LATTICE_MAX (2^53, where doubles stop counting exactly; no machine holds that many). */
+#define LAHAR_LATTICE_MAX 9007199254740992.0
+double lahar_particle_block_lattice_size(const lahar_particle_block *b, int dim, double dx);
 
 /* lo/hi of a polygon or mesh block from its vertices (z = 0 .. 0 in 2D). */
 void lahar_particle_block_bounds(lahar_particle_block *b, int dim);

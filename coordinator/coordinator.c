@@ -1,6 +1,7 @@
 /* The coordinator (see coordinator.h, protocol in lcm_types/README.md). */
 #define _GNU_SOURCE
 #include "coordinator.h"
+#include "msg_check.h"
 #include <cjson/cJSON.h>
 #include <dirent.h>
 #include <errno.h>
@@ -377,7 +378,7 @@ static void coord_release_files(coord *co)
 static void coord_read_hello(coord_node *n, const lahar_link_msg *m)
 {
     lahar_hello_t h;
-    if (lahar_hello_t_decode(m->data, 0, m->size, &h) < 0)
+    if (LAHAR_MSG_DECODE(lahar_hello_t, m->data, m->size, &h) < 0)
         return;
     snprintf(n->engine, sizeof n->engine, "%s", h.engine ? h.engine : "");
     snprintf(n->version, sizeof n->version, "%s", h.version ? h.version : "");
@@ -553,7 +554,7 @@ static int coord_collect_status(coord *co, int64_t k)
             return LAHAR_EXIT_RUN_ERROR;
         }
         lahar_status_t s;
-        if (lahar_status_t_decode(m.data, 0, m.size, &s) < 0) {
+        if (LAHAR_MSG_DECODE(lahar_status_t, m.data, m.size, &s) < 0) {
             snprintf(co->message, sizeof co->message, "undecodable STATUS(%lld) from the %s", (long long)k,
                      lahar_link_role_name(r));
             return LAHAR_EXIT_RUN_ERROR;
