@@ -2760,12 +2760,10 @@ static void read_case(reader *r, lahar_case *c)
     read_check(r, rmap_get(&m, "check"), c);
 }
 
-int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen)
-{
-    return lahar_case_load_dir(path, NULL, out, err, errlen);
-}
-
-int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out, char *err, size_t errlen)
+/* The one loader: YAML bytes in memory; `path` names them in messages, relative paths in the case
+ * start from base_dir (NULL: the directory of `path`). */
+static int case_load_bytes(const char *path, const char *base_dir, const void *data, size_t size, lahar_case *out,
+                           char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     if (errlen)
@@ -2806,7 +2804,12 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
     return 0;
 }
 
-int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen)
+{
+    return case_load_bytes(path, NULL, data, size, out, err, errlen);
+}
+
+int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
     if (errlen)
@@ -2844,9 +2847,14 @@ int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t err
         snprintf(err, errlen, "%s: cannot read the case file; check the path", path);
         return LAHAR_EXIT_BAD_INPUT;
     }
-    int rc = lahar_case_load_mem(path, data, size, out, err, errlen);
+    int rc = case_load_bytes(path, base_dir, data, size, out, err, errlen);
     free(data);
     return rc;
+}
+
+int lahar_case_load_err(const char *path, lahar_case *out, char *err, size_t errlen)
+{
+    return lahar_case_load_dir(path, NULL, out, err, errlen);
 }
 
 int lahar_case_load(const char *path, lahar_case *out)
