@@ -565,6 +565,12 @@ static int coord_collect_status(coord *co, int64_t k)
             double silent = coord_silence(co) + ln->starved_s;
             if (ln->pid > 0 && coord_node_ended(ln))
                 silent = lahar_now() - lahar_link_last_heard(co->link, lost);
+            if (ln->pid > 0 && !coord_node_ended(ln))
+                snprintf(how, sizeof how, ln->starved_s >= COORD_NODE_STARVED_MAX
+                                              ? "still running, but it has not answered for %.0f s"
+                                              : "hangs: no thread of it ran or waited for a CPU in %.0f ms",
+                         ln->starved_s >= COORD_NODE_STARVED_MAX ? COORD_NODE_STARVED_MAX
+                                                                 : (double)COORD_STARVED_PROBE_MS);
             if (ln->pid > 0 && coord_node_ended(ln))
                 snprintf(how, sizeof how, "%s %d", ln->exit_status > 128 ? "killed by signal" : "exited with status",
                          ln->exit_status > 128 ? ln->exit_status - 128 : ln->exit_status);

@@ -145,20 +145,15 @@ fp_run() { # kind case index
 }
 if has_phase fp; then
     load_on
-    jobs_running=()
     fp_start() { # kind case index: start a run, at most $parallel at a time
-        if [ ${#jobs_running[@]} -ge "$parallel" ]; then
-            wait "${jobs_running[0]}"
-            jobs_running=("${jobs_running[@]:1}")
-        fi
+        while [ "$(jobs -rp | wc -l)" -ge $((parallel + ${#busy_pids[@]})) ]; do wait -n; done
         fp_run "$@" &
-        jobs_running+=($!)
     }
     for i in $(seq "$runs"); do
         if [ $((i % 4)) -eq 0 ]; then fp_start floating_box box_short.yaml "$i"; else fp_start debris debris_short.yaml "$i"; fi
     done
     for i in $(seq "$soil_runs"); do fp_start soil soil_short.yaml "$i"; done
-    for p in "${jobs_running[@]}"; do wait "$p"; done
+    while [ "$(jobs -rp | wc -l)" -gt "${#busy_pids[@]}" ]; do wait -n; done
     load_off
 fi
 
@@ -191,8 +186,11 @@ fault_run() { # kind signal node-exe index
     IFS=, read -r st wall msd mss starved gap <<< "$f"
     files=$(files_ok "$out")
     nodes=$("$python" -c "import json; s=json.load(open('$out/summary.json')); print(' '.join('%s:%s' % (k, v['exit_status']) for k, v in s['nodes'].items()))" 2>/dev/null)
-    local ddet=""
-    [ -n "$t_det" ] && ddet=$(sub "$t_det" "$t0")
+    # detected: lahar's exit less summary.json finish_s (STOP, the nodes' exit, the summary: after
+    # the lockstep ended on the loss); the "lost" line itself is printed only after that
+    local ddet="" fin
+    fin=$("$python" -c "import json; print(json.load(open('$out/summary.json'))['finish_s'])" 2>/dev/null)
+    [ -n "$fin" ] && ddet=$("$python" -c "print('%.2f' % ($t_exit - $t0 - $fin))")
     echo "detect,$kind,$i,$rc,$st,$wall,$ddet,$(sub "$t_exit" "$t0"),$msd,$mss,$starved,$gap,$(loadavg),nodes $nodes; files $files" >> "$csv"
     echo "detect $kind $i: rc $rc $st, lost after $ddet s, exit after $(sub "$t_exit" "$t0") s, nodes $nodes, files $files"
     rm -rf "$out"
@@ -249,6 +247,8 @@ if has_phase xhost; then
         f=$(summary_fields "$out")
         IFS=, read -r st wall msd mss starved gap <<< "$f"
         files=$(files_ok "$out")
+        fin=$("$python" -c "import json; print(json.load(open('$out/summary.json'))['finish_s'])" 2>/dev/null)
+        t_det=$("$python" -c "print($t_exit - ${fin:-0})")
         echo "xhost,kill_dem_remote,$i,$rc,$st,$wall,$(sub "$t_det" "$t0"),$(sub "$t_exit" "$t0"),$msd,$mss,$starved,$gap,$(loadavg),sph node exit $sph_rc; files $files" >> "$csv"
         echo "xhost $i: rc $rc $st, lost after $(sub "$t_det" "$t0") s, exit after $(sub "$t_exit" "$t0") s, SPH node (by hand) exit $sph_rc, files $files"
         rm -rf "$out"
