@@ -1037,8 +1037,12 @@ static int coord_reserve_summary(coord *co)
             memcpy(buf, head, sizeof head - 1);
             buf[COORD_SUMMARY_RESERVE - 1] = '\n';
         }
-        if (fd < 0 || !buf || pwrite(fd, buf, COORD_SUMMARY_RESERVE, 0) != COORD_SUMMARY_RESERVE || fsync(fd) != 0)
-            rc = fd < 0 || !buf ? errno : (errno ? errno : EIO);
+        /* the blocks are allocated now (posix_fallocate), not at some later write-back */
+        if (fd < 0 || !buf)
+            rc = errno ? errno : ENOMEM;
+        else if ((rc = posix_fallocate(fd, 0, COORD_SUMMARY_RESERVE)) == 0 &&
+                 pwrite(fd, buf, COORD_SUMMARY_RESERVE, 0) != COORD_SUMMARY_RESERVE)
+            rc = errno ? errno : EIO;
         free(buf);
     }
     if (rc) {
