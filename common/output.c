@@ -1390,7 +1390,12 @@ int lahar_output_release_swmr(const char *path)
     H5Pclose(fapl);
     if (f < 0)
         return -1;
-    H5Fclose(f);
+    /* The SWMR writer flushes its datasets but not the superblock's end of allocation, so the
+     * objects it added lie beyond it and a reader that is not a SWMR reader fails on them ("addr
+     * overflow"): the EOA becomes max(EOA, EOF), as h5clear -i does. */
+    herr_t inc = H5Fincrement_filesize(f, 0);
+    if (H5Fclose(f) < 0 || inc < 0)
+        return -1;
     return 1;
 }
 

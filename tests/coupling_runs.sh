@@ -184,6 +184,8 @@ node_killed)
     grep -q "DEM node" stderr.txt || fail "message does not name the DEM node"
     grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
     h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
+    # the force stream of the killed SWMR writer: every row it flushed reads (h5dump reads the data)
+    h5dump killed/forces.h5 > /dev/null || fail "forces.h5 of the killed node does not read"
     [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
     ;;
 node_stopped)
