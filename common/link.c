@@ -21,6 +21,12 @@
 #define LINK_MAX_MISSING 256
 #define LINK_FRAME_BUF (LAHAR_FRAME_PAYLOAD + 256 + LAHAR_AUTH_MACBYTES)
 #define LINK_MAX_MESSAGE (1 << 28) /* as LCM_MAX_MESSAGE_SIZE: a larger claim is a corrupt frame */
+/* A wait that returns this much later than asked means this process was not running (an
+ * overloaded machine): that time is not counted as the peers' silence (link_pump_timed). */
+#define LINK_LATE_SLACK 0.05
+/* Before a watched peer is called lost, this long is spent reading what has arrived: LCM's
+ * receive thread may not have run yet to move queued datagrams from the socket. */
+#define LINK_LOST_GRACE_MS 50
 
 static const char *const link_channels[LAHAR_NMSG] = {
     "LAHAR_UNKNOWN", "LAHAR_HELLO", "LAHAR_SCENE", "LAHAR_STEP", "LAHAR_STATUS",
@@ -111,6 +117,8 @@ struct lahar_link {
     link_window window[LAHAR_NROLES][LAHAR_NMSG];
 
     double last_heard[LAHAR_NROLES];
+    double max_gap[LAHAR_NROLES];   /* longest time between two frames heard from a peer */
+    double late_max, late_sum;      /* this process's own scheduling gaps seen in wait/poll */
     int64_t peer_step[LAHAR_NROLES];
     double watch_silence[LAHAR_NROLES]; /* 0 = not watched */
     int lost_role;
@@ -426,7 +434,10 @@ static void link_on_frame(const char *channel, const void *data, size_t size, vo
                                                              (f.total_size == 0))
         return;
 
-    l->last_heard[f.sender] = lahar_now();
+    double heard = lahar_now();
+    if (l->last_heard[f.sender] > 0.0 && heard - l->last_heard[f.sender] > l->max_gap[f.sender])
+        l->max_gap[f.sender] = heard - l->last_heard[f.sender];
+    l->last_heard[f.sender] = heard;
     lahar_link_stats *st = &l->stats[f.type];
     st->frames_heard++;
     st->bytes_heard += (uint64_t)size;
@@ -534,6 +545,34 @@ static void link_pump(lahar_link *l, int timeout_ms)
         r = lahar_transport_handle(l->t, 0);
 }
 
+/* link_pump, and a check that this process was running meanwhile: a pump that returns more than
+ * LINK_LATE_SLACK after its time-out was descheduled (a machine with more runnable threads than
+ * cores). A process that did not run could not hear its peers, so the time it lost is not their
+ * silence: the silence clocks of the watched peers move forward by it. The gaps are recorded
+ * (lahar_link_sched_gaps). */
+static void link_pump_timed(lahar_link *l, int timeout_ms)
+{
+    double t0 = lahar_now();
+    link_pump(l, timeout_ms);
+    double now = lahar_now(), late = now - t0 - 1e-3 * (timeout_ms > 0 ? timeout_ms : 0);
+    if (late <= LINK_LATE_SLACK)
+        return;
+    if (late > l->late_max)
+        l->late_max = late;
+    l->late_sum += late;
+    for (int r = 0; r < LAHAR_NROLES; r++)
+        if (l->watch_silence[r] > 0.0 && l->last_heard[r] > 0.0)
+            l->last_heard[r] = l->last_heard[r] + late < now ? l->last_heard[r] + late : now;
+}
+
+/* Read for ms milliseconds whatever arrives (the grace before a peer is called lost). */
+static void link_pump_for(lahar_link *l, int ms)
+{
+    double until = lahar_now() + 1e-3 * ms, now;
+    while ((now = lahar_now()) < until)
+        link_pump(l, (int)((until - now) * 1e3) + 1);
+}
+
 int lahar_link_wait(lahar_link *l, int sender, int type, int64_t step, int timeout_ms, lahar_link_msg *out)
 {
     link_release_taken(l);
@@ -554,10 +593,10 @@ int lahar_link_wait(lahar_link *l, int sender, int type, int64_t step, int timeo
         }
         double now = lahar_now();
         if (link_check_lost(l, now)) {
-            /* Before calling a peer lost, read what is already queued: when this process itself
-             * was descheduled (an overloaded machine), the peer's frames wait in the socket and
-             * would otherwise count as silence. */
-            link_pump(l, 0);
+            /* Before calling a peer lost, read what has arrived: when this process itself was
+             * descheduled (an overloaded machine), the peer's frames wait in the socket, and
+             * LCM's receive thread needs to run to hand them over (LINK_LOST_GRACE_MS). */
+            link_pump_for(l, LINK_LOST_GRACE_MS);
             if (link_find(l, sender, type, step, out)) {
                 rc = LAHAR_LINK_OK;
                 break;
@@ -580,7 +619,7 @@ int lahar_link_wait(lahar_link *l, int sender, int type, int64_t step, int timeo
         }
         double until = next_nack < deadline ? next_nack : deadline;
         int ms = (int)((until - now) * 1e3) + 1;
-        link_pump(l, ms);
+        link_pump_timed(l, ms);
     }
     l->wait_seconds += lahar_now() - start;
     return rc;
@@ -593,7 +632,7 @@ void lahar_link_poll(lahar_link *l, int timeout_ms)
     double deadline = start + 1e-3 * timeout_ms;
     double now = start;
     do {
-        link_pump(l, (int)((deadline - now) * 1e3) + 1);
+        link_pump_timed(l, (int)((deadline - now) * 1e3) + 1);
         now = lahar_now();
     } while (now < deadline);
     l->wait_seconds += now - start;
@@ -623,6 +662,21 @@ void lahar_link_unwatch(lahar_link *l, int role)
 }
 
 int lahar_link_lost_role(const lahar_link *l) { return l->lost_role; }
+double lahar_link_last_heard(const lahar_link *l, int role)
+{
+    return (role >= 0 && role < LAHAR_NROLES) ? l->last_heard[role] : 0.0;
+}
+double lahar_link_max_silence(const lahar_link *l, int role)
+{
+    return (role >= 0 && role < LAHAR_NROLES) ? l->max_gap[role] : 0.0;
+}
+void lahar_link_sched_gaps(const lahar_link *l, double *max_s, double *sum_s)
+{
+    if (max_s)
+        *max_s = l->late_max;
+    if (sum_s)
+        *sum_s = l->late_sum;
+}
 int64_t lahar_link_peer_step(const lahar_link *l, int role)
 {
     return (role >= 0 && role < LAHAR_NROLES) ? l->peer_step[role] : -1;

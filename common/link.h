@@ -75,13 +75,21 @@ int lahar_link_republish(lahar_link *l, int type, int64_t step);
     } while (0)
 
 /* Peers whose silence ends every wait with LAHAR_LINK_LOST (silence measured from the last frame
- * heard, heartbeats included; the clock starts at the call). */
+ * heard, heartbeats included; the clock starts at the call; time this process itself was not
+ * running while it waited does not count, and what arrived meanwhile is read first). */
 void lahar_link_watch(lahar_link *l, int role, double silence_s);
 void lahar_link_unwatch(lahar_link *l, int role);
 /* Restart the silence clock of a watched peer that the caller knows by other means to be alive
  * (the coordinator: a node it started whose CPU time is advancing). */
 void lahar_link_heard_now(lahar_link *l, int role);
 int lahar_link_lost_role(const lahar_link *l);
+/* When the last frame of a peer was heard (lahar_now() clock; 0 never). */
+double lahar_link_last_heard(const lahar_link *l, int role);
+/* Longest time between two frames heard from a peer so far (heartbeats included), in s. */
+double lahar_link_max_silence(const lahar_link *l, int role);
+/* This process's own scheduling gaps seen while it waited (a wait that returned over 50 ms
+ * late): the longest and their sum, in s. That time is not counted as a watched peer's silence. */
+void lahar_link_sched_gaps(const lahar_link *l, double *max_s, double *sum_s);
 /* Last step a peer reported done in its heartbeats (-1 if none). */
 int64_t lahar_link_peer_step(const lahar_link *l, int role);
 

@@ -9,7 +9,9 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdatomic.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 #include "vec.h"
@@ -19,6 +21,86 @@
 #define OUT_XML_CAP 16384
 #define FORCES_FLUSH_SECONDS 0.5
 #define FORCES_BUFFER_BYTES (256 * 1024)
+
+/* ---------------------------------------------------------------- room on the disk ----- */
+
+/* A full disk must not cost what was written before it. HDF5 that runs out of space in the
+ * middle of a snapshot may leave its metadata half-written (a file that no longer opens) and an
+ * identifier that crashes the library's clean-up at exit, so every write first checks that the
+ * file system has room for it with a margin (LAHAR_OUTPUT_RESERVE: the other node may be
+ * writing at the same time) and refuses otherwise, leaving the file as it was. */
+static _Thread_local char out_err[OUT_PATH_MAX + 512];
+static atomic_int out_hdf5_failed;
+
+const char *lahar_output_error(void) { return out_err; }
+int lahar_output_failed(void) { return atomic_load(&out_hdf5_failed); }
+void lahar_output_explain(char *err, size_t n)
+{
+    if (out_err[0] && n > 0)
+        snprintf(err, n, "%s", out_err);
+}
+
+/* Bytes an unprivileged writer may still use on the file system of directory dir (-1 unknown). */
+double lahar_output_free_bytes(const char *dir)
+{
+    struct statvfs v;
+    if (statvfs(dir, &v) != 0)
+        return -1.0;
+    return (double)v.f_bavail * (double)v.f_frsize;
+}
+
+static void out_dir_of(const char *path, char *dir, size_t n)
+{
+    snprintf(dir, n, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash && slash != dir)
+        *slash = '\0';
+    else if (!slash)
+        snprintf(dir, n, ".");
+}
+
+/* 0 when the file system of `path` has room for `need` bytes (with the margin); else -1 and the
+ * message (which file, how much, what was being written at which step and time) in out_err and
+ * on stderr. */
+static int out_room(const char *path, double need, const char *what, int64_t step, double t)
+{
+    char dir[OUT_PATH_MAX];
+    out_dir_of(path, dir, sizeof dir);
+    double avail = lahar_output_free_bytes(dir);
+    if (avail < 0.0 || avail >= 1.5 * need + LAHAR_OUTPUT_RESERVE)
+        return 0;
+    snprintf(out_err, sizeof out_err,
+             "%s: no space left on device (%.0f bytes free): %s at step %" PRId64 " (t = %.9g s) needs about %.0f "
+             "bytes; not written, the file keeps what was written before; free space there or choose another -o",
+             path, avail, what, step, t, 1.5 * need + LAHAR_OUTPUT_RESERVE);
+    fprintf(stderr, "lahar: %s\n", out_err);
+    return -1;
+}
+
+/* A write to `path` failed after its room was checked (another writer took the space, or an I/O
+ * error): the message in out_err, naming a full disk when it is one. */
+static void out_write_failed(const char *path, const char *what, int64_t step, double t)
+{
+    int e = errno;
+    char dir[OUT_PATH_MAX];
+    out_dir_of(path, dir, sizeof dir);
+    double avail = lahar_output_free_bytes(dir);
+    const char *why = (e == ENOSPC || (avail >= 0.0 && avail < LAHAR_OUTPUT_RESERVE)) ? "no space left on device"
+                      : e ? strerror(e) : "HDF5 error";
+    snprintf(out_err, sizeof out_err, "%s: writing %s at step %" PRId64 " (t = %.9g s) failed: %s (%.0f bytes free)",
+             path, what, step, t, why, avail);
+    fprintf(stderr, "lahar: %s\n", out_err);
+}
+
+/* H5Fclose that failed leaves HDF5 an identifier its clean-up at exit crashes on (HDF5 1.10):
+ * remembered, so that a program can leave with _exit (lahar_output_failed). */
+static int out_close(hid_t f)
+{
+    if (H5Fclose(f) >= 0)
+        return 0;
+    atomic_store(&out_hdf5_failed, 1);
+    return -1;
+}
 
 /* ---------------------------------------------------------------- small HDF5 helpers ---- */
 
@@ -165,6 +247,8 @@ static int out_resume_sidecar(const char *h5path, const char *xmfpath, lahar_xdm
 
 typedef struct {
     hid_t file, t, step, force, torque, ncontacts;
+    char path[OUT_PATH_MAX + 16];
+    int failed;           /* a flush failed: nothing more is written (the rows before stay readable) */
     int nbody;
     int64_t rows;         /* rows on disk */
     int cap, nbuf;        /* buffered rows */
@@ -386,6 +470,7 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    snprintf(fs->path, sizeof fs->path, "%s", path);
     if (c->resume) {
         /* a resumed run appends to the stream as lahar_output_resume_trim left it (cut at the
          * checkpoint): the rows on disk, and the next forces_interval slot after the last row */
@@ -484,6 +569,16 @@ static int forces_flush(forces_stream *fs)
 {
     if (fs->file < 0 || fs->nbuf == 0)
         return 0;
+    if (fs->failed)
+        return -1;
+    int64_t last_step = fs->bstep[fs->nbuf - 1];
+    double last_t = fs->bt[fs->nbuf - 1];
+    /* the rows, plus the chunks they may open (one per dataset, FORCES_BUFFER_BYTES in all) */
+    double need = (double)fs->nbuf * (16.0 + 52.0 * fs->nbody) + FORCES_BUFFER_BYTES;
+    if (out_room(fs->path, need, "the force rows", last_step, last_t) != 0) {
+        fs->failed = 1;
+        return -1;
+    }
     hsize_t rows = (hsize_t)fs->nbuf, start = (hsize_t)fs->rows, nb = (hsize_t)fs->nbody;
     struct {
         hid_t id, mtype;
@@ -518,6 +613,10 @@ static int forces_flush(forces_stream *fs)
     fs->rows += fs->nbuf;
     fs->nbuf = 0;
     fs->last_flush = out_wall_seconds();
+    if (rc) {
+        out_write_failed(fs->path, "the force rows", last_step, last_t);
+        fs->failed = 1;
+    }
     return rc;
 }
 
@@ -529,7 +628,7 @@ static void forces_close(forces_stream *fs)
         for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
             if (ids[k] >= 0)
                 H5Dclose(ids[k]);
-        H5Fclose(fs->file);
+        out_close(fs->file);
     }
     free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont);
     memset(fs, 0, sizeof *fs);
@@ -666,6 +765,10 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
             o->vvel[3 * iv + 0] = (float)u.x, o->vvel[3 * iv + 1] = (float)u.y, o->vvel[3 * iv + 2] = (float)u.z;
         }
     }
+    /* the snapshot's data, its object headers, and the XDMF text */
+    double need = 8.0 * 13.0 * nb + 24.0 * (double)o->nmoving_vert + 6.0 * 1024.0 + OUT_XML_CAP;
+    if (out_room(o->h5path, need, "a body snapshot", step, t) != 0)
+        return -1;
     hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
@@ -687,11 +790,10 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
                           o->vvel);
         H5Gclose(g);
     }
-    if (H5Fclose(f) < 0)
+    if (out_close(f) < 0)
         rc = -1;
     if (rc) {
-        fprintf(stderr, "lahar: %s: writing snapshot %" PRId64 " (step %" PRId64 ") failed\n", o->h5path, o->nsnap,
-                step);
+        out_write_failed(o->h5path, "a body snapshot", step, t);
         return -1;
     }
     lahar_xdmf_bodies xb;
@@ -852,6 +954,11 @@ static int out_particle_stress(hid_t g, const lahar_particles_view *p)
 
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
 {
+    /* at most 17 values of 8 bytes per particle (position, velocity, density, pressure, phase,
+     * id, stress), the datasets' headers and the XDMF text */
+    double need = 17.0 * 8.0 * (double)(p->n > 0 ? p->n : 0) + 16.0 * 1024.0 + OUT_XML_CAP;
+    if (out_room(o->h5path, need, "a particle snapshot", step, t) != 0)
+        return -1;
     hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (f < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
@@ -910,10 +1017,10 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
             rc |= out_particle_stress(g, p);
         H5Gclose(g);
     }
-    if (H5Fclose(f) < 0)
+    if (out_close(f) < 0)
         rc = -1;
     if (rc) {
-        fprintf(stderr, "lahar: %s: writing snapshot %" PRId64 " failed\n", o->h5path, o->nsnap);
+        out_write_failed(o->h5path, "a particle snapshot", step, t);
         return -1;
     }
     lahar_xdmf_particles xp = {"particles.h5", o->fields};
@@ -1425,6 +1532,9 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         }
         off += npoints[i];
     }
+    double need = 48.0 * (double)off + 4096.0 * (o->nmarked + 1);
+    if (out_room(o->h5path, need, "the contact points", step, t) != 0)
+        return -1;
     hid_t file = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
     if (file < 0) {
         fprintf(stderr, "lahar: %s: cannot reopen for contacts at step %" PRId64 "\n", o->h5path, step);
@@ -1456,10 +1566,10 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         }
         H5Gclose(g);
     }
-    if (H5Fclose(file) < 0)
+    if (out_close(file) < 0)
         rc = -1;
     if (rc) {
-        fprintf(stderr, "lahar: %s: writing contacts %" PRId64 " failed\n", o->h5path, o->nsnap);
+        out_write_failed(o->h5path, "the contact points", step, t);
         return -1;
     }
     o->nsnap++;
@@ -1472,6 +1582,14 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
 {
     char path[OUT_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/%s", outdir, file);
+    if (access(path, F_OK) != 0)
+        return -1;
+    double avail = lahar_output_free_bytes(outdir);
+    if (avail >= 0.0 && avail < LAHAR_OUTPUT_RESERVE) {
+        fprintf(stderr, "lahar: %s: the last snapshot is not marked (no space left on device: %.0f bytes free)\n",
+                path, avail);
+        return -1;
+    }
     hid_t f = out_file_open(path, H5F_ACC_RDWR, 0);
     if (f < 0)
         return -1;
@@ -1491,7 +1609,7 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
     }
     if (g >= 0)
         H5Gclose(g);
-    if (H5Fclose(f) < 0)
+    if (out_close(f) < 0)
         rc = -1;
     if (rc)
         fprintf(stderr, "lahar: %s: cannot mark the last snapshot\n", path);
@@ -1539,7 +1657,12 @@ int lahar_output_release_swmr(const char *path)
     H5Pclose(fapl);
     if (f < 0)
         return -1;
-    H5Fclose(f);
+    /* The SWMR writer flushes its datasets but not the superblock's end of allocation, so the
+     * objects it added lie beyond it and a reader that is not a SWMR reader fails on them ("addr
+     * overflow"): the EOA becomes max(EOA, EOF), as h5clear -i does. */
+    herr_t inc = H5Fincrement_filesize(f, 0);
+    if (H5Fclose(f) < 0 || inc < 0)
+        return -1;
     return 1;
 }
 
@@ -1562,6 +1685,8 @@ typedef struct {
 
 struct lahar_gauge_output {
     hid_t file;
+    char path[OUT_PATH_MAX + 16];
+    int failed;
     int n;
     gauge_stream *g;
     double last_flush;
@@ -1569,7 +1694,22 @@ struct lahar_gauge_output {
 
 static int gauge_flush(lahar_gauge_output *o)
 {
+    if (o->failed)
+        return -1;
     int rc = 0;
+    double need = 0.0;
+    int64_t last_step = 0;
+    double last_t = 0.0;
+    for (int k = 0; k < o->n; k++)
+        if (o->g[k].nbuf > 0) {
+            need += 24.0 * o->g[k].nbuf + 3.0 * 8.0 * GAUGE_BUFFER_ROWS; /* rows, and the chunks they may open */
+            last_step = o->g[k].bstep[o->g[k].nbuf - 1];
+            last_t = o->g[k].bt[o->g[k].nbuf - 1];
+        }
+    if (need > 0.0 && out_room(o->path, need, "the gauge rows", last_step, last_t) != 0) {
+        o->failed = 1;
+        return -1;
+    }
     for (int k = 0; k < o->n; k++) {
         gauge_stream *g = &o->g[k];
         if (g->nbuf == 0)
@@ -1599,6 +1739,10 @@ static int gauge_flush(lahar_gauge_output *o)
         g->nbuf = 0;
     }
     o->last_flush = out_wall_seconds();
+    if (rc) {
+        out_write_failed(o->path, "the gauge rows", last_step, last_t);
+        o->failed = 1;
+    }
     return rc;
 }
 
@@ -1632,6 +1776,7 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
     snprintf(path, sizeof path, "%s/gauges.h5", outdir);
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    snprintf(o->path, sizeof o->path, "%s", path);
     if (c->resume) { /* continue the stream as lahar_output_resume_trim left it */
         o->file = lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
         H5Pclose(fapl);
@@ -1794,7 +1939,7 @@ void lahar_gauge_output_close(lahar_gauge_output *o)
         free(g->bt), free(g->bp), free(g->bstep);
     }
     if (o->file >= 0)
-        H5Fclose(o->file);
+        out_close(o->file);
     free(o->g);
     free(o);
 }

@@ -119,6 +119,23 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
  * the file is missing or has none. */
 int lahar_output_last_snapshot(const char *outdir, const char *file, char *group, size_t n, int64_t *step, double *t);
 
+/* Room on the disk. Every writer above first checks that the file system of OUT has room for
+ * what it is about to write, with a margin of LAHAR_OUTPUT_RESERVE for the other node writing at
+ * the same time, and refuses (-1, nothing written, the file as it was) otherwise: HDF5 that runs
+ * out of space in the middle of a write can leave a file that no longer opens. */
+#define LAHAR_OUTPUT_RESERVE (256.0 * 1024.0)
+/* The last failure of a writer in this thread: which file, what, at which step and time, and
+ * why ("no space left on device", with the bytes free); "" when none. */
+const char *lahar_output_error(void);
+/* Replace the message in err (a caller's generic "cannot write ...") by lahar_output_error()
+ * when there is one. */
+void lahar_output_explain(char *err, size_t n);
+/* 1 when an HDF5 file failed to close in this process: HDF5's clean-up at exit crashes on what
+ * it left (HDF5 1.10), so the program leaves with _exit after flushing its own streams. */
+int lahar_output_failed(void);
+/* Bytes an unprivileged writer may still use on the file system of directory dir (-1 unknown). */
+double lahar_output_free_bytes(const char *dir);
+
 /* The files a run writes into OUT (NULL-terminated): HDF5 streams, XDMF sidecars, the
  * coordinator's summary.json and `lahar check`'s check.json / check.png. A new output file is
  * added here, so that `lahar run --overwrite` removes it with the rest of an earlier run. */

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/prctl.h>
 #include <sys/file.h>
+#include <dirent.h>
 #include <sys/random.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -50,6 +51,10 @@
 #define COORD_SETUP_SHOW 2.0     /* s of set-up after which a progress line is shown (terminal only) */
 #define COORD_SETUP_STOP_WAIT 0.3 /* s a node interrupted in set-up gets to exit before it is killed */
 #define COORD_STEP_RESEND_MS 250 /* re-publish STEP(k) while STATUS(k) is missing */
+#define COORD_DEATH_POLL_MS 50   /* while STATUS(k) is missing, the started nodes are reaped this often */
+/* summary.json's room, taken on the disk when the run starts, so that a run that fills the disk
+ * can still say how it ended */
+#define COORD_SUMMARY_RESERVE (64 * 1024)
 
 typedef struct {
     int role;
@@ -69,7 +74,9 @@ typedef struct {
     int64_t substeps, last_step;
     double dt_proposed, dt_stable, kinetic_energy;
     int ncontacts;
-    double starved_s;            /* silence forgiven so far (COORD_NODE_STARVED_MAX) */
+    double starved_s;            /* silence forgiven in the current silence (COORD_NODE_STARVED_MAX) */
+    double starved_max_s;        /* the longest silence forgiven in the run */
+    int starved_count, starved_warned; /* silences forgiven (probes that found it starved); warned once */
     int checkpointed;            /* STATUS(k).checkpointed of the last step */
     lahar_status_t work;         /* the work_* fields of the last STATUS (cumulative) */
 } coord_node;
@@ -98,6 +105,7 @@ typedef struct {
     double last_progress;
     int setup_shown;        /* a set-up progress line is on the terminal (ended by a newline) */
     double stop_wait;       /* s the nodes get to exit after STOP (0: COORD_STOP_WAIT) */
+    int summary_fd;         /* OUT/summary.json, its room reserved at the start (-1: none) */
     char auth_key_path[PATH_MAX]; /* authenticated run: the key file (absolute), passed to the nodes */
     uint8_t auth_key[LAHAR_AUTH_KEYBYTES];
     /* checkpoints (case section checkpoint:; coordinator/README.md "Checkpoints and resume") */
@@ -249,12 +257,40 @@ static int coord_node_ended(coord_node *n)
     return n->exited;
 }
 
-/* CPU seconds used so far by a node this coordinator started (process: /proc/PID/stat utime +
- * stime; thread: its CPU clock), or -1 when it cannot be read (node started by hand). */
-static double coord_node_cpu_seconds(const coord_node *n)
+/* How much a node this coordinator started has run or wanted to run so far, in s: for a process
+ * the sum over its threads of the time on a CPU and the time runnable but waiting for one
+ * (/proc/PID/task/TID/schedstat, fields 1 and 2, ns); for an --in-process thread its CPU clock.
+ * A node that is only starved by an overloaded machine advances this (its threads are runnable),
+ * a stopped (SIGSTOP) or dead-locked one does not (no thread runs or waits for a CPU). -1 when it
+ * cannot be read (a node started by hand, or a kernel without schedstat: then the process's
+ * utime + stime from /proc/PID/stat, in clock ticks). */
+static double coord_node_activity(const coord_node *n)
 {
     if (n->pid > 0) {
         char path[64], buf[1024];
+        snprintf(path, sizeof path, "/proc/%d/task", (int)n->pid);
+        DIR *d = opendir(path);
+        if (d) {
+            unsigned long long sum = 0;
+            int seen = 0;
+            for (struct dirent *e; (e = readdir(d));) {
+                if (e->d_name[0] < '0' || e->d_name[0] > '9')
+                    continue;
+                char p2[96];
+                snprintf(p2, sizeof p2, "/proc/%d/task/%.16s/schedstat", (int)n->pid, e->d_name);
+                FILE *fp = fopen(p2, "r");
+                unsigned long long run = 0, wait = 0;
+                if (fp && fscanf(fp, "%llu %llu", &run, &wait) == 2) {
+                    sum += run + wait;
+                    seen = 1;
+                }
+                if (fp)
+                    fclose(fp);
+            }
+            closedir(d);
+            if (seen)
+                return 1e-9 * (double)sum;
+        }
         snprintf(path, sizeof path, "/proc/%d/stat", (int)n->pid);
         FILE *fp = fopen(path, "r");
         if (!fp)
@@ -279,25 +315,31 @@ static double coord_node_cpu_seconds(const coord_node *n)
     return -1.0;
 }
 
-/* A watched node went silent: 1 if it is one of ours, still running and using CPU over a short
- * probe (starved by the machine, not dead or hung), so that its silence is forgiven. The link is
- * pumped during the probe, so nothing that arrives meanwhile is missed. */
+/* A watched node went silent: 1 if it is one of ours, still running and running or runnable over
+ * a short probe (starved by the machine, not dead or hung), so that its silence is forgiven. The
+ * link is pumped during the probe, so nothing that arrives meanwhile is missed. One silence is
+ * forgiven for at most COORD_NODE_STARVED_MAX s (the count starts again with the node's next
+ * STATUS). */
 static int coord_node_starved(coord *co, coord_node *n)
 {
     if (n->starved_s >= COORD_NODE_STARVED_MAX || coord_node_ended(n))
         return 0;
-    double before = coord_node_cpu_seconds(n);
+    double before = coord_node_activity(n);
     if (before < 0.0)
         return 0;
     lahar_link_poll(co->link, COORD_STARVED_PROBE_MS);
-    double after = coord_node_cpu_seconds(n);
+    double after = coord_node_activity(n);
     if (coord_node_ended(n) || !(after > before))
         return 0;
-    if (n->starved_s == 0.0)
-        fprintf(stderr, "\nlahar: warning: the %s has been silent for %.1f s but is still computing (the machine "
+    if (!n->starved_warned)
+        fprintf(stderr, "\nlahar: warning: the %s has been silent for %.1f s but is still running (the machine "
                         "is overloaded?); waiting up to %.0f s more\n",
                 lahar_link_role_name(n->role), coord_silence(co), COORD_NODE_STARVED_MAX);
+    n->starved_warned = 1;
+    n->starved_count++;
     n->starved_s += coord_silence(co) + 1e-3 * COORD_STARVED_PROBE_MS;
+    if (n->starved_s > n->starved_max_s)
+        n->starved_max_s = n->starved_s;
     return 1;
 }
 
@@ -517,13 +559,26 @@ static int coord_collect_status(coord *co, int64_t k)
         int rc;
         /* Requests are idempotent: besides the NACKs of both sides, STEP(k) goes out again every
          * 250 ms until STATUS(k) is in (a node that has it already drops the duplicate, and its
-         * kept STATUS(k) answers the coordinator's NACK). */
+         * kept STATUS(k) answers the coordinator's NACK). Every COORD_DEATH_POLL_MS without it,
+         * the nodes this coordinator started are reaped: a node that died is lost at once, not
+         * after its silence. */
+        int lost = -1;
+        double resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
         for (;;) {
             rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k,
-                                 k < 0 ? COORD_SETUP_POLL_MS : COORD_STEP_RESEND_MS, &m);
+                                 k < 0 ? COORD_SETUP_POLL_MS : COORD_DEATH_POLL_MS, &m);
             if (rc == LAHAR_LINK_TIMEOUT) {
-                if (k >= 0)
+                for (int d = 1; d < LAHAR_NROLES && k >= 0; d++)
+                    if (co->node[d].needed && co->node[d].pid > 0 && coord_node_ended(&co->node[d]))
+                        lost = d;
+                if (lost >= 0) {
+                    rc = LAHAR_LINK_LOST;
+                    break;
+                }
+                if (k >= 0 && lahar_now() >= resend) {
                     lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
+                    resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
+                }
                 if (k < 0 && coord_setup_wait(co, n)) /* Ctrl-C while a node sets up: stop now */
                     return LAHAR_EXIT_RUN_ERROR;
             } else if (rc == LAHAR_LINK_LOST && coord_node_starved(co, &co->node[lahar_link_lost_role(co->link)])) {
@@ -533,18 +588,28 @@ static int coord_collect_status(coord *co, int64_t k)
             }
         }
         if (rc == LAHAR_LINK_LOST) {
-            int lost = lahar_link_lost_role(co->link);
+            if (lost < 0)
+                lost = lahar_link_lost_role(co->link);
             coord_node *ln = &co->node[lost];
             int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
                                                                                  : lahar_link_peer_step(co->link, lost);
             char how[96] = "died or hangs";
+            double silent = coord_silence(co) + ln->starved_s;
+            if (ln->pid > 0 && coord_node_ended(ln))
+                silent = lahar_now() - lahar_link_last_heard(co->link, lost);
+            if (ln->pid > 0 && !coord_node_ended(ln))
+                snprintf(how, sizeof how, ln->starved_s >= COORD_NODE_STARVED_MAX
+                                              ? "still running, but it has not answered for %.0f s"
+                                              : "hangs: no thread of it ran or waited for a CPU in %.0f ms",
+                         ln->starved_s >= COORD_NODE_STARVED_MAX ? COORD_NODE_STARVED_MAX
+                                                                 : (double)COORD_STARVED_PROBE_MS);
             if (ln->pid > 0 && coord_node_ended(ln))
                 snprintf(how, sizeof how, "%s %d", ln->exit_status > 128 ? "killed by signal" : "exited with status",
                          ln->exit_status > 128 ? ln->exit_status - 128 : ln->exit_status);
             snprintf(co->message, sizeof co->message,
                      "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
                      "(t = %.9g s); stopping the run",
-                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, coord_silence(co) + ln->starved_s, how,
+                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, silent, how,
                      (long long)last, co->sim_time);
             co->status = "node lost";
             return LAHAR_EXIT_NODE_LOST;
@@ -583,6 +648,7 @@ static int coord_collect_status(coord *co, int64_t k)
         coord_take_work(n, &s);
         if (!err)
             n->last_step = k;
+        n->starved_s = 0.0; /* an answer ends a silence */
         lahar_status_t_decode_cleanup(&s);
         if (err) {
             co->status = co->has_inst ? "unstable" : "error";
@@ -983,6 +1049,12 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(root, "stepping_s", stepped ? co->lock1 - co->lock0 : 0.0);
     cJSON_AddNumberToObject(root, "finish_s", stepped ? wall - (co->lock1 - co->wall0) : 0.0);
     cJSON_AddNumberToObject(root, "coordinator_wait_s", co->link ? lahar_link_wait_seconds(co->link) : 0.0);
+    /* the coordinator's own scheduling gaps while it waited (not counted as the nodes' silence) */
+    double gap_max = 0.0, gap_sum = 0.0;
+    if (co->link)
+        lahar_link_sched_gaps(co->link, &gap_max, &gap_sum);
+    cJSON_AddNumberToObject(root, "coordinator_sched_gap_max_s", gap_max);
+    cJSON_AddNumberToObject(root, "coordinator_sched_gap_sum_s", gap_sum);
     cJSON *nodes = cJSON_AddObjectToObject(root, "nodes");
     int64_t dem_substeps = 0;
     for (int r = 1; r < LAHAR_NROLES; r++) {
@@ -1006,6 +1078,11 @@ static void coord_write_summary(coord *co)
             dem_substeps = n->substeps;
         }
         cJSON_AddNumberToObject(j, "exit_status", n->exit_status);
+        /* liveness: the longest gap between two frames heard from the node, and the silences
+         * forgiven because the node was still running (coordinator/README.md) */
+        cJSON_AddNumberToObject(j, "max_silence_s", co->link ? lahar_link_max_silence(co->link, r) : 0.0);
+        cJSON_AddNumberToObject(j, "starved_silences", n->starved_count);
+        cJSON_AddNumberToObject(j, "starved_max_s", n->starved_max_s);
     }
     cJSON_AddNumberToObject(root, "dem_substeps", (double)dem_substeps);
     /* Traffic as seen by the coordinator: what it sent, and every frame of the run it heard
@@ -1071,15 +1148,22 @@ static void coord_write_summary(coord *co)
     char *text = cJSON_Print(root);
     char path[PATH_MAX + 32];
     snprintf(path, sizeof path, "%s/summary.json", co->outdir);
-    FILE *f = fopen(path, "w");
-    if (f && text) {
-        fputs(text, f);
-        fputc('\n', f);
+    /* into the room reserved at the start (coord_reserve_summary): written in place, then cut to
+     * its length, which needs no new space on a full disk */
+    int fd = co->summary_fd >= 0 ? co->summary_fd : open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    int ok = 0;
+    if (fd >= 0 && text) {
+        size_t len = strlen(text);
+        text[len] = '\n'; /* cJSON_Print's terminator becomes the final newline */
+        ok = pwrite(fd, text, len + 1, 0) == (ssize_t)(len + 1) && ftruncate(fd, (off_t)(len + 1)) == 0;
+        text[len] = '\0';
     }
-    if (f)
-        fclose(f);
-    else
+    if (!ok)
+        fprintf(stderr, "lahar: cannot write %s: %s (the run ended with status %d: %s)\n", path,
+                text ? strerror(errno) : "out of memory", co->exit_status, co->status);
+    if (fd >= 0 && close(fd) != 0 && ok)
         fprintf(stderr, "lahar: cannot write %s: %s\n", path, strerror(errno));
+    co->summary_fd = -1;
     free(text);
     cJSON_Delete(root);
 }
@@ -1179,6 +1263,63 @@ static int coord_clear_outdir(const char *outdir, int overwrite)
                     "are removed first),%s or choose another -o\n", outdir, found,
             strstr(found, LAHAR_CKPT_DIR) ? " continue it with `lahar resume OUT`," : "");
     return -1;
+}
+
+/* Before anything runs: OUT must have room for the first snapshots, the writers' margin and
+ * summary.json, whose room is taken now (a placeholder that says the run has not ended, padded
+ * to COORD_SUMMARY_RESERVE bytes), so that a run that fills the disk can still write it. A full
+ * disk is refused with exit status 2. The descriptor goes to co->summary_fd. */
+static int coord_reserve_summary(coord *co)
+{
+    const lahar_case *c = co->c;
+    double particles = 0.0;
+    for (int b = 0; b < c->nblock; b++) {
+        double cells = 1.0;
+        for (int a = 0; a < c->dim; a++)
+            cells *= (c->blocks[b].hi[a] - c->blocks[b].lo[a]) / c->sph_dx + 1.0;
+        particles += cells;
+    }
+    /* a particle snapshot (17 values per particle at most), the bodies' files with their
+     * geometry, the writers' margin */
+    double need = 17.0 * 8.0 * particles + 64.0 * 1024.0 * (c->nbody + 1) + 2.0 * LAHAR_OUTPUT_RESERVE +
+                  COORD_SUMMARY_RESERVE;
+    double avail = lahar_output_free_bytes(co->outdir);
+    char path[PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/summary.json", co->outdir);
+    int fd = -1, rc = avail >= 0.0 && avail < need ? ENOSPC : 0;
+    if (!rc) {
+        fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        static const char head[] = "{\"status\": \"running\", \"message\": \"the run has not ended, or lahar was "
+                                   "killed before it could write this summary\"}\n";
+        char *buf = fd >= 0 ? malloc(COORD_SUMMARY_RESERVE) : NULL;
+        if (buf) {
+            memset(buf, ' ', COORD_SUMMARY_RESERVE);
+            memcpy(buf, head, sizeof head - 1);
+            buf[COORD_SUMMARY_RESERVE - 1] = '\n';
+        }
+        /* the blocks are allocated now (posix_fallocate), not at some later write-back */
+        if (fd < 0 || !buf)
+            rc = errno ? errno : ENOMEM;
+        else if ((rc = posix_fallocate(fd, 0, COORD_SUMMARY_RESERVE)) == 0 &&
+                 pwrite(fd, buf, COORD_SUMMARY_RESERVE, 0) != COORD_SUMMARY_RESERVE)
+            rc = errno ? errno : EIO;
+        free(buf);
+    }
+    if (rc) {
+        if (fd >= 0) {
+            close(fd);
+            unlink(path);
+        }
+        if (rc == ENOSPC)
+            fprintf(stderr, "lahar: %s: no space left on device (%.0f bytes free; this run needs at least %.0f for "
+                            "its first snapshots and summary.json); free space there or choose another -o\n",
+                    co->outdir, avail, need);
+        else
+            fprintf(stderr, "lahar: cannot write %s: %s; choose another -o\n", path, strerror(rc));
+        return -1;
+    }
+    co->summary_fd = fd;
+    return 0;
 }
 
 static int64_t coord_random_run_id(void)
@@ -1368,6 +1509,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     co.c = c;
     co.o = o;
     co.status = "error";
+    co.summary_fd = -1;
     co.wall0 = lahar_now();
     co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
     co.node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
@@ -1440,6 +1582,10 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
             close(lock_fd);
             return LAHAR_EXIT_SETUP;
         }
+    }
+    if (coord_reserve_summary(&co) != 0) {
+        close(lock_fd);
+        return LAHAR_EXIT_SETUP;
     }
     co.run_id = coord_random_run_id();
     co.progress = !o->quiet && isatty(STDERR_FILENO);

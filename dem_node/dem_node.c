@@ -338,6 +338,7 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
                                            (const double(*)[3])lm->force, (const double(*)[3])lm->torque) != 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "cannot write to contacts.h5 in %s", d->ns.output_dir);
+                lahar_output_explain(err, sizeof err);
             }
         }
         at_output_time = step.write_output;
@@ -360,6 +361,7 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
         if (lahar_body_output_forces(d->out, k + 1, step.t_next, d->reports) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot append to forces.h5 in %s", d->ns.output_dir);
+            lahar_output_explain(err, sizeof err);
         }
         /* On an engine error the last state is kept as a snapshot to look at. */
         if (step.write_output || st.error) {
@@ -370,6 +372,7 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
             } else if (!st.error) {
                 st.error = 1;
                 snprintf(err, sizeof err, "cannot write a snapshot to bodies.h5 in %s", d->ns.output_dir);
+                lahar_output_explain(err, sizeof err);
             }
         }
         st.dt_proposed = 0.0; /* the engine subcycles: no limit on the coordinator step */
@@ -458,8 +461,10 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
                      (long long)d.ns.scene.resume_step);
     } else {
         dem_node_get_states(&d);
-        if (lahar_body_output_snapshot(d.out, 0, 0.0, d.states) != 0)
+        if (lahar_body_output_snapshot(d.out, 0, 0.0, d.states) != 0) {
             snprintf(err, sizeof err, "cannot write the first snapshot in %s", d.ns.output_dir);
+            lahar_output_explain(err, sizeof err);
+        }
     }
     char engine_desc[128];
     if (d.ops)

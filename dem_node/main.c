@@ -1,7 +1,9 @@
 /* lahar-dem: the DEM node as a process. Normally started by `lahar run` inside the run's private
  * network namespace; can be started by hand for `lahar run --no-spawn` / across hosts. */
 #include <stdio.h>
+#include <unistd.h>
 #include "dem_engine.h"
+#include "output.h"
 #include "dem_node.h"
 
 int main(int argc, char **argv)
@@ -16,5 +18,12 @@ int main(int argc, char **argv)
                                    "Exit status: 0 run finished, 1 engine or output error, 2 setup error, "
                                    "3 coordinator lost.",
                                    &o);
-    return rc >= 0 ? rc : lahar_dem_node_run(&o);
+    if (rc >= 0)
+        return rc;
+    rc = lahar_dem_node_run(&o);
+    if (lahar_output_failed()) { /* HDF5's clean-up at exit would crash on a file that failed to close */
+        fflush(NULL);
+        _exit(rc);
+    }
+    return rc;
 }

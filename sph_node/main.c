@@ -1,5 +1,8 @@
 /* lahar-sph: the SPH node as a process. Normally started by `lahar run` inside the run's private
  * network namespace; can be started by hand for `lahar run --no-spawn` / across hosts. */
+#include <stdio.h>
+#include <unistd.h>
+#include "output.h"
 #include "sph_node.h"
 
 int main(int argc, char **argv)
@@ -10,5 +13,12 @@ int main(int argc, char **argv)
                                    "fills the\nparticle blocks of the scene on a lattice and advances the particles "
                                    "step by step.",
                                    "Exit status: 0 run finished, 1 output error, 2 setup error, 3 coordinator lost.", &o);
-    return rc >= 0 ? rc : lahar_sph_node_run(&o);
+    if (rc >= 0)
+        return rc;
+    rc = lahar_sph_node_run(&o);
+    if (lahar_output_failed()) { /* HDF5's clean-up at exit would crash on a file that failed to close */
+        fflush(NULL);
+        _exit(rc);
+    }
+    return rc;
 }

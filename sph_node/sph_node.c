@@ -523,6 +523,7 @@ static int sph_node_fixed_open(sph_node *s, char *err, size_t errlen)
         return 0;
     if (sph_node_fixed_snapshot(s, 0, 0.0) != 0) {
         snprintf(err, errlen, "cannot write the first body snapshot in %s", s->ns.output_dir);
+        lahar_output_explain(err, errlen);
         return -1;
     }
     return 0;
@@ -546,6 +547,7 @@ static int sph_node_fixed_forces(sph_node *s, int64_t k, const lahar_step_t *ste
     }
     if (lahar_body_output_forces(s->bout, k + 1, step->t_next, s->reports) != 0) {
         snprintf(err, errlen, "cannot append to forces.h5 in %s", s->ns.output_dir);
+        lahar_output_explain(err, errlen);
         return -1;
     }
     int at_output = s->at_output_time;
@@ -575,6 +577,7 @@ static int sph_node_fixed_forces(sph_node *s, int64_t k, const lahar_step_t *ste
                                    (const double(*)[3])s->c_f, (const double(*)[3])s->l_force,
                                    (const double(*)[3])s->l_torque) != 0) {
         snprintf(err, errlen, "cannot write to contacts.h5 in %s", s->ns.output_dir);
+        lahar_output_explain(err, errlen);
         return -1;
     }
     return 0;
@@ -812,6 +815,7 @@ static int sph_node_probes_open(sph_node *s, char *err, size_t errlen)
     sph_probes_sample(&s->probes, &s->f, c, s->nbody > 0 ? s->states : NULL, 0.0);
     if (lahar_gauge_output_write(s->gauges, 0, 0.0, s->probes.value, s->probes.due) != 0) {
         snprintf(err, errlen, "cannot write gauges.h5 in %s", s->ns.output_dir);
+        lahar_output_explain(err, errlen);
         return -1;
     }
     return 0;
@@ -1052,6 +1056,7 @@ static int sph_node_loop(sph_node *s, int64_t k0, double t0)
             } else if (!st.error && sph_node_probes_sample(s, k, step.t_next) != 0) {
                 st.error = 1;
                 snprintf(err, sizeof err, "cannot write gauges.h5 in %s", s->ns.output_dir);
+                lahar_output_explain(err, sizeof err);
             }
         }
         /* on an error the state reached is kept as the last snapshot to look at: after the step,
@@ -1059,6 +1064,7 @@ static int sph_node_loop(sph_node *s, int64_t k0, double t0)
         if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot write a snapshot in %s", s->ns.output_dir);
+            lahar_output_explain(err, sizeof err);
         } else if (!stepped && !begun && s->last_snapshot != k) {
             sph_node_snapshot(s, k, step.t);
         }
@@ -1191,9 +1197,10 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
         ;
     else if (!(s.out = lahar_particle_output_open(s.ns.output_dir, c, c->output_fields, err, sizeof err)))
         ;
-    else if (!c->resume && sph_node_snapshot(&s, 0, 0.0) != 0)
+    else if (!c->resume && sph_node_snapshot(&s, 0, 0.0) != 0) {
         snprintf(err, sizeof err, "cannot write the first particle snapshot in %s", s.ns.output_dir);
-    else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
+        lahar_output_explain(err, sizeof err);
+    } else if (sph_node_setup_bodies(&s, err, sizeof err) != 0) {
         /* the message is in err */
     } else if (sph_node_probes_open(&s, err, sizeof err) != 0) {
         /* the message is in err */

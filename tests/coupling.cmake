@@ -53,4 +53,7 @@ lahar_coupling_run_test(cross_host_auth "slow;netns;coupling")
 set_property(TEST coupling_cross_host_auth APPEND PROPERTY ENVIRONMENT "LAHAR_ATTACK=$<TARGET_FILE:lahar_attack>")
 lahar_coupling_run_test(no_namespace "fast;netns;coupling")
 lahar_coupling_run_test(engine_error "fast;coupling")
+# a full disk on OUT (a small tmpfs in a private user + mount namespace): mid-run and at the start
+lahar_coupling_run_test(disk_full "slow;netns;coupling")
+lahar_coupling_run_test(disk_full_start "fast;netns;coupling")
 lahar_coupling_run_test(cli "fast;netns;coupling")

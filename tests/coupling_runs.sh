@@ -7,7 +7,7 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | node_stopped | coordinator_killed | concurrent |
-#         cross_host | cross_host_auth | no_namespace | engine_error | cli
+#         cross_host | cross_host_auth | no_namespace | engine_error | cli | disk_full | disk_full_start
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -169,14 +169,23 @@ node_killed)
     t0=$(date +%s.%N)
     wait "$lahar_pid"
     rc=$?
-    elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+    t1=$(date +%s.%N) # before python starts: its start-up takes seconds on a loaded machine
+    elapsed=$("$python" -c "print(round($t1 - $t0, 2))")
     cat stderr.txt
     echo "coordinator exited with $rc after ${elapsed} s"
     [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
-    "$python" -c "import sys; sys.exit(0 if $elapsed < 4.0 else 1)" || fail "took ${elapsed} s to notice (limit 4 s)"
+    # a dead node is reaped at once (every 50 ms while a STATUS is missing): far below the 2 s of
+    # silence that would otherwise end the run
+    gap=$(summary killed "s['coordinator_sched_gap_sum_s']")
+    "$python" -c "import sys; sys.exit(0 if $elapsed < 4.0 + $gap else 1)" ||
+        fail "took ${elapsed} s to notice (limit 4 s + the coordinator's own scheduling gaps ${gap} s)"
+    grep -q "silent for [01]\.[0-9] s (killed by signal 9)" stderr.txt ||
+        fail "the killed node was not noticed before its silence reached 2 s"
     grep -q "DEM node" stderr.txt || fail "message does not name the DEM node"
     grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
     h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
+    # the force stream of the killed SWMR writer: every row it flushed reads (h5dump reads the data)
+    h5dump killed/forces.h5 > /dev/null || fail "forces.h5 of the killed node does not read"
     [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
     ;;
 node_stopped)
@@ -186,7 +195,7 @@ node_stopped)
     # the same hung node is lost after 4 s of silence, not 2.
     write_case long.yaml 30
     stop_dem_run() { # out [lahar options]: run, SIGSTOP the DEM node, set rc and elapsed
-        local out=$1 dem_pid="" lahar_pid t0
+        local out=$1 dem_pid="" lahar_pid t0 t1
         shift
         "$bin/lahar" run long.yaml -o "$out" -q "$@" 2> "$out.stderr" &
         lahar_pid=$!
@@ -201,19 +210,35 @@ node_stopped)
         t0=$(date +%s.%N)
         wait "$lahar_pid"
         rc=$?
-        elapsed=$("$python" -c "import time; print(round(time.time() - $t0, 2))")
+        t1=$(date +%s.%N) # before python starts: its start-up takes seconds on a loaded machine
+    elapsed=$("$python" -c "print(round($t1 - $t0, 2))")
         kill -9 "$dem_pid" 2>/dev/null
         cat "$out.stderr"
         echo "$out: coordinator exited with $rc after ${elapsed} s"
     }
+    # Detection counts from the signal to the end of the lockstep (lahar's exit less summary.json
+    # finish_s: STOP, the 3 s the stopped node gets before it is killed, the summary): the silence
+    # (up to one 0.25 s heartbeat period of it may precede the signal), the 0.5 s probe and 1 s of
+    # slack, plus the time the coordinator itself was not running while it waited (summary.json
+    # coordinator_sched_gap_sum_s, not counted as the node's silence): on a loaded machine the
+    # judge may be starved too, and only its own measured gaps widen the limit.
+    detected() { # out: sets det and lim_extra
+        det=$("$python" -c "import json; print(round($elapsed - json.load(open('$1/summary.json'))['finish_s'], 2))")
+        lim_extra=$(summary "$1" "s['coordinator_sched_gap_sum_s']")
+    }
     stop_dem_run stopped
     [ "$rc" -eq 3 ] || fail "exit status $rc, expected 3 (node lost)"
-    "$python" -c "import sys; sys.exit(0 if $elapsed < 6.0 else 1)" || fail "took ${elapsed} s to notice (limit 6 s)"
+    detected stopped
+    echo "stopped: detected after $det s (coordinator's own scheduling gaps $lim_extra s)"
+    "$python" -c "import sys; sys.exit(0 if 1.7 <= $det < 3.5 + $lim_extra else 1)" ||
+        fail "detected after $det s (want 1.7-3.5 s + the coordinator's own scheduling gaps $lim_extra s)"
     grep -q "DEM node.*hangs" stopped.stderr || fail "message does not name the DEM node as hung"
     stop_dem_run stopped4 --node-timeout 4
     [ "$rc" -eq 3 ] || fail "--node-timeout 4: exit status $rc, expected 3"
-    "$python" -c "import sys; sys.exit(0 if 4.0 <= $elapsed < 12.0 else 1)" ||
-        fail "--node-timeout 4: lost after ${elapsed} s (want 4-12 s)"
+    detected stopped4
+    echo "stopped4: detected after $det s (coordinator's own scheduling gaps $lim_extra s)"
+    "$python" -c "import sys; sys.exit(0 if 3.7 <= $det < 5.5 + $lim_extra else 1)" ||
+        fail "--node-timeout 4: detected after $det s (want 3.7-5.5 s + the coordinator's own scheduling gaps $lim_extra s)"
     grep -q "silent for 4.0 s" stopped4.stderr || fail "--node-timeout 4: the message does not give the 4 s"
     ;;
 coordinator_killed)
@@ -379,6 +404,81 @@ cli)
     "$bin/lahar" check "$cases/dem_bounce_3d.yaml" -o bounce -q || fail "lahar check on dem_bounce_3d failed"
     "$python" -c "import json; c = json.load(open('bounce/check.json')); assert c['pass'] is True, c" ||
         fail "check.json does not say pass"
+    ;;
+disk_full)
+    # OUT on a small file system (a 2 MB tmpfs in a private user + mount namespace) that the run
+    # fills: the node that cannot write says which file, "no space left on device" and the step
+    # and time; the run stops with exit 1 and status "error" (no hang, no crash); every HDF5 file
+    # opens with h5py and every dataset reads; the particle snapshots written before the failure
+    # are bitwise those of the same run on a roomy disk; summary.json is written; no node process
+    # is left.
+    cases=$(cd "$tools/../cases" && pwd)
+    "$python" "$tools/case_override.py" "$cases/debris_2d.yaml" full.yaml time.end=0.03 time.output_interval=0.001 ||
+        fail "cannot write the case"
+    "$bin/lahar" run full.yaml -o ref -q --in-process || fail "reference run failed"
+    mkdir -p mnt
+    unshare --user --map-root-user --mount bash -c "
+        mount -t tmpfs -o size=2m tmpfs mnt || exit 9
+        '$bin/lahar' run full.yaml -o mnt/out -q 2> full.stderr & lahar=\$!
+        nodes=''
+        while kill -0 \$lahar 2>/dev/null; do
+            for stat in /proc/[0-9]*/stat; do
+                read -r pid comm state ppid rest < \$stat 2>/dev/null || continue
+                [ \"\$ppid\" = \$lahar ] && case \$comm in '(lahar-sph)'|'(lahar-dem)') case \" \$nodes \" in *\" \$pid \"*) ;; *) nodes=\"\$nodes \$pid\" ;; esac ;; esac
+            done
+            sleep 0.05
+        done
+        wait \$lahar; echo \$? > full_rc.txt
+        echo \$nodes > full_nodes.txt
+        df -k mnt | tail -1 > full_df.txt
+        cp -r mnt/out full_out"
+    [ -s full_rc.txt ] || fail "the tmpfs could not be mounted in a private mount namespace"
+    cat full.stderr
+    rc=$(cat full_rc.txt)
+    echo "exit status $rc; tmpfs: $(cat full_df.txt); node pids seen: $(cat full_nodes.txt)"
+    [ "$rc" -eq 1 ] || fail "exit status $rc, expected 1"
+    grep -q "no space left on device" full.stderr || fail "the message does not say 'no space left on device'"
+    grep -q "\.h5: no space left on device.* at step [0-9]* (t = " full.stderr || fail "the message does not name the file, step and time"
+    for p in $(cat full_nodes.txt); do [ ! -e "/proc/$p" ] || fail "node process $p is left"; done
+    [ -n "$(cat full_nodes.txt)" ] || fail "no node process was seen"
+    "$python" - full_out ref <<'PY' || fail "files after the full disk"
+import glob, json, sys
+import h5py, numpy as np
+out, ref = sys.argv[1], sys.argv[2]
+s = json.load(open(out + "/summary.json"))
+assert s["status"] == "error" and s["exit_status"] == 1, (s["status"], s["exit_status"])
+assert "no space left on device" in s["message"], s["message"]
+for p in sorted(glob.glob(out + "/*.h5")):
+    with h5py.File(p, "r") as f:  # opens, and every dataset reads
+        f.visititems(lambda n, o: o[()] if isinstance(o, h5py.Dataset) else None)
+with h5py.File(out + "/particles.h5", "r") as f, h5py.File(ref + "/particles.h5", "r") as g:
+    names = sorted(f["snapshots"])
+    assert len(names) >= 2, names
+    for name in names:
+        a, b = f["snapshots"][name], g["snapshots"][name]
+        assert a.attrs["time"] == b.attrs["time"], name
+        for d in a:
+            assert np.array_equal(a[d][()], b[d][()]), (name, d)
+    t_last = float(f["snapshots"][names[-1]].attrs["time"])
+print("disk_full: stopped at step %d (t = %.4g s); %d particle snapshots kept, to t = %.4g s, bitwise those of the "
+      "run on a roomy disk; every HDF5 file opens" % (s["steps"], s["sim_time"], len(names), t_last))
+PY
+    ;;
+disk_full_start)
+    # OUT on a file system without room for the first snapshots: exit 2 before anything runs,
+    # saying so; nothing written but the lock file.
+    write_case case.yaml 0.3
+    mkdir -p mnt
+    unshare --user --map-root-user --mount bash -c "
+        mount -t tmpfs -o size=192k tmpfs mnt || exit 9
+        '$bin/lahar' run case.yaml -o mnt/out -q 2> start.stderr; echo \$? > start_rc.txt
+        ls -A mnt/out > start_ls.txt"
+    [ -s start_rc.txt ] || fail "the tmpfs could not be mounted in a private mount namespace"
+    cat start.stderr
+    rc=$(cat start_rc.txt)
+    [ "$rc" -eq 2 ] || fail "exit status $rc, expected 2"
+    grep -q "no space left on device" start.stderr || fail "the message does not say 'no space left on device'"
+    [ "$(cat start_ls.txt)" = .lahar.lock ] || fail "files were written: $(cat start_ls.txt)"
     ;;
 no_namespace)
     # When no user namespace can be created (here: nested to the kernel's limit), lahar run exits 2
