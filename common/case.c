@@ -406,7 +406,7 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
     for (int k = 0; dem_only[k] && !m->r->failed; k++)
         if (rmap_get(m, dem_only[k]))
             rmap_fail(m, dem_only[k], "is a DEM contact key, but this material is an SPH soil (model: soil); remove "
-                      "it (the soil-DEM contact uses the SPH coupling's K_n, paper 000 eq. 15)");
+                      "it (the soil-DEM contact uses the SPH coupling's K_n, Trujillo-Vela et al. 2020 eq. 15)");
     mat->young = rmap_num(m, "young", 1, 0.0, "8.4e5");
     mat->poisson = rmap_num(m, "poisson", 0, 0.3, "0.3");
     double phi = rmap_num(m, "friction_angle", 1, 0.0, "30");
@@ -447,7 +447,7 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
         rmap_fail(m, "damping", "must be >= 0 1/s (got %g); 0 = off, about the column's first frequency pi c/(2 H) "
                   "damps its start-up in a few periods", cd);
     else if (!(ava >= 0))
-        rmap_fail(m, "av_alpha", "must be >= 0 (got %g); Monaghan's alpha of the soil, 0.1 by default, 1 in paper 000's "
+        rmap_fail(m, "av_alpha", "must be >= 0 (got %g); Monaghan's alpha of the soil, 0.1 by default, 1 in Trujillo-Vela et al.'s (2020) "
                   "granular impact", ava);
     else if (!(avb >= 0))
         rmap_fail(m, "av_beta", "must be >= 0 (got %g); Monaghan's beta of the soil, 0 by default", avb);
@@ -1797,7 +1797,7 @@ int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
 /* The bodies a lattice point must stay out of, with the bounding sphere of each about its x to skip
  * the exact test for most points (fixed bodies keep world coordinates with x = 0: the sphere
  * still covers them). A point must also not start inside the coupling's halo eps = dx/2 about a
- * body's surface (sph_coupling.h, paper 000 eq. 14): a particle at d < eps starts with an overlap
+ * body's surface (sph_coupling.h, Trujillo-Vela et al. 2020 eq. 14): a particle at d < eps starts with an overlap
  * delta = eps - d whose first push, K_n delta with K_n = 0.1 m_min/dt^2 (eq. 15), is an impulse
  * growing as 1/dt: a free body is kicked by it, so that its motion depended on the time step
  * (the boulder pool of `lahar bench`, README "DEM subcycling": kicked up at 0.16 or 0.51 m/s at
@@ -1915,7 +1915,7 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
 /* sph.body_layers = N > 0: after the lattice points (which leave out the zone within N dx of every
  * round body's surface), the points of that zone on N layers concentric with each round body, at
  * r_l = R + (l + 1/2) dx, l = 0 .. N - 1, like the rows of fluid a flat wall sees in the lattice (the
- * first at the halo eps = dx/2, paper 000 eq. 14, and at the depths of the coupling's ghost layers,
+ * first at the halo eps = dx/2, Trujillo-Vela et al. 2020 eq. 14, and at the depths of the coupling's ghost layers,
  * sph_coupling.h). Layer l holds the lattice's share of its shell R + l dx .. R + (l + 1) dx,
  * round(volume / dx^D) points (4 pi / 3 ((R + (l+1) dx)^3 - (R + l dx)^3) / dx^3 in 3D,
  * pi ((R + (l+1) dx)^2 - (R + l dx)^2) / dx^2 = 2 pi r_l / dx in 2D; the outermost layer also the
@@ -2043,7 +2043,7 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
         for (int j = 0; j < i; j++) {
             const lahar_particle_block *o = &c->blocks[j];
             if (b->kind != LAHAR_BLOCK_BOX || o->kind != LAHAR_BLOCK_BOX || b->phase != o->phase)
-                continue; /* water may fill the pores of a soil block (paper 000 section 2.3) */
+                continue; /* water may fill the pores of a soil block (Trujillo-Vela et al. 2020 section 2.3) */
             int overlap = 1;
             for (int a = 0; a < dim; a++)
                 overlap = overlap && b->lo[a] < o->hi[a] - 1e-9 * dx && o->lo[a] < b->hi[a] - 1e-9 * dx;
@@ -2325,7 +2325,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                       "lower the viscosity or dt_min, or raise dx", dt_v, c->dt_min);
         return;
     }
-    /* water and soil particles share space where they seep (000 section 2.3): a shift of the
+    /* water and soil particles share space where they seep (Trujillo-Vela et al. 2020, section 2.3): a shift of the
      * water by its own particles only would push it into the soil */
     for (int b = 0; b < c->nblock && o->shifting > 0.0; b++)
         if (c->blocks[b].phase == 1) {

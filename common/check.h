@@ -147,7 +147,7 @@ double lahar_check_zick_homsy_K(double c);
 /* Transient plane Poiseuille flow from rest (Morris et al. 1997 eq. 21, shared/reference/05
  * section 5.1): velocity at distance y from the lower wall of a channel of width H driven by
  * the acceleration a, kinematic viscosity nu, time t; and the shear force per unit wall area on
- * one wall, rho nu du/dy at the wall (steady value rho a H / 2, paper 000 eq. 31-32). */
+ * one wall, rho nu du/dy at the wall (steady value rho a H / 2, Trujillo-Vela et al. 2020 eq. 31-32). */
 double lahar_check_poiseuille_u(double y, double t, double H, double a, double nu);
 double lahar_check_poiseuille_wall_stress(double t, double H, double a, double nu, double rho);
 /* Comma-separated reference names for messages. */

@@ -290,7 +290,7 @@ double lahar_check_poiseuille_u(double y, double t, double H, double a, double n
 }
 
 /* rho nu du/dy at y = 0 of the same series: rho a H/2 - sum 4 rho a H/(pi^2 (2n+1)^2) e^(...),
- * zero at t = 0 (sum 1/(2n+1)^2 = pi^2/8) and rho a H/2 when steady (paper 000 eq. 31-32). */
+ * zero at t = 0 (sum 1/(2n+1)^2 = pi^2/8) and rho a H/2 when steady (Trujillo-Vela et al. 2020 eq. 31-32). */
 double lahar_check_poiseuille_wall_stress(double t, double H, double a, double nu, double rho)
 {
     double tau = rho * a * H / 2.0;
@@ -306,7 +306,7 @@ double lahar_check_poiseuille_wall_stress(double t, double H, double a, double n
     return tau;
 }
 
-/* Plane Poiseuille flow between two fixed parallel plates (paper 000 section 5.1), driven by the
+/* Plane Poiseuille flow between two fixed parallel plates (Trujillo-Vela et al. 2020 section 5.1), driven by the
  * acceleration a = |gravity + sph.body_force| along the plates, periodic along the flow.
  *  - H: distance between the plates' swept surfaces, from their geometry (the two fixed bodies
  *    nearest the fluid's centre on opposite sides); y is measured from the lower plate's surface.
@@ -509,7 +509,7 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
     snprintf(r->note, sizeof r->note,
              "plates %s (y = 0) and %s; u(y,t): transient series of shared/reference/05 section 5.1 (Morris et al. "
              "1997 eq. 21); plate force: late-window mean along the flow vs tau(t) L W, steady tau = rho a H/2 "
-             "(paper 000 eq. 31-32)",
+             "(Trujillo-Vela et al. 2020 eq. 31-32)",
              c->bodies[lo].name, c->bodies[hi].name);
     snprintf(r->title, sizeof r->title, "poiseuille: H = %.4g m, a = %.3g m/s^2, nu = %.3g m^2/s", H, a, nu);
     return 0;
@@ -535,7 +535,7 @@ double lahar_check_sangani_acrivos_K(double c)
     return exp((1.0 - s) * log(sa_K[i]) + s * log(sa_K[i + 1]));
 }
 
-/* Periodic square cell with one fixed disc (paper 000 section 5.2), flow driven by the
+/* Periodic square cell with one fixed disc (Trujillo-Vela et al. 2020 section 5.2), flow driven by the
  * acceleration g = |gravity + sph.body_force|: K = rho g L^2 / (mu U_s) with U_s = (1 - c) <u>,
  * <u> the mean particle velocity along g (the particles fill the fluid area uniformly, so it is
  * the fluid-area mean) at the last snapshot, c = pi r^2 / L^2; against Sangani & Acrivos at c. */

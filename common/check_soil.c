@@ -209,7 +209,7 @@ int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, l
 
 /* soil_slide: a soil block resting on a fixed floor whose normal is +y (2D) / +z (3D), gravity
  * tilted by theta from the normal (the same as a block on a plane inclined by theta). With the
- * soil-DEM friction mu_phi (paper 000 eq. 22-25) the block slides when tan(theta) > mu_phi with
+ * soil-DEM friction mu_phi (Trujillo-Vela et al. 2020 eq. 22-25) the block slides when tan(theta) > mu_phi with
  *   a = g (sin theta - mu_phi cos theta)
  * and stays put otherwise (a = 0). Measured: the mean velocity of the soil particles along the
  * tangential part of gravity, fitted by a straight line over the snapshots after the first
@@ -469,7 +469,7 @@ int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d
 /* darcy: water driven through a soil by sph.body_force b (fluid only; hydraulic gradient
  * i = |b| / g with g = |gravity|, 9.81 m/s^2 without gravity, the g of k = k_h mu / (rho_w g)).
  * Darcy's law gives the seepage (superficial) velocity u = k_h i along b relative to the soil
- * (paper 000 eq. 10). Measured: mean water velocity minus mean soil velocity along b, averaged
+ * (Trujillo-Vela et al. 2020 eq. 10). Measured: mean water velocity minus mean soil velocity along b, averaged
  * over the snapshots of the last quarter of the run. Metric:
  *   darcy_velocity_rel_error = |u - k_h i| / (k_h i). */
 int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
@@ -529,7 +529,7 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
     return 0;
 }
 
-/* granular_impact: a soil mass flowing down a chute onto a fixed wall (paper 000 section 5.3,
+/* granular_impact: a soil mass flowing down a chute onto a fixed wall (Trujillo-Vela et al. 2020 section 5.3,
  * Moriguchi et al. 2009). The chute's bed is normal to the last axis (z in 3D, y in 2D) and
  * gravity is tilted from it; "down the chute" is the unit vector t along gravity's tangential part,
  * and the wall is the fixed body named `wall` across it. The soil block fills the chute's width at
@@ -545,7 +545,7 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
  *         section A stopped by a wall pushes it with rho u^2 A (the fluid-mechanics estimate of a
  *         granular impact, dynamic part only);
  *   momentum balance along t: the soil's momentum changes by M g_t T minus the impulse of every
- *         body's force on it (action and reaction of paper 000 eq. 15, 20 and 26), so
+ *         body's force on it (action and reaction of Trujillo-Vela et al. 2020 eq. 15, 20 and 26), so
  *         sum_b J_b(T) = M g_t T - (P(T) - P(0)), with J_b the impulse of the force stream of body b.
  * Metrics:
  *   escaped_particles           soil particles that went through the wall, the bed or a side wall:
@@ -566,7 +566,7 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
  *                               frictionless dam-break front on the slope, s = 2 sqrt(g_n H) t + g_t
  *                               t^2/2, arrives first; a rigid block sliding from rest with mu_phi,
  *                               s = (g_t - mu_phi g_n) t^2/2, last (0)
- * Paper 000 Fig. 14-15 are images without numbers in the text (shared/papers/000): no published
+ * Trujillo-Vela et al. 2020, Fig. 14-15 are images without numbers in the text (shared/papers/000): no published
  * peak force is compared; the peak, its time and the first impact are reported. */
 
 /* The particle ids of snapshot k (output field id), read beside the check's buffers. */
@@ -816,7 +816,7 @@ int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, 
                       isnan(t_first) ? INFINITY : fmax(0.0, fmax(t_ritter - t_first, t_first - t_block)));
     lahar_check_value(r, "sliding_block_arrival_s", t_block);
     lahar_check_value(r, "frictionless_front_arrival_s", t_ritter);
-    snprintf(r->note, sizeof r->note, "slope %.1f deg, travel %.3g m from the block's front to the wall; paper 000 "
+    snprintf(r->note, sizeof r->note, "slope %.1f deg, travel %.3g m from the block's front to the wall; Trujillo-Vela et al. 2020 "
              "Fig. 14-15 give no numbers in the text: no published peak compared", theta, travel);
     snprintf(r->convention, sizeof r->convention, "F = force of the soil on the body `wall` along the chute, "
              "10 ms moving average; F_mf = sum m u^2 / L over particles moving to the wall within L = %.3g m", L);

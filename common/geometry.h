@@ -1,7 +1,7 @@
 /* Geometry of sphero-polyhedra, in one place: closest points between features (vertex, edge,
  * face), closest point on a body's surface, distance between two bodies. Used by the DEM
  * contact detection, by the case loader (overlap at t = 0) and by the SPH-DEM coupling
- * (virtual particle at the closest surface point, paper 000 eq. 12-14). */
+ * (virtual particle at the closest surface point, Trujillo-Vela et al. 2020 eq. 12-14). */
 #ifndef LAHAR_GEOMETRY_H
 #define LAHAR_GEOMETRY_H
 #include "scene.h"

@@ -1,9 +1,9 @@
 /* SPH smoothing kernels, in one place: W(r, h) = sigma_D / h^D * f(q), q = r / h, compact support
  * kappa h. Three kernels, selectable by name through a table (kernel_find):
  *   "cubic"     cubic spline (Monaghan & Lattanzio 1985), kappa = 2,
- *               sigma 2D 10/(7 pi), 3D 1/pi. This is the f(q) printed in paper 000 eq. 4.
+ *               sigma 2D 10/(7 pi), 3D 1/pi. This is the f(q) printed in Trujillo-Vela et al. 2020 eq. 4.
  *   "quintic"   quintic spline (Morris et al. 1997), kappa = 3,
- *               sigma 2D 7/(478 pi), 3D 1/(120 pi). Paper 000 eq. 4 prints these constants
+ *               sigma 2D 7/(478 pi), 3D 1/(120 pi). Trujillo-Vela et al. 2020, eq. 4, print these constants
  *               beside the cubic f(q): they belong to this kernel (shared/papers/README.md). The
  *               README's 3D value 3/(359 pi) (as in Liu & Liu 2003) integrates to 1.0028, not 1;
  *               1/(120 pi) integrates to 1 within 1e-6 (tests/test_kernel.c).

@@ -22,7 +22,7 @@ typedef struct {
     double kn;          /* N/m (3D) or N/m per m (2D), linear model normal stiffness */
     double kt_ratio;    /* tangential/normal stiffness ratio, default 2/7 */
     double restitution; /* normal coefficient of restitution e in (0, 1] */
-    double friction;    /* Coulomb coefficient mu >= 0; soil: mu_phi against DEM surfaces (paper 000 eq. 24) */
+    double friction;    /* Coulomb coefficient mu >= 0; soil: mu_phi against DEM surfaces (Trujillo-Vela et al. 2020 eq. 24) */
     lahar_contact_model model; /* LAHAR_CONTACT_SOIL: an SPH soil (model: soil), not a DEM contact law */
     /* soil only (model: soil; sph_node/sph_soil.h): elastic-perfectly plastic Drucker-Prager matched
      * to Mohr-Coulomb; young and poisson above are its elastic constants */
@@ -31,7 +31,7 @@ typedef struct {
     double dilatancy;       /* psi, radians (case: degrees) */
     double permeability;    /* k_h, Darcy hydraulic conductivity, m/s (0: no seepage) */
     double damping;         /* c_d, 1/s: velocity damping -c_d v of the soil (quasi-static start; 0 = off) */
-    double av_alpha, av_beta; /* Monaghan artificial viscosity of the soil (paper 000 section 5.3: 1, 1) */
+    double av_alpha, av_beta; /* Monaghan artificial viscosity of the soil (Trujillo-Vela et al. 2020 section 5.3: 1, 1) */
 } lahar_material;
 
 /* A sphero-polyhedron: a convex (or, for fixed bodies, any) set of vertices, edges and faces
@@ -113,7 +113,7 @@ typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
     double h_over_dx;      /* smoothing length h = h_over_dx dx (default 1.3) */
     double c0;             /* m/s, numerical speed of sound (default 10 U_ref, see the example) */
-    lahar_sph_eos eos;     /* default linear (paper 000 eq. 3); tait: paper 003 eq. 19 */
+    lahar_sph_eos eos;     /* default linear (Trujillo-Vela et al. 2020 eq. 3); tait: Canelas et al. 2015 eq. 19 */
     double gamma;          /* Tait exponent (default 7) */
     double mu;             /* Pa s, dynamic viscosity (default 1e-3, water) */
     double alpha;          /* Monaghan artificial viscosity (default 0 = off) */
@@ -123,20 +123,20 @@ typedef struct {
     int periodic[3];       /* 1: axis periodic with period [lo[a], hi[a]) */
     double lo[3], hi[3];   /* the periods (only meaningful on periodic axes) */
     int shepard_interval;  /* steps between Shepard density filters, 0 = off (default) */
-    int sps;               /* 1: Smagorinsky SPS turbulence (003); default 0 */
+    int sps;               /* 1: Smagorinsky SPS turbulence (Canelas et al. 2015); default 0 */
     double sps_cs;         /* Smagorinsky constant (default 0.12) */
-    double halo;           /* m, coupling halo eps (paper 000 eq. 14; default dx/2) */
+    double halo;           /* m, coupling halo eps (Trujillo-Vela et al. 2020 eq. 14; default dx/2) */
     double kappa;          /* coupling range in units of h (default: the kernel's support radius) */
     lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/sph_coupling.h) */
     lahar_sph_initial_pressure initial_pressure; /* block densities at t = 0: rest (none, default) or
                                                    hydrostatic per block (lahar_sph_node_fill) */
-    lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, paper 000
+    lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, Trujillo-Vela et al. 2020
                                               eq. 15) or ghost layers (sph_node/sph_coupling.h) */
-    lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of paper 000 eq. 15 with the
+    lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of Trujillo-Vela et al. 2020 eq. 15 with the
                                               step's dt (step, default) or the acoustic step
                                               cfl h / c0 (acoustic: independent of the step) */
     lahar_sph_wall_pressure soil_wall_stress; /* the soil's wall term: penalty + friction spring only
-                                                 (default, paper 000 eq. 15, 22-27) or ghost layers
+                                                 (default, Trujillo-Vela et al. 2020 eq. 15, 22-27) or ghost layers
                                                  carrying the soil stress (sph_node/sph_coupling.h) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
                               confined flows only; default 0 = off (sph_node/sph_fluid.c) */

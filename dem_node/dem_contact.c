@@ -108,7 +108,7 @@ double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot,
 {
     double f, k, c;
     if (law->model == LAHAR_CONTACT_HERTZ) {
-        /* paper 003 eq. 14-15 with exponent 3/2 (the printed 3/4 is a typo, shared/papers/README):
+        /* Canelas et al. 2015 eq. 14-15 with exponent 3/2 (the printed 3/4 is a typo, shared/papers/README):
          * F = k_H delta^(3/2) + alpha sqrt(m* k_H) delta^(1/4) delta_dot, k_H = 4/3 E* sqrt(R*) */
         double kh = 4.0 / 3.0 * law->estar * sqrt(rstar);
         double sd = sqrt(delta);
@@ -139,7 +139,7 @@ vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn,
                           double c_normal)
 {
     /* k_t = kt_ratio k_n (secant k_n for Hertz), c_t = sqrt(kt_ratio) c_n: the same damping ratio
-     * as the normal direction (paper 003 uses 2/7 for both, which changes the ratio). */
+     * as the normal direction (Canelas et al. 2015 uses 2/7 for both, which changes the ratio). */
     double kt = law->kt_ratio * k_secant;
     double ct = sqrt(law->kt_ratio) * c_normal;
     vec3 f = v3_add(v3_scale(*xi, -kt), v3_scale(vt, -ct));

@@ -1,5 +1,5 @@
 /* The "spheropoly" DEM engine: rigid sphero-polyhedra (Galindo-Torres 2009-2013 as used in paper
- * 000 sec. 3) with linear or Hertz normal contacts, a tangential spring with Coulomb limit, a
+ * Trujillo-Vela et al. 2020, sec. 3) with linear or Hertz normal contacts, a tangential spring with Coulomb limit, a
  * uniform grid broad phase (dense or hashed), per-body feature grids for big surfaces, kick-drift-kick
  * leap-frog for translation and an exactly rotating splitting (NO_SQUISH / Dullweber-Leimkuhler-
  * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
@@ -333,7 +333,7 @@ static void contact_emit(sp_pair_ctx *x, int type, int fa, int fb, vec3 pa, vec3
     o->cp = cp;
     o->n = n;
     o->delta = rsum - d;
-    /* R*: sweep radius for a vertex or edge, infinite for a face (paper 003 eq. 16) */
+    /* R*: sweep radius for a vertex or edge, infinite for a face (Canelas et al. 2015 eq. 16) */
     o->rstar = a_flat ? gb->radius : (b_flat ? ga->radius : ga->radius * gb->radius / rsum);
 }
 

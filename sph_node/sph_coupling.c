@@ -1,4 +1,4 @@
-/* SPH-DEM coupling (sph_coupling.h; paper 000 section 4). */
+/* SPH-DEM coupling (sph_coupling.h; Trujillo-Vela et al. 2020 section 4). */
 #include "sph_coupling.h"
 #include <float.h>
 #include <math.h>
@@ -77,7 +77,7 @@ static double ghost_layers_curved(const kernel *k, int dim, double d, double dx,
 
 /* ---- SPH_WALL_PRESSURE_GHOST (sph_coupling.h) ----
  * A region of ghosts (volume V_g, pressure p_g = pbar_i + rho_i b.r_g, r_g = x_g - x_i, density
- * rho_i, moving with the wall) adds to particle i (000 eq. 2, symmetric pressure term, and eq. 1,
+ * rho_i, moving with the wall) adds to particle i (Trujillo-Vela et al. 2020, eq. 2, symmetric pressure term, and eq. 1,
  * continuity):
  *   a = -sum_g V_g (p_i + p_g)/rho_i grad_i W_ig = (p_i + pbar_i)/rho_i A + B b,
  *   drho = rho_i sum_g V_g u_rel.grad_i W_ig = -rho_i u_rel.A,

@@ -1,4 +1,4 @@
-/* SPH-DEM coupling through virtual particles (paper 000 section 4, eq. 12-21).
+/* SPH-DEM coupling through virtual particles (Trujillo-Vela et al. 2020 section 4, eq. 12-21).
  *
  * For every SPH particle i within the kernel support kappa h of the swept surface of a DEM body:
  *   c    closest point of the body's core (vertex, edge or face; geom_point_body_core)
@@ -43,10 +43,10 @@ typedef enum {
 } sph_wall_viscous;
 
 /* The wall pressure term: what, besides the penalty force of eq. 15, holds the fluid off a body.
- * PENALTY (default): paper 000 as printed, K_n delta n only. A particle in the second row from a
+ * PENALTY (default): Trujillo-Vela et al. 2020 as printed, K_n delta n only. A particle in the second row from a
  *   wall (d > eps) misses the kernel neighbours behind the wall and nothing replaces them, so the
  *   first rows carry it with a pressure rise: hydrostatic pressures near a floor read 4-6 % high.
- * GHOST: the penalty force plus the pressure and continuity terms of 000 eq. 1-2 summed over
+ * GHOST: the penalty force plus the pressure and continuity terms of Trujillo-Vela et al. 2020, eq. 1-2 summed over
  *   ghost layers behind the surface, the same layers as SPH_WALL_VISCOUS_HALFSPACE (depths
  *   s_k = (k + 1/2) dx, continuous along the wall, moving with it). The ghost pressure is
  *   extrapolated hydrostatically (Adami, Hu & Adams 2012, eq. 27, wall at rest) from pbar_i, the
@@ -175,7 +175,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
  * (and the support around it) along an axis: it is outside the fluid's domain (a marker body
  * parked far away stays inert). z is ignored in 2D. */
 void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const double lo[3], const double hi[3]);
-/* Soil-DEM friction (paper 000 section 4.2, eq. 22-27) for the soil particles (phase != 0): instead
+/* Soil-DEM friction (Trujillo-Vela et al. 2020 section 4.2, eq. 22-27) for the soil particles (phase != 0): instead
  * of the water's viscous term, a tangential spring with a history per (particle, body) pair, kept
  * by particle id (so it survives the sort):
  *   u_tau = u_rel - (u_rel . n) n                                        (eq. 22)
@@ -202,7 +202,7 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  *   sigma_g = sigmabar_i - rho_i g.(x_g - x_i) I,
  *   sigmabar_i = sum_j V_j W_ij (sigma_j - rho_j g.(x_i - x_j) I) / sum_j V_j W_ij
  * (Shepard mean over i and its soil neighbours, carried to x_i with the weight term; g the soil's
- * gravity). 000 eq. 5 summed over the ghosts (m_g = rho_i V_g, rho_g = rho_i) then reads
+ * gravity). Trujillo-Vela et al. 2020, eq. 5 summed over the ghosts (m_g = rho_i V_g, rho_g = rho_i) then reads
  *   a = -(sigma_i + sigmabar_i) . A / rho_i + B g    (A, B the tables of the water's ghosts)
  * with the shear across the wall, (sigma_i + sigmabar_i)_nt, set to zero, and only the component
  * along n kept (free slip: on a full flat wall the rest vanishes; where the ghosts are cut, along

@@ -116,7 +116,7 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
                           f->prm.wall_viscous, f->p.cap) != 0)
         return -1;
     sph_coupling_set_periodic(&f->cpl, f->prm.periodic, f->prm.lo, f->prm.hi); /* bodies act across them */
-    if (f->has_soil && sph_coupling_enable_soil(&f->cpl, f->prm.soil_mat.mu_phi) != 0) { /* 000 section 4.2 */
+    if (f->has_soil && sph_coupling_enable_soil(&f->cpl, f->prm.soil_mat.mu_phi) != 0) { /* Trujillo-Vela et al. 2020, section 4.2 */
         sph_coupling_free(&f->cpl);
         return -1;
     }
@@ -167,9 +167,9 @@ void sph_fluid_free(sph_fluid *f)
 
 double sph_fluid_pressure(const sph_params *prm, double rho)
 {
-    if (prm->eos == SPH_EOS_TAIT) /* 003 eq. 19 */
+    if (prm->eos == SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 */
         return prm->rho0 * prm->c0 * prm->c0 / prm->gamma * (pow(rho / prm->rho0, prm->gamma) - 1.0);
-    return prm->c0 * prm->c0 * (rho - prm->rho0); /* 000 eq. 3 */
+    return prm->c0 * prm->c0 * (rho - prm->rho0); /* Trujillo-Vela et al. 2020, eq. 3 */
 }
 
 static inline int prm_tvf(const sph_fluid *f) { return f->prm.transport_velocity != 0; }
@@ -219,7 +219,7 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
                  hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
                  hz = prm->periodic[2] || dim == 2 ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
-    /* SPS stress of i over rho_i^2 (003 eq. 10); unused when sps is 0 */
+    /* SPS stress of i over rho_i^2 (Canelas et al. 2015, eq. 10); unused when sps is 0 */
     double ti[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     double *const *tau = f->sps_tau;
     if (sps)
@@ -231,7 +231,7 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     SPH_HALF_NEIGHBOUR_CHUNKS_D(c, p, i, xi, yi, zi, s2, dim, {
         for (int k = 0; k < nb_n; k++) {
             const int64_t j = nb_j[k];
-            if (soil && ph[j] != 0) /* soil neighbours: sph_soil.h (fluid-soil: paper 000 section 2.3) */
+            if (soil && ph[j] != 0) /* soil neighbours: sph_soil.h (fluid-soil: Trujillo-Vela et al. 2020 section 2.3) */
                 continue;
             npair++;
             const double rx = nb_xi - nb_x[j], ry = nb_yi - nb_y[j], rz = dim == 2 ? 0.0 : nb_zi - nb_z[j];
@@ -242,19 +242,19 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
             const double rhoj = rhoa[j], volj = vola[j], mj = ma[j];
             const double vdotr = vx * rx + vy * ry + vz * rz;
             const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
-            /* continuity (000 eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h); x_ji = -x_ij,
+            /* continuity (Trujillo-Vela et al. 2020, eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h); x_ji = -x_ij,
              * v_ji.x_ji = v_ij.x_ij, and the diffusion term changes sign */
             const double dev = ddelta * ((rhoi - rhoj) - (hx * rx + hy * ry + hz * rz)) * rsoft;
             drhoi += volj * fij * (rhoi * vdotr + dev);
             drho[j] += voli * fij * (rhoj * vdotr - dev);
-            /* pressure, symmetric (000 eq. 2), with Monaghan's Pi_ij > 0 when approaching
+            /* pressure, symmetric (Trujillo-Vela et al. 2020, eq. 2), with Monaghan's Pi_ij > 0 when approaching
              * (av = 0 without artificial viscosity): -m_i m_j (...) F_ij x_ij */
             const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
             const double gp = -mi * mj * (pri + pra[j] - pav) * fij;
             /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij */
             const double gv = visci * volj * fij * rsoft;
             double Fx = gp * rx + gv * vx, Fy = gp * ry + gv * vy, Fz = dim == 3 ? gp * rz + gv * vz : 0.0;
-            if (sps) { /* 003 eq. 10, third term: m_i m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
+            if (sps) { /* Canelas et al. 2015, eq. 10, third term: m_i m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
                 const double irj2 = 1.0 / (rhoj * rhoj), mf = mi * mj * fij;
                 const double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2,
                              txz = ti[2] + tau[2][j] * irj2;
@@ -302,7 +302,7 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     return npair;
 }
 
-/* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, 003 eq. 11). */
+/* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, Canelas et al. 2015, eq. 11). */
 static inline void fluid_sps_particle(sph_fluid *f, const kernel_kind kind, int64_t i)
 {
     const sph_particles *p = &f->p;
@@ -506,7 +506,7 @@ static void fluid_shift(sph_fluid *f)
         p->vhx[i] = d.x, p->vhy[i] = d.y, p->vhz[i] = d.z;
     }
     if (f->prm.shifting_density) {
-        /* shifting_density: the shift is a displacement the continuity equation (000 eq. 1)
+        /* shifting_density: the shift is a displacement the continuity equation (Trujillo-Vela et al. 2020, eq. 1)
          * never saw, so the density takes the change that operator gives a particle moved by dr,
          * drho_i = rho_i sum_j V_j (dr_i - dr_j).grad_i W_ij (the arbitrary-Lagrangian-Eulerian
          * reading of the shift; Lind et al. 2012 correct the fields after the shift as well).
@@ -612,7 +612,7 @@ static void fluid_rates_particles(sph_fluid *f)
     if (f->has_soil) {
         int64_t soil_water = 0;
         f->work_neighbours_soil += sph_soil_momentum(&f->soil, p, &f->cells, &f->k, &soil_water);
-        /* 000 eq. 8, when k_h > 0 */
+        /* Trujillo-Vela et al. 2020, eq. 8, when k_h > 0 */
         f->work_neighbours_fluid_soil += soil_water + sph_soil_water_seepage(&f->soil, p, &f->cells, &f->k);
     }
 }

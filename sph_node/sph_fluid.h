@@ -1,29 +1,29 @@
-/* Weakly compressible SPH water (paper 000 section 2.1, paper 003 section 3), the solver core the
+/* Weakly compressible SPH water (Trujillo-Vela et al. 2020 section 2.1, Canelas et al. 2015 section 3), the solver core the
  * SPH node drives. Equations (x_ij = x_i - x_j, v_ij = v_i - v_j, r = |x_ij|, F_ij = W'(r)/r so
  * that grad_i W_ij = F_ij x_ij, eta^2 = 0.01 h^2, V_j = m_j / rho_j):
  *
- *   continuity (000 eq. 1, first term; 003 eq. 9 in the rho_i V_j form):
+ *   continuity (Trujillo-Vela et al. 2020, eq. 1, first term; Canelas et al. 2015, eq. 9 in the rho_i V_j form):
  *     drho_i/dt = rho_i sum_j V_j v_ij . grad_i W_ij
- *   delta-SPH density diffusion (Molteni & Colagrossi 2009; 000 eq. 1, second term):
+ *   delta-SPH density diffusion (Molteni & Colagrossi 2009; Trujillo-Vela et al. 2020, eq. 1, second term):
  *     + 2 delta h c0 sum_j V_j [(rho_i - rho_j) - rho0 b.x_ij / c0^2] F_ij r^2 / (r^2 + eta^2)
- *     000 prints (rho_j - rho_i) x_ij with eta^2 = 0.1 h^2; Molteni & Colagrossi write
+ *     Trujillo-Vela et al. 2020 print (rho_j - rho_i) x_ij with eta^2 = 0.1 h^2; Molteni & Colagrossi write
  *     (rho_j - rho_i) x_ji. With x_ij the sign must be (rho_i - rho_j) for the term to be
  *     Brookshaw's Laplacian delta h c0 lap(rho), which diffuses a bump (test_sph_fluid.c checks
- *     the rate of a sine mode against -delta h c0 k^2); eta^2 = 0.01 h^2 as 000's text says.
+ *     the rate of a sine mode against -delta h c0 k^2); eta^2 = 0.01 h^2 as their text says.
  *     The hydrostatic part rho0 b.x_ij/c0^2 (b = body force along the non-periodic axes) is not
  *     diffused (Fourtakas et al. 2019, DualSPHysics "DDT 2"): the plain Molteni term drives a
- *     column at rest away from hydrostatics (003 section 3.3 says so; measured here: wall force
+ *     column at rest away from hydrostatics (Canelas et al. 2015, section 3.3 says so; measured here: wall force
  *     -4.6 % on a 20-particle column), the corrected one leaves it hydrostatic.
- *   momentum (000 eq. 2, 003 eq. 10):
+ *   momentum (Trujillo-Vela et al. 2020, eq. 2, Canelas et al. 2015, eq. 10):
  *     dv_i/dt = g - sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2 + Pi_ij) grad_i W_ij         (symmetric)
  *             + sum_j m_j (mu_i + mu_j)/(rho_i rho_j) F_ij r^2/(r^2 + eta^2) v_ij     (Morris 1997)
  *             + (coupling forces of DEM bodies, sph_coupling.h) / m_i
- *     000 eq. 2 prints the laminar term without x_ij . grad W / r^2; the complete Morris (1997)
+ *     Trujillo-Vela et al. 2020, eq. 2 prints the laminar term without x_ij . grad W / r^2; the complete Morris (1997)
  *     form is used (equal to Lo & Shao's 4 (mu_i + mu_j)/(rho_i + rho_j)^2 at equal densities).
  *     Pi_ij = -alpha c0 mu_ij / rho_ij, mu_ij = h v_ij.x_ij/(r^2 + eta^2) when v_ij.x_ij < 0
  *     (Monaghan 1992), rho_ij the mean density; off when alpha = 0.
- *   EOS: linear p = c0^2 (rho - rho0) (000 eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
- *     (003 eq. 19). c0 is the constant numerical speed of sound.
+ *   EOS: linear p = c0^2 (rho - rho0) (Trujillo-Vela et al. 2020, eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
+ *     (Canelas et al. 2015, eq. 19). c0 is the constant numerical speed of sound.
  *
  *   Background pressure p_b (prm.background_pressure, default 0): without the transport velocity
  *     the momentum equation uses p_i + p_b (p.p and the snapshots keep the EOS pressure); with it,
@@ -38,15 +38,15 @@
  *       evaluation); density by summation rho_i = m_i sum_j W_ij (j includes i; continuity and
  *       delta-SPH unused, drho = 0). Adami et al. write the pair terms with (V_i^2 + V_j^2): equal
  *       to these for equal masses. Off: no arrays, the pair loop's branch is never taken.
- *   Shepard filter (003 eq. 5, optional, every N steps): rho_i = sum_j m_j W_ij / sum_j V_j W_ij
+ *   Shepard filter (Canelas et al. 2015, eq. 5, optional, every N steps): rho_i = sum_j m_j W_ij / sum_j V_j W_ij
  *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
- *     hydrostatic bias that delta-SPH has (003 section 3.3; test_sph_hydrostatic.c).
+ *     hydrostatic bias that delta-SPH has (Canelas et al. 2015, section 3.3; test_sph_hydrostatic.c).
  *
  * Time integration: kick-drift-kick leapfrog, second order, one neighbour pass per step:
  *   v_h = v + dt/2 a;  rho_h = rho + dt/2 D;  x += dt v_h;
  *   predict v = v_h + dt/2 a, rho = rho_h + dt/2 D;  sort;  evaluate a, D at (x, v, rho);
  *   v = v_h + dt/2 a;  rho = rho_h + dt/2 D.
- * Step proposal (003 eq. 20 split in its three parts, plus the viscous limit):
+ * Step proposal (Canelas et al. 2015, eq. 20 split in its three parts, plus the viscous limit):
  *   dt = min(C_cfl h/(c0 + |v|max), C_f sqrt(h/|a|max), C_v h^2/(nu + nu_t,max)),
  *   nu_t,max the largest SPS eddy viscosity (0 without SPS).
  * The water's particle-particle sums are symmetric: each pair (i, j) is evaluated once, from the
@@ -85,16 +85,16 @@ typedef struct {
     int periodic[3];        /* 1: axis periodic with period [lo, hi) */
     double lo[3], hi[3];
     sph_wall_viscous wall_viscous;
-    sph_wall_pressure wall_pressure; /* default penalty only (paper 000 eq. 15); sph_coupling.h */
+    sph_wall_pressure wall_pressure; /* default penalty only (Trujillo-Vela et al. 2020 eq. 15); sph_coupling.h */
     int penalty_acoustic;   /* 1: K_n of eq. 15 with the acoustic step cfl h / c0, not the step's dt
                                (sph_coupling.kn_dt); 0 (default): the step's dt as printed */
     sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
-    int shepard_every;      /* Shepard density filter every N steps (003 eq. 5), 0 = off */
+    int shepard_every;      /* Shepard density filter every N steps (Canelas et al. 2015, eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
     int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */
     double background_pressure; /* p_b, Pa (see "Background pressure" above), 0 = off */
     int transport_velocity; /* 1: Adami et al. 2013 transport velocity (see above), 0 = off */
-    int sps;                /* SPS (Smagorinsky) turbulence (003 eq. 10-11), 0 = off */
+    int sps;                /* SPS (Smagorinsky) turbulence (Canelas et al. 2015, eq. 10-11), 0 = off */
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
     sph_soil_material soil_mat;
@@ -114,7 +114,7 @@ typedef struct {
     int64_t crossings;      /* of the last step */
     int begun;              /* sph_fluid_step_begin done, sph_fluid_step_end due */
     /* SPS only (NULL when prm.sps is off): per particle, in the sorted order of the last
-     * evaluation, the eddy viscosity nu_t and the SPS stress tau (003 eq. 11, with density:
+     * evaluation, the eddy viscosity nu_t and the SPS stress tau (Canelas et al. 2015, eq. 11, with density:
      * xx, xy, xz, yy, yz, zz) */
     double *sps_nut;
     double nut_max;         /* largest nu_t of the last evaluation (viscous step limit), 0 without SPS */
@@ -151,14 +151,14 @@ void sph_fluid_free(sph_fluid *f);
 /* Pressure from density by the EOS of the parameters. */
 double sph_fluid_pressure(const sph_params *prm, double rho);
 
-/* SPS turbulence (003 eq. 10-11, Dalrymple & Rogers 2006), when prm.sps is on. Before the
+/* SPS turbulence (Canelas et al. 2015, eq. 10-11, Dalrymple & Rogers 2006), when prm.sps is on. Before the
  * particle-particle sums, one gather pass takes the velocity gradient
  *   (grad v)_ab,i = sum_j V_j (v_j - v_i)_a (grad_i W_ij)_b,
  * the strain rate S = (grad v + grad v^T)/2, |S| = sqrt(2 S:S), the eddy viscosity
- * nu_t = (C_s Delta)^2 |S| with Delta = dx, and the SPS stress (003 eq. 11; the delta term of the
+ * nu_t = (C_s Delta)^2 |S| with Delta = dx, and the SPS stress (Canelas et al. 2015, eq. 11; the delta term of the
  * printed equation is the trace S_kk)
  *   tau_i / rho_i = 2 nu_t (S - tr(S)/3 I) - 2/3 C_I Delta^2 |S|^2 I,   C_I = 0.0066.
- * The momentum equation gains the symmetric term of 003 eq. 10:
+ * The momentum equation gains the symmetric term of Canelas et al. 2015, eq. 10:
  *   dv_i/dt += sum_j m_j (tau_i / rho_i^2 + tau_j / rho_j^2) . grad_i W_ij.
  * Off: no pass, no arrays, and the pair loop is compiled without the term. The largest nu_t joins
  * the viscous limit of the step proposal. */

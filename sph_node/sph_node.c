@@ -41,8 +41,8 @@
 
 #define ROLE LAHAR_ROLE_SPH
 
-/* Density of pressure p by the inverse of the case's EOS: linear rho = rho0 + p / c0^2 (paper 000
- * eq. 3), Tait rho = rho0 (1 + gamma p / (rho0 c0^2))^(1/gamma) (paper 003 eq. 19). */
+/* Density of pressure p by the inverse of the case's EOS: linear rho = rho0 + p / c0^2 (Trujillo-Vela et al. 2020
+ * eq. 3), Tait rho = rho0 (1 + gamma p / (rho0 c0^2))^(1/gamma) (Canelas et al. 2015 eq. 19). */
 static double sph_node_eos_density(const lahar_case *c, double p)
 {
     const double rho0 = c->sph_density, c2 = c->sph.c0 * c->sph.c0;
@@ -269,7 +269,7 @@ static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t);
 
 /* A particle snapshot of the fields the case writes (output.fields), nothing else: unselected
  * fields are neither gathered nor computed. The pressure written is the EOS of the density
- * written (000 eq. 3 / 003 eq. 19), computed here only when the case writes pressure: the
+ * written (Trujillo-Vela et al. 2020, eq. 3 / Canelas et al. 2015, eq. 19), computed here only when the case writes pressure: the
  * solver's own pressure array belongs to its last evaluation (the predicted density at the end
  * of the step, before the second kick and any Shepard filter), so a snapshot's density and
  * pressure agree exactly, whatever the solver stores. */

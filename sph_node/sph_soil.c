@@ -132,7 +132,7 @@ static void soil_artificial_stress(const double sig[SPH_NSTRESS], double rho, do
             out[SYM[i][j]] = v[i][0] * r[0] * v[j][0] + v[i][1] * r[1] * v[j][1] + v[i][2] * r[2] * v[j][2];
 }
 
-/* The stress rate of soil particle i (000 eq. 6-7) from its velocity gradient L into s->dsig. */
+/* The stress rate of soil particle i (Trujillo-Vela et al. 2020, eq. 6-7) from its velocity gradient L into s->dsig. */
 static void soil_stress_rate(sph_soil *s, const sph_particles *p, int64_t i, const double L[3][3])
 {
     double sig[3][3], eps[3][3], spin[3][3];
@@ -153,7 +153,7 @@ static void soil_stress_rate(sph_soil *s, const sph_particles *p, int64_t i, con
             sde += dev[a][b] * eps[a][b];
         }
     double rj2 = sqrt(j2);
-    /* plastic multiplier (000 eq. 7) on the yield surface, when loading */
+    /* plastic multiplier (Trujillo-Vela et al. 2020, eq. 7) on the yield surface, when loading */
     double lam = 0.0;
     double lim = -ap * i1 + s->kc;
     if (rj2 > 0.0 && rj2 >= lim * (1.0 - 1e-9)) {
@@ -168,7 +168,7 @@ static void soil_stress_rate(sph_soil *s, const sph_particles *p, int64_t i, con
                 jau += sig[a][g] * spin[b][g] + sig[g][b] * spin[a][g];
             double el = 2.0 * G * (eps[a][b] - (a == b ? tre / 3.0 : 0.0)) + (a == b ? K * tre : 0.0);
             double pl = lam > 0.0 ? lam * ((a == b ? 3.0 * K * aps : 0.0) + G / rj2 * dev[a][b]) : 0.0;
-            s->dsig[SYM[a][b]][i] = jau + el - pl; /* 000 eq. 6 */
+            s->dsig[SYM[a][b]][i] = jau + el - pl; /* Trujillo-Vela et al. 2020, eq. 6 */
         }
 }
 
@@ -331,7 +331,7 @@ static int64_t soil_momentum_particle(const sph_soil *s, sph_particles *p, const
     } else {
         SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
             if (p->phase[j] != SPH_SOIL_PHASE) {
-                if (seep > 0.0) { /* water neighbour: seepage and pore pressure (000 eq. 9, 10) */
+                if (seep > 0.0) { /* water neighbour: seepage and pore pressure (Trujillo-Vela et al. 2020, eq. 9, 10) */
                     nw++;
                     double r = sqrt(r2), q = r * inv_h;
                     double fij = r > 0.0 ? dnorm * kernel_dshape(kind, q) / r : 0.0;

@@ -1,4 +1,4 @@
-/* SPH soil (paper 000 section 2.2; Bui, Fukagawa, Sako & Ohno 2008, "Bui 2008" below): particles of
+/* SPH soil (Trujillo-Vela et al. 2020 section 2.2; Bui, Fukagawa, Sako & Ohno 2008, "Bui 2008" below): particles of
  * phase 1 carry an effective stress sigma (tension positive, the SoA arrays p->sig of
  * sph_particles.h, allocated only when a scene has soil) and follow an elastic-perfectly plastic
  * Drucker-Prager law matched to Mohr-Coulomb in plane strain. Equations (x_ij = x_i - x_j,
@@ -6,15 +6,15 @@
  *
  *   velocity gradient  L_ab = sum_j V_j (v_j - v_i)_a (grad_i W_ij)_b;  strain rate eps = (L + L^T)/2,
  *                      spin w = (L - L^T)/2 (2D: the out-of-plane rows stay 0, plane strain)
- *   stress rate (000 eq. 6, Bui 2008 eq. 23-24; Jaumann):
+ *   stress rate (Trujillo-Vela et al. 2020, eq. 6, Bui 2008 eq. 23-24; Jaumann):
  *     dsigma_ab/dt = sigma_ac w_bc + sigma_cb w_ac + 2 G e_ab + K eps_cc delta_ab
  *                    - lambda' (3 K alpha_psi delta_ab + G / sqrt(J2) s_ab)
  *     e = eps - tr(eps)/3 I, s = sigma - tr(sigma)/3 I, J2 = s:s/2, G = E/(2(1+nu)),
  *     K = E/(3(1-2nu)).
- *   plastic multiplier (000 eq. 7), only on the yield surface f = alpha_phi I1 + sqrt(J2) - k_c = 0
+ *   plastic multiplier (Trujillo-Vela et al. 2020, eq. 7), only on the yield surface f = alpha_phi I1 + sqrt(J2) - k_c = 0
  *   and when loading (lambda' > 0):
  *     lambda' = (3 alpha_phi K eps_cc + G / sqrt(J2) s:eps) / (9 alpha_phi alpha_psi K + G)
- *     000 prints 9 K sin(psi) and 27 alpha_phi K sin(psi), i.e. alpha_psi = 3 sin(psi); the
+ *     Trujillo-Vela et al. 2020 print 9 K sin(psi) and 27 alpha_phi K sin(psi), i.e. alpha_psi = 3 sin(psi); the
  *     plastic potential g = alpha_psi I1 + sqrt(J2) with the same plane-strain match as the
  *     yield function is used (Bui 2008 eq. 21): both forms vanish at psi = 0.
  *   Drucker-Prager matched to Mohr-Coulomb in plane strain (shared/papers/README.md):
@@ -23,9 +23,9 @@
  *   after every stress update (Bui 2008 section 3.3):
  *     tension cracking: if -alpha_phi I1 + k_c < 0, sigma_aa -= (I1 - k_c / alpha_phi) / 3
  *     return to the yield surface: if -alpha_phi I1 + k_c < sqrt(J2), s *= (-alpha_phi I1 + k_c) / sqrt(J2)
- *   continuity (000 section 2.2: eq. 1 without the delta term):
+ *   continuity (Trujillo-Vela et al. 2020, section 2.2: eq. 1 without the delta term):
  *     drho_i/dt = rho_i sum_j V_j v_ij . grad_i W_ij
- *   momentum (000 eq. 5 with tension-positive stress; Bui 2008 eq. 31):
+ *   momentum (Trujillo-Vela et al. 2020, eq. 5 with tension-positive stress; Bui 2008 eq. 31):
  *     dv_i/dt = g + sum_j m_j (sigma_i/rho_i^2 + sigma_j/rho_j^2 + (R_i + R_j) f_ij^n - Pi_ij I) . grad_i W_ij
  *     Pi_ij = (-alpha c_s mu_ij + beta mu_ij^2) / rho_ij, mu_ij = h v_ij.x_ij / (r^2 + 0.01 h^2) when
  *     v_ij.x_ij < 0 (Monaghan 1992), c_s = sqrt((K + 4G/3) / rho_s) the P-wave speed.
@@ -37,7 +37,7 @@
  *     conservative equations above would otherwise reach only after their elastic waves die out.
  *   The mean pressure -tr(sigma)/3 goes to p->p of soil particles (for output).
  * Water particles are not neighbours of soil particles in these sums (and the water pass skips
- * soil neighbours). Water and soil interact (paper 000 section 2.3) when the soil has k_h > 0:
+ * soil neighbours). Water and soil interact (Trujillo-Vela et al. 2020 section 2.3) when the soil has k_h > 0:
  *   seepage force (eq. 10): f_ij = (mu / k) (u_f - u_s) = (rho_w g / k_h) (u_f - u_s), since
  *     k = k_h mu / (rho_w g) (rho_w the water's rest density, g = |gravity|, 9.81 without gravity)
  *   on soil particle s (eq. 9):  a_s += sum_f m_f / (rho_f rho_s) [f_sf W_sf - p_f grad_s W_sf]
@@ -65,10 +65,10 @@ typedef struct {
     double young, poisson; /* Pa, - */
     double phi, cohesion, psi; /* friction angle (rad), cohesion (Pa), dilatancy (rad) */
     double kh;             /* Darcy hydraulic conductivity, m/s (0: none) */
-    double mu_phi;         /* soil-DEM friction coefficient (paper 000 eq. 24) */
+    double mu_phi;         /* soil-DEM friction coefficient (Trujillo-Vela et al. 2020 eq. 24) */
     double damping;        /* c_d, 1/s: dv/dt += -c_d v (0 = off) */
     double av_alpha, av_beta; /* Monaghan artificial viscosity (Bui 2008 section 4.1; the case's
-                               * defaults 0.1, 0; paper 000 section 5.3 uses 1, 1) */
+                               * defaults 0.1, 0; Trujillo-Vela et al. 2020 section 5.3 uses 1, 1) */
     double g_ref;          /* g of k = k_h mu / (rho_w g), m/s^2 */
     double gravity[3];     /* m/s^2: the soil's body force (sph.body_force drives the water only) */
     double rho_water;      /* rho_w of the same, kg/m^3 */
@@ -127,7 +127,7 @@ void sph_soil_wall_gradient(sph_soil *s, const sph_particles *p, int64_t i, cons
  * (xx, xy, xz, yy, yz, zz), in place. */
 void sph_soil_return(const sph_soil *s, double sig[SPH_NSTRESS]);
 
-/* Seepage (sph_soil.h, paper 000 eq. 8-10) on the water particles: their reaction to every soil
+/* Seepage (sph_soil.h, Trujillo-Vela et al. 2020 eq. 8-10) on the water particles: their reaction to every soil
  * neighbour, added to p->ax.. after the water pass. No-op when s->seep is 0. */
 int64_t sph_soil_water_seepage(const sph_soil *s, sph_particles *p, const sph_cells *c, const kernel *k);
 /* (returns the soil neighbours of the water particles summed over: work counter, 0 without seepage) */

@@ -28,7 +28,7 @@
 #               holds only the fields asked for, no value is computed for output without
 #               pressure (output_derived 0) and one pressure per particle and snapshot with it;
 #               the written pressure is the linear EOS c0^2 (rho - rho0) of the written density
-#               (paper 000 eq. 3) to 1e-9; positions and velocities are bitwise equal.
+#               (Trujillo-Vela et al. 2020 eq. 3) to 1e-9; positions and velocities are bitwise equal.
 # dem_contacts  a DEM-only scene: a sphere set down touching a fixed plane settles into it and
 #               stays in contact: one body-body contact in every substep, none at the engine's
 #               set-up (touching is not a contact), so body_body = substeps; no particle work.
@@ -296,7 +296,7 @@ with h5py.File(a + "/particles.h5", "r") as fa, h5py.File(b + "/particles.h5", "
         for d in ga:
             assert np.array_equal(np.asarray(ga[d]), np.asarray(gb[d])), (k, d)
         rho, p = np.asarray(gb["density"]), np.asarray(gb["pressure"])
-        eos = 15.0 ** 2 * (rho - 1000.0)  # paper 000 eq. 3, c0 = 15 m/s, rho0 = 1000 kg/m^3
+        eos = 15.0 ** 2 * (rho - 1000.0)  # Trujillo-Vela et al. 2020 eq. 3, c0 = 15 m/s, rho0 = 1000 kg/m^3
         assert np.abs(p - eos).max() <= 1e-9 * np.abs(eos).max(), (k, np.abs(p - eos).max())
         n += len(rho)
 assert wa["output_derived"] == 0, wa["output_derived"]

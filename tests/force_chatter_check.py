@@ -10,7 +10,7 @@ constant rho g h^2 / 2 = 196.2 N/m, so its step-to-step change is noise. Asserts
 [0.2, 0.4] s:
   - penalty_stiffness: acoustic: std of the step-to-step force change <= 0.5 % of rho g h^2 / 2,
     and the mean force within 5 % of it;
-  - penalty_stiffness: step (paper 000 eq. 15 as printed, K_n = 0.1 m / dt^2): std of the change
+  - penalty_stiffness: step (Trujillo-Vela et al. 2020 eq. 15 as printed, K_n = 0.1 m / dt^2): std of the change
     >= 2 %: the chatter the acoustic stiffness removes (so this test fails if it ever stops
     showing).
 Measured (cases/README.md "Wall force chatter"): step 9.05 %, acoustic 0.20 %."""

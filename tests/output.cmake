@@ -44,7 +44,7 @@ add_test(NAME output_check_fluid COMMAND test_check_fluid ${LAHAR_OUTPUT_TEST_DI
 set_tests_properties(output_check_fluid PROPERTIES LABELS "fast;output" TIMEOUT 180
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 
-# End to end: the Poiseuille case (paper 000 section 5.1, 20 particles across H) run in-process
+# End to end: the Poiseuille case (Trujillo-Vela et al. 2020 section 5.1, 20 particles across H) run in-process
 # and evaluated by `lahar check` against its bounds (steady L2 <= 1 %, plate force <= 1 %).
 # Measured: 0.28 % and 0.12 %, 4 s in Release.
 add_test(NAME check_poiseuille_2d COMMAND lahar check ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml

@@ -31,7 +31,7 @@ add_test(NAME soil_geostatic_ghost_3d
 set_tests_properties(soil_geostatic_ghost_2d soil_geostatic_ghost_3d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 
-# Soil-DEM friction (paper 000 eq. 22-27): a soil block on a 30 deg plane with mu_phi = 0.3 slides
+# Soil-DEM friction (Trujillo-Vela et al. 2020 eq. 22-27): a soil block on a 30 deg plane with mu_phi = 0.3 slides
 # at g (sin - mu_phi cos) within 5 %; on a 15 deg plane with mu_phi = 0.5 it stays put (|a| within
 # 5 % of g sin theta), and moves less than 1 mm in 0.4 s.
 add_test(NAME soil_block_incline_2d
@@ -52,7 +52,7 @@ add_test(NAME soil_granular_collapse_2d
 set_tests_properties(soil_granular_collapse_2d PROPERTIES LABELS "validation;slow;soil" TIMEOUT 600
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 
-# Darcy (paper 000 eq. 8-10): water driven through a soil at i = 0.5 flows at k_h i within 5 %.
+# Darcy (Trujillo-Vela et al. 2020 eq. 8-10): water driven through a soil at i = 0.5 flows at k_h i within 5 %.
 add_test(NAME soil_darcy_column_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/darcy_column_2d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/darcy_column_2d)

@@ -4,7 +4,7 @@
  * perturbation implies):
  *  - the Poiseuille series itself against a Crank-Nicolson solution of u_t = nu u_yy + a and its
  *    wall stress against a finite difference of the series;
- *  - poiseuille: H = 0.1, a = 1e-4, rho = 1000, mu = 0.1 (paper 000 section 5.1), 20 particles
+ *  - poiseuille: H = 0.1, a = 1e-4, rho = 1000, mu = 0.1 (Trujillo-Vela et al. 2020 section 5.1), 20 particles
  *    across; velocity x 1.02 -> steady_l2_rel_error 0.02; plate force x 1.03 -> 0.03;
  *  - cylinder_array: c = 0.1 (K = 24.83), uniform velocity giving U_s exactly; U x 1.06 fails;
  *    the table's interpolation and low-c asymptote (7.981 at c = 0.01, shared/reference/01);

@@ -1,6 +1,6 @@
 /* Kernels (common/kernel.h) checked numerically on a fine lattice (spacing h/40 in 2D, h/16 in
  * 3D, origin shifted off the kernel centre so that no symmetry hides an error), tolerance 1e-3:
- *   sum W dV = 1                         (normalisation: catches the constants of paper 000 eq. 4;
+ *   sum W dV = 1                         (normalisation: catches the constants of Trujillo-Vela et al. 2020 eq. 4;
  *                                         the quintic 3D constant is 1/(120 pi), not 3/(359 pi))
  *   sum grad W dV = 0                    (each component)
  *   sum x (x) grad W dV = -I             (trace -D: the gradient of a linear field is exact)
@@ -77,7 +77,7 @@ int main(void)
     CHECK(kernel_find("quintic") && kernel_find("quintic")->kappa == 3.0, "quintic support");
     CHECK(kernel_def_of(KERNEL_WENDLAND2) == kernel_find("wendland2"), "table order");
     /* the often quoted 3D quintic constant 3/(359 pi) (shared/papers/README.md) is off by 0.28 %: this
-     * test resolves 1e-3, so it would fail with that constant; 1/(120 pi) (paper 000 eq. 4) is right */
+     * test resolves 1e-3, so it would fail with that constant; 1/(120 pi) (Trujillo-Vela et al. 2020 eq. 4) is right */
     CHECK(fabs((3.0 / 359.0) / (1.0 / 120.0) - 1.0) > 2e-3, "3/359 and 1/120 indistinguishable at 1e-3");
     if (failures)
         return 1;

@@ -2,7 +2,7 @@
  * 1997 eq. 22): fluid at rest between two DEM plates H = 0.1 m apart, nu = 1e-4 (rho = 1000,
  * mu = 0.1), periodic in x; at t = 0 the upper plate starts moving along x at V0 = 1.25e-3 m/s.
  * The upper plate is a PRESCRIBED body whose pose and velocity are passed to the coupling as body
- * states every step (paper 000 eq. 16: u_rel = u_i - v_body - w x r), the lower one is fixed.
+ * states every step (Trujillo-Vela et al. 2020 eq. 16: u_rel = u_i - v_body - w x r), the lower one is fixed.
  * Against the series at t = 5, 10, 20 s and 100 s (steady within 1e-4): max error <= 2 % of V0 at
  * every time (measured 0.52 % at most), steady L2 relative error <= 1 % (measured 0.56 %); the
  * shear force on each plate at steady state is mu V0 / H * l within 5 % (measured +2.7 % on the

@@ -1,4 +1,4 @@
-/* SPH-DEM coupling (sph_coupling.h, paper 000 eq. 12-21) on single particles, against the
+/* SPH-DEM coupling (sph_coupling.h, Trujillo-Vela et al. 2020 eq. 12-21) on single particles, against the
  * closed forms:
  *  1. a particle at rest inside the halo of a flat plate: F = K_n (eps - d) n with
  *     K_n = 0.1 m_min/dt^2 (eq. 15), exactly (1e-12); the plate gets -F at the surface point

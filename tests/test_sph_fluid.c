@@ -10,7 +10,7 @@
  *  3. delta-SPH diffuses: for rho = rho0 (1 + A sin(k x)) at rest on a lattice, drho/dt equals
  *     delta h c0 lap(rho) = -delta h c0 k^2 (rho - rho0) within 2 % (Brookshaw's Laplacian,
  *     Molteni & Colagrossi 2009), i.e. a crest decays;
- *  4. EOS: linear (000 eq. 3) and Tait (003 eq. 19) values, Tait slope c0^2 at rho0;
+ *  4. EOS: linear (Trujillo-Vela et al. 2020, eq. 3) and Tait (Canelas et al. 2015, eq. 19) values, Tait slope c0^2 at rho0;
  *  5. a falling block of 2400 particles (parallel loops active) gives the same bits on 1 and 2
  *     threads, and its centre of mass follows g t^2/2 while nothing touches it (1e-9). */
 #include <math.h>
@@ -294,7 +294,7 @@ static void check_delta_sph(void)
     }
     printf("delta-SPH on a sine mode: drho/dt off -delta h c0 k^2 (rho - rho0) by %.3f %% of its amplitude\n",
            100 * worst);
-    CHECK(crest_decays, "delta-SPH sharpens a density crest (sign of 000 eq. 1 as printed?)");
+    CHECK(crest_decays, "delta-SPH sharpens a density crest (sign of Trujillo-Vela et al. 2020, eq. 1 as printed?)");
     CHECK(worst < 0.02, "delta-SPH rate off the diffusion rate by %.2f %%", 100 * worst);
     sph_fluid_free(&f);
 }
@@ -360,7 +360,7 @@ static void run_fall(int threads, fall_state *out)
     sph_fluid_free(&f);
 }
 
-/* Shepard filter (003 eq. 5): rho_i = sum_j m_j W_ij / sum_j (m_j / rho_j) W_ij (self included).
+/* Shepard filter (Canelas et al. 2015, eq. 5): rho_i = sum_j m_j W_ij / sum_j (m_j / rho_j) W_ij (self included).
  * It keeps a uniform density exactly on any particle arrangement, equals this brute-force sum, and
  * smooths noise (the spread of rho - rho0 falls). */
 /* A 12 x 12 lattice of water (dx = 10 mm) in a 0.12 m cell periodic on both axes, every particle

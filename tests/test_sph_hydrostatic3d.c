@@ -8,7 +8,7 @@
  *   - each side wall carries rho0 g H^2 W / 2 within 1 % (ghost: measured +0.44 % on all four);
  *   - no crossing, |v|max < 5 % of sqrt(g H) (ghost: 0.02 %).
  * usage: test_sph_hydrostatic3d [NZ [T [ghost]]]. The ctest runs "ghost" (sph.wall_pressure: ghost,
- * quintic at h = dx: the settings of cases/hydrostatic_3d.yaml). The penalty wall of paper 000
+ * quintic at h = dx: the settings of cases/hydrostatic_3d.yaml). The penalty wall of Trujillo-Vela et al. 2020
  * alone (no third argument, cubic at h = 1.3 dx) does not settle in 3 s in this 8 x 8 tank: its
  * wall force moved between +0.27 % and +1.63 % and |v|max between 0.038 and 0.059 m/s when only
  * the summation order of the neighbours changed (cells of half the support), so it is no test.

@@ -3,9 +3,9 @@
  * a spacing above its highest particle centre, = the box's hi along gravity), volume dx^D (its lattice
  * cell), mass rho dx^D.
  * References computed here independently of the node's code, tolerance 1e-12 relative on rho:
- *  - linear EOS (paper 000 eq. 3), 2D box 0.4 x 0.2 m, dx 10 mm, gravity -y:
+ *  - linear EOS (Trujillo-Vela et al. 2020 eq. 3), 2D box 0.4 x 0.2 m, dx 10 mm, gravity -y:
  *    rho = rho0 + rho0 g (h - y) / c0^2;
- *  - Tait EOS (paper 003 eq. 19, gamma 7), 3D, gravity -z, two blocks one above the other, each
+ *  - Tait EOS (Canelas et al. 2015 eq. 19, gamma 7), 3D, gravity -z, two blocks one above the other, each
  *    with its own free surface: rho = rho0 (1 + gamma g (h - z) / c0^2)^(1/gamma);
  *  - the pressure of those densities by the solver's own EOS (sph_fluid_pressure) is
  *    rho0 g (h - y) to 1e-9 of rho0 g H (round trip);

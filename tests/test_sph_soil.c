@@ -11,10 +11,10 @@
  *     dsigma = W sigma - sigma W, dsigma_xy = -s0 w, no elastic part, within 1 %;
  *  4. a uniform stress exerts no force on an interior particle: |a - g| < 1e-9 s0/(rho dx);
  *  5. a water-only fluid allocates no stress arrays;
- *  6. seepage (000 eq. 8-10): water moving at u through a resting soil on the same periodic
+ *  6. seepage (Trujillo-Vela et al. 2020, eq. 8-10): water moving at u through a resting soil on the same periodic
  *     lattice: the water's acceleration is -(g/k_h) u (sum_s V_s W = 1) within 1 %, and the
  *     water-soil forces cancel pair by pair: |sum_i m_i (a_i - b_i)| < 1e-12 of sum_water m |a - b|;
- *  7. soil-DEM friction (000 eq. 22-27) of soil particles sliding on a fixed plate: after one
+ *  7. soil-DEM friction (Trujillo-Vela et al. 2020, eq. 22-27) of soil particles sliding on a fixed plate: after one
  *     evaluation F_t = -K_n dt u_tau (to 1e-12), the body takes -F; after enough evaluations the
  *     spring is capped, |F_t| = mu_phi |F_n|; the spring follows its particle id through a sort that
  *     swaps the particles; leaving the halo releases it (a new contact starts from dt u again).

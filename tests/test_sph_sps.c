@@ -1,4 +1,4 @@
-/* SPS (Smagorinsky) turbulence of the SPH core (sph_fluid.h; paper 003 eq. 10-11, Dalrymple &
+/* SPS (Smagorinsky) turbulence of the SPH core (sph_fluid.h; Canelas et al. 2015 eq. 10-11, Dalrymple &
  * Rogers 2006), checked against analytic values:
  *  1. uniform shear u = gamma y on a lattice, periodic in x (and z in 3D): in the interior (two
  *     kernel supports away from the top and bottom rows) nu_t = (C_s dx)^2 gamma within 1 %
@@ -7,7 +7,7 @@
  *     force of this constant stress (its divergence) vanishes to round-off: |a - g| < 1e-9 of the
  *     scale |tau| / (rho dx) of one pair's term.
  *  2. a shear wave u = A sin(k y) (periodic in x and y): the SPS acceleration equals the analytic
- *     divergence of tau (003 eq. 11 with nu_t = (C_s dx)^2 |u'|):
+ *     divergence of tau (Canelas et al. 2015, eq. 11 with nu_t = (C_s dx)^2 |u'|):
  *       a_x = d/dy (nu_t u') = -2 (C_s dx)^2 A^2 k^3 sin(ky) |cos(ky)|,
  *       a_y = d/dy (-2/3 C_I dx^2 u'^2) = 4/3 C_I dx^2 A^2 k^3 sin(ky) cos(ky),
  *     RMS error within 3 % of the amplitude of a_x (40 particles per wavelength);

@@ -19,7 +19,7 @@ function(lahar_validation_test name case)
     ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 endfunction()
 
-# Poiseuille (000 section 5.1): 20 and 40 particles across H, steady L2 <= 1 % and <= 0.5 %,
+# Poiseuille (Trujillo-Vela et al. 2020, section 5.1): 20 and 40 particles across H, steady L2 <= 1 % and <= 0.5 %,
 # plate force <= 1 %, both errors fall with resolution.
 add_test(NAME validation_poiseuille_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_poiseuille.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml
@@ -39,7 +39,7 @@ lahar_validation_test(dam_break_3d dam_break_3d dx=0.02 paraview=1)
 # draft) and upright.
 lahar_validation_test(floating_box_2d floating_box_2d dx=0.01 "draft_spread_rel<=0.05" "tilt_deg<=2")
 
-# Cylinder array (000 section 5.2; K = rho a L^2 / (mu U_s), U_s the superficial velocity, within
+# Cylinder array (Trujillo-Vela et al. 2020, section 5.2; K = rho a L^2 / (mu U_s), U_s the superficial velocity, within
 # 5 % of Sangani & Acrivos) at 50 x 50 (dx = 4 mm) for c = 0.05, 0.1 and 0.4, 200 s with the case's
 # particle shifting (c = 0.05 measured 2.3 %; 14 % without shifting, which this test would fail);
 # the full sweep (c = 0.05 ... 0.4 at 100 x 100, all within 2.5 %) on demand: cases/README.md,

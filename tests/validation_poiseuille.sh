@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 3, Poiseuille flow (paper 000 section 5.1): `lahar check` on cases/poiseuille_2d.yaml with
+# Issue 3, Poiseuille flow (Trujillo-Vela et al. 2020 section 5.1): `lahar check` on cases/poiseuille_2d.yaml with
 # 20 particles across H (the case, dx = 5 mm) and with 40 (dx = 2.5 mm); passes when both runs meet
 # the case's bounds (steady L2 <= 1 %, plate force <= 1 %), the 40-across run meets the issue's
 # steady L2 <= 0.5 %, and both errors fall from 20 to 40 across.

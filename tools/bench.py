@@ -68,7 +68,7 @@ SETTINGS = [
 ]
 QUICK_SETTINGS = ["kernel=wendland2", "cfl=0.4", "soil_av=paper"]
 # The soil's own trade (Drucker-Prager SPH, sph_node/sph_soil.h): lahar's default artificial
-# viscosity alpha = 0.1, beta = 0 against the paper's alpha = beta = 1 (000 section 5.3);
+# viscosity alpha = 0.1, beta = 0 against the paper's alpha = beta = 1 (Trujillo-Vela et al. 2020, section 5.3);
 # `{soil}` is replaced by the name of the case's soil material.
 SOIL_SETTINGS = [
     ("soil_av", "paper", {"materials.{soil}.av_alpha": 1.0, "materials.{soil}.av_beta": 1.0}),
@@ -84,7 +84,7 @@ BENCH = {
         file="poiseuille_2d.yaml", overrides={"time.end": 30.0},
         dx=[0.1 / 10, 0.1 / 16, 0.1 / 20, 0.1 / 25, 0.1 / 40], vary_at=[1, 2],
         error=["steady_l2_rel_error", "plate_force_rel_error"], target=0.01,
-        error_note="max(steady L2 of u against the transient series at t = 30 s, plate force) (000 eq. 28-32)"),
+        error_note="max(steady L2 of u against the transient series at t = 30 s, plate force) (Trujillo-Vela et al. 2020, eq. 28-32)"),
     "cylinder_array_2d": dict(
         file="cylinder_array_2d.yaml", overrides={},
         dx=[0.2 / 20, 0.2 / 25, 0.2 / 32, 0.2 / 40], vary_at=[0, 1],
@@ -124,12 +124,12 @@ BENCH = {
         file="soil_block_incline_2d.yaml", overrides={}, soil="block",
         dx=[0.01, 0.005, 0.0025, 0.00125], vary_at=[0, 1], families=["kernel", "cfl", "soil_av"],
         error=["accel_rel_error"], target=0.05,
-        error_note="sliding block's acceleration against g (sin theta - mu_phi cos theta) (000 eq. 22-27)"),
+        error_note="sliding block's acceleration against g (sin theta - mu_phi cos theta) (Trujillo-Vela et al. 2020, eq. 22-27)"),
     "darcy_column_2d": dict(
         file="darcy_column_2d.yaml", overrides={}, soil="skeleton",
         dx=[0.1 / 8, 0.1 / 10, 0.1 / 20, 0.1 / 40], vary_at=[1, 2], families=["kernel", "cfl", "delta", "c0", "soil_av"],
         error=["darcy_velocity_rel_error"], target=0.05,
-        error_note="water's velocity through the soil against Darcy k_h i (000 eq. 8-10)"),
+        error_note="water's velocity through the soil against Darcy k_h i (Trujillo-Vela et al. 2020, eq. 8-10)"),
 }
 QUICK = {
     "poiseuille_2d": dict(dx=[0.1 / 10, 0.1 / 16], vary_at=[0], overrides={"time.end": 10.0}),
@@ -754,7 +754,7 @@ def bench_subcycle(args, outdir):
               f"{fmt(finals[0][1] if finals and finals[0] else float('nan'), 4)} s differ by at most "
               f"**{fmt(diff_mm, 3)} mm** ({fmt(diff_mm / dx / 1e3, 3)} dx; the forced run's boulders moved up to "
               f"{fmt(moved_mm, 4)} mm): the error of subcycling, with that of the coupling's step-dependent "
-              f"penalty stiffness K_n = 0.1 m_min / dt^2 (paper 000 eq. 15).")
+              f"penalty stiffness K_n = 0.1 m_min / dt^2 (Trujillo-Vela et al. 2020 eq. 15).")
     with open(os.path.join(outdir, "subcycle.md"), "w") as f:
         f.write("\n".join(md) + "\n")
     log(f"  gain: {fmt(gain, 3)}")

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Impact force of granular_impact_3d runs at several slopes (paper 000 section 5.3, Fig. 14-15).
+"""Impact force of granular_impact_3d runs at several slopes (Trujillo-Vela et al. 2020 section 5.3, Fig. 14-15).
 
 usage: plot_impact.py OUT.png RUN_DIR [RUN_DIR ...] [--peaks "LABEL=SLOPE:N,SLOPE:N,..."]...
 
@@ -8,7 +8,7 @@ the script reads only its check.json (reference granular_impact), so the force h
 the check's own (the wall's force along the chute, 10 ms moving average; common/check_soil.c),
 and prints a Markdown table: slope, dx, first impact, peak force and its time, the momentum flux
 estimate rho u^2 A, and the run's metrics. Left panel: F(t) per slope; right panel: peak force
-against the slope. Paper 000 Fig. 14-15 are images whose numbers are not in the paper's text
+against the slope. Trujillo-Vela et al. 2020, Fig. 14-15, are images whose numbers are not in the paper's text
 (shared/papers/000), so no published curve is drawn. --peaks (repeatable) adds a series of peak
 forces from elsewhere to the right panel, e.g. the same case at another dx whose run directories
 are gone: --peaks "dx 25 mm=45:366,50:433,55:570,60:824,65:928"."""
@@ -97,7 +97,7 @@ def main(argv):
     bx.plot(s, [r[3]["weight_along_chute_N"] for r in runs], ":", label="M g sin(theta)")
     bx.set_xlabel("slope (deg)")
     bx.set_ylabel("force (N)")
-    bx.set_title("peak force per slope (paper 000 Fig. 15: no numbers in its text)", fontsize=10)
+    bx.set_title("peak force per slope (Trujillo-Vela et al. 2020 Fig. 15: no numbers in its text)", fontsize=10)
     bx.legend()
     bx.grid(alpha=0.3)
     fig.tight_layout()
