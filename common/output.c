@@ -34,6 +34,15 @@ static atomic_int out_hdf5_failed;
 
 const char *lahar_output_error(void) { return out_err; }
 int lahar_output_failed(void) { return atomic_load(&out_hdf5_failed); }
+
+int lahar_output_exit(int status)
+{
+    if (lahar_output_failed()) {
+        fflush(NULL);
+        _exit(status);
+    }
+    return status;
+}
 void lahar_output_explain(char *err, size_t n)
 {
     if (out_err[0] && n > 0)

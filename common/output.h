@@ -133,6 +133,9 @@ void lahar_output_explain(char *err, size_t n);
 /* 1 when an HDF5 file failed to close in this process: HDF5's clean-up at exit crashes on what
  * it left (HDF5 1.10), so the program leaves with _exit after flushing its own streams. */
 int lahar_output_failed(void);
+/* The end of main() in a program that writes HDF5: returns status, or leaves with _exit(status)
+ * after flushing stdio when lahar_output_failed(). */
+int lahar_output_exit(int status);
 /* Bytes an unprivileged writer may still use on the file system of directory dir (-1 unknown). */
 double lahar_output_free_bytes(const char *dir);
 

@@ -338,9 +338,5 @@ int main(int argc, char **argv)
         }
     }
     lahar_case_free(&cs);
-    if (lahar_output_failed()) { /* --in-process: HDF5's clean-up at exit would crash on a file that failed to close */
-        fflush(NULL);
-        _exit(status);
-    }
-    return status;
+    return lahar_output_exit(status); /* HDF5's clean-up at exit would crash on a file that failed to close */
 }

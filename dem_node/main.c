@@ -21,9 +21,5 @@ int main(int argc, char **argv)
     if (rc >= 0)
         return rc;
     rc = lahar_dem_node_run(&o);
-    if (lahar_output_failed()) { /* HDF5's clean-up at exit would crash on a file that failed to close */
-        fflush(NULL);
-        _exit(rc);
-    }
-    return rc;
+    return lahar_output_exit(rc); /* HDF5's clean-up at exit would crash on a file that failed to close */
 }
