@@ -1,6 +1,7 @@
 /* The coordinator's clock: times from integers and exactly known quantities only.
  *
- * Output times are T_j = j * output_interval (j an integer; T_nout = t_end). Between two output
+ * Output times are T_j = j * output_interval (j an integer; T_nout = t_end, or nout * output_interval
+ * when t_end is that multiple up to round-off). Between two output
  * times the coordinator takes m equal steps h = (T_{j+1} - t_b) / m from a segment start t_b,
  * so t_k = t_b + i * h (i = steps since t_b) and the last step of the segment ends exactly at
  * T_{j+1}, which is assigned, not summed. t_b is T_j, or the time t_b + i * h at which the
@@ -26,7 +27,14 @@ void lahar_clock_init(lahar_clock *c, double t_end, double out_interval)
 
 double lahar_clock_output_time(const lahar_clock *c, int64_t j)
 {
-    return j >= c->nout ? c->t_end : (double)j * c->out_interval;
+    if (j < c->nout)
+        return (double)j * c->out_interval;
+    /* The end. When t_end is a multiple of the interval up to round-off (0.15 = 3 x 0.05 is not
+     * exact in binary), it is that grid time, the same double a longer run passes on its way:
+     * a run extended by `lahar resume --time-end` then continues from exactly where the longer
+     * run would be, bit for bit. */
+    double grid = (double)c->nout * c->out_interval;
+    return fabs(grid - c->t_end) <= 1e-9 * c->t_end ? grid : c->t_end;
 }
 
 int lahar_clock_next(lahar_clock *c, double dt_allowed, double *t, double *t_next, int *is_output)
