@@ -3,10 +3,6 @@
 # tests/test_bench_output.py checks the CSVs, PNGs and summary.md it wrote: columns, particles x
 # steps / wall, the error column against each run's check.json, n ~ dx^-D, one DEM substep per
 # step when dt_max is forced to the DEM's stable dt. Speed is never asserted.
-find_program(LAHAR_BENCH_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT LAHAR_BENCH_PYTHON)
-  find_program(LAHAR_BENCH_PYTHON python3)
-endif()
 set(LAHAR_BENCH_OUT ${CMAKE_CURRENT_BINARY_DIR}/bench_quick)
 set(LAHAR_BENCH_QUICK_CASES poiseuille_2d,dam_break_2d,soil_block_incline_2d)
 add_test(NAME bench_quick

@@ -26,10 +26,6 @@ target_link_libraries(test_sph_particles PRIVATE lahar_sph)
 add_test(NAME sph_particles COMMAND test_sph_particles)
 set_tests_properties(sph_particles PROPERTIES LABELS "fast;coupling")
 
-find_program(LAHAR_COUPLING_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT LAHAR_COUPLING_PYTHON)
-  find_program(LAHAR_COUPLING_PYTHON python3)
-endif()
 # coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 function(lahar_coupling_run_test name labels)
   add_test(NAME coupling_${name}

@@ -4,9 +4,6 @@
 # sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 (the case's level gauges)
 # within 0.05 H (mean over t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
 # measured values: cases/README.md "Lobovsky dam break".
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 add_test(NAME sph_dam_break_lobovsky_2d
   COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/lobovsky_check.py $<TARGET_FILE:lahar>
           ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d)

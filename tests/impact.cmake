@@ -8,9 +8,6 @@
 # soil + M g sin(theta); the first impact between the frictionless dam-break front on the slope
 # and a rigid block sliding with mu_phi = tan 26 deg. Measured values: cases/README.md ("Granular
 # impact").
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 add_test(NAME soil_granular_impact_3d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_impact_3d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_impact_3d dx=0.05 end=1.2 threads=2)

@@ -1,10 +1,6 @@
 # HDF5/XDMF writers, the SWMR force stream, `lahar check` evaluation, tools/ (brief D).
 # Python parts need python3 with h5py/numpy (Debian's python3-h5py): prefer /usr/bin/python3,
 # where Debian installs them (tools/*.py also re-exec themselves there when h5py is missing).
-find_program(LAHAR_OUTPUT_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
-if(NOT LAHAR_OUTPUT_PYTHON)
-  find_program(LAHAR_OUTPUT_PYTHON python3)
-endif()
 set(LAHAR_OUTPUT_TEST_DIR ${CMAKE_BINARY_DIR}/test_output_data)
 file(MAKE_DIRECTORY ${LAHAR_OUTPUT_TEST_DIR})
 

@@ -5,9 +5,6 @@
 # the 100 Hz probe one sample per 10 ms slot, a case without probes writes no gauges.h5; a level
 # gauge (kind: level) in the middle reads h within 0.05 dx at every sample (measured 0.0016 dx).
 # The bad-probe fixtures are in tests/bad_cases/probe_*.yaml (case_bad_inputs).
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 add_test(NAME probes_tank_2d
   COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/probes_check.py $<TARGET_FILE:lahar>
           ${CMAKE_CURRENT_BINARY_DIR}/probes/tank_2d)

@@ -7,9 +7,6 @@ target_link_libraries(test_sph_soil PRIVATE lahar_sph)
 add_test(NAME soil_sph_unit COMMAND test_sph_soil)
 set_tests_properties(soil_sph_unit PROPERTIES LABELS "fast;soil" TIMEOUT 120)
 
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 # Geostatic layer: sigma_v = rho g z and sigma_h = K0 sigma_v within 5 %, no creep (4 s wall).
 add_test(NAME soil_geostatic_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_geostatic_2d.yaml

@@ -6,9 +6,6 @@ set_tests_properties(sph_initial_pressure PROPERTIES LABELS "fast;sph")
 
 # Per-particle initial fields from an HDF5 file equal the same fields given as expressions
 # (tests/sph_initial_file.sh; two runs of 625 particles for 0.04 s).
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 add_test(NAME sph_initial_file COMMAND sh ${LAHAR_TEST_DIR}/sph_initial_file.sh $<TARGET_FILE:lahar>
   ${CMAKE_SOURCE_DIR}/cases/taylor_green_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/sph_initial_file ${LAHAR_OUTPUT_PYTHON})
 set_tests_properties(sph_initial_file PROPERTIES LABELS "fast;sph" TIMEOUT 120)

@@ -6,9 +6,6 @@
 # fraction are overridden. Measured values and the full-resolution runs: cases/README.md,
 # "Validation results". Run them all: ctest -L validation.
 set(LAHAR_VALIDATION_DIR ${CMAKE_CURRENT_BINARY_DIR}/validation)
-if(NOT DEFINED LAHAR_OUTPUT_PYTHON)
-  set(LAHAR_OUTPUT_PYTHON python3)
-endif()
 
 # name, script arguments after LAHAR CASE OUT
 function(lahar_validation_test name case)
