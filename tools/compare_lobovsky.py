@@ -72,18 +72,7 @@ def peak(t, p, t0):
 
 
 def peak_mean(t, p, t0, tau):
-    """Largest (1/tau) int_s^{s+tau} p dt for s in [t0 - tau, t0 + PEAK_SPAN] (trapezoids)."""
-    # cumulative integral, then the window means at the sample starts
-    c = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
-    starts = t[(t >= t0 - tau) & (t <= t0 + PEAK_SPAN)]
-    if len(starts) == 0 or t[-1] - t[0] < tau:
-        return float("nan")
-    best = -np.inf
-    for s in starts:
-        if s + tau > t[-1]:
-            break
-        best = max(best, (np.interp(s + tau, t, c) - np.interp(s, t, c)) / tau)
-    return float(best)
+    return lahar_py.window_mean_peak(t, p, t0, tau, PEAK_SPAN)
 
 
 def main():

@@ -45,13 +45,7 @@ def first_at_or_above(t, p, level):
 
 
 def window_peak(t, p, t0, tau):
-    c = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
-    best = -np.inf
-    for s in t[(t >= t0 - tau) & (t <= t0 + SPAN)]:
-        if s + tau > t[-1]:
-            break
-        best = max(best, (np.interp(s + tau, t, c) - np.interp(s, t, c)) / tau)
-    return float(best)
+    return lahar_py.window_mean_peak(t, p, t0, tau, SPAN)
 
 
 def main():

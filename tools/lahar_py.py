@@ -27,3 +27,20 @@ def require(*modules):
     sys.stderr.write(f"{os.path.basename(sys.argv[0])}: python modules missing: {', '.join(missing)} "
                      f"(apt-get install {pkgs})\n")
     sys.exit(3)
+
+
+def window_mean_peak(t, p, t0, tau, span):
+    """Largest mean of p over a window of length tau, (1/tau) int_s^{s+tau} p dt (trapezoids), for
+    window starts s at the samples in [t0 - tau, t0 + span]: a peak as a sensor of response time
+    tau reads it. nan when the series is shorter than tau or has no start there."""
+    import numpy as np
+    c = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
+    starts = t[(t >= t0 - tau) & (t <= t0 + span)]
+    if len(starts) == 0 or t[-1] - t[0] < tau:
+        return float("nan")
+    best = -np.inf
+    for s in starts:
+        if s + tau > t[-1]:
+            break
+        best = max(best, (np.interp(s + tau, t, c) - np.interp(s, t, c)) / tau)
+    return float(best)
