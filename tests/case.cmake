@@ -11,7 +11,9 @@ set_tests_properties(case_shapes PROPERTIES LABELS fast)
 add_executable(test_case_bad ${LAHAR_TEST_DIR}/test_case_bad.c)
 target_link_libraries(test_case_bad PRIVATE lahar_common)
 # one fixture per class of bad input: exit status 2, message names file, line and key
-add_test(NAME case_bad_inputs COMMAND test_case_bad $<TARGET_FILE:lahar-case-check> ${LAHAR_TEST_DIR}/bad_cases)
+file(MAKE_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}/case_bad_inputs)
+add_test(NAME case_bad_inputs COMMAND test_case_bad $<TARGET_FILE:lahar-case-check> ${LAHAR_TEST_DIR}/bad_cases
+  ${CMAKE_CURRENT_BINARY_DIR}/case_bad_inputs)
 set_tests_properties(case_bad_inputs PROPERTIES LABELS fast)
 
 add_executable(test_case_blocks ${LAHAR_TEST_DIR}/test_case_blocks.c)

@@ -5,13 +5,59 @@
  * The fixture is run through lahar-case-check, which must exit with status 2 and print exactly
  * one line on stderr that starts with `<fixture path>:<line>:` and contains every expected
  * fragment (one `# expect:` line each, up to 4). Under the sanitizer build a leak on the error
- * path changes the exit status, so this also checks that nothing stays allocated on failure. */
+ * path changes the exit status, so this also checks that nothing stays allocated on failure.
+ * A fixture that needs an input file of HDF5 says so in a header line
+ *     # h5: NAME DATASET N
+ * and is run from a copy in SCRATCH_DIR beside a file NAME holding DATASET of N doubles, written
+ * here (inputs are made by the test, not kept in the source tree). */
 #include <dirent.h>
+#include <hdf5.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+/* dir/name with one dataset of n doubles (0, 1, 2, ...). 0 or -1. */
+static int write_h5_input(const char *dir, const char *name, const char *dataset, int n)
+{
+    char path[2048];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (f < 0)
+        return -1;
+    hsize_t dims = (hsize_t)n;
+    hid_t sp = H5Screate_simple(1, &dims, NULL);
+    hid_t ds = H5Dcreate2(f, dataset, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    double *v = calloc((size_t)(n > 0 ? n : 1), sizeof *v);
+    for (int i = 0; v && i < n; i++)
+        v[i] = (double)i;
+    int rc = ds >= 0 && v && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0 ? 0 : -1;
+    free(v);
+    if (ds >= 0)
+        H5Dclose(ds);
+    H5Sclose(sp);
+    H5Fclose(f);
+    return rc;
+}
+
+/* Copy src to dir/name. 0 or -1. */
+static int copy_file(const char *src, const char *dir, const char *name)
+{
+    char path[2048], buf[8192];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *in = fopen(src, "rb"), *out = in ? fopen(path, "wb") : NULL;
+    int rc = in && out ? 0 : -1;
+    size_t k;
+    while (!rc && (k = fread(buf, 1, sizeof buf, in)) > 0)
+        if (fwrite(buf, 1, k, out) != k)
+            rc = -1;
+    if (in)
+        fclose(in);
+    if (out && fclose(out) != 0)
+        rc = -1;
+    return rc;
+}
 
 static int name_cmp(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
@@ -46,8 +92,8 @@ static int run_capture(const char *prog, const char *arg, char *buf, size_t n)
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: %s LAHAR_CASE_CHECK BAD_CASES_DIR\n", argv[0]);
+    if (argc != 4) {
+        fprintf(stderr, "usage: %s LAHAR_CASE_CHECK BAD_CASES_DIR SCRATCH_DIR\n", argv[0]);
         return 1;
     }
     DIR *d = opendir(argv[2]);
@@ -68,7 +114,8 @@ int main(int argc, char **argv)
     int failures = 0;
     for (int i = 0; i < n; i++) {
         char path[2048], expect[4][1100] = {"", "", "", ""}, line[1100] = "", buf[8192], want[4200];
-        int nexpect = 0;
+        char h5name[256] = "", h5set[256] = "";
+        int nexpect = 0, h5n = -1;
         snprintf(path, sizeof path, "%s/%s", argv[2], names[i]);
         FILE *fp = fopen(path, "r");
         if (!fp) {
@@ -83,8 +130,18 @@ int main(int argc, char **argv)
                 snprintf(expect[nexpect++], sizeof expect[0], "%.1000s", l + 10);
             else if (strncmp(l, "# line: ", 8) == 0)
                 snprintf(line, sizeof line, "%.1000s", l + 8);
+            else if (strncmp(l, "# h5: ", 6) == 0 && sscanf(l + 6, "%255s %255s %d", h5name, h5set, &h5n) != 3)
+                h5n = -1;
         }
         fclose(fp);
+        if (h5n >= 0) { /* run it from a copy beside its generated input */
+            if (copy_file(path, argv[3], names[i]) != 0 || write_h5_input(argv[3], h5name, h5set, h5n) != 0) {
+                printf("FAIL %s: cannot make its input %s/%s\n", names[i], argv[3], h5name);
+                failures++;
+                continue;
+            }
+            snprintf(path, sizeof path, "%s/%s", argv[3], names[i]);
+        }
         if (!nexpect || !line[0]) {
             printf("FAIL %s: fixture lacks '# expect:' or '# line:' header\n", names[i]);
             failures++;
