@@ -769,8 +769,9 @@ static int coord_state_io(coord *co, lahar_ckpt_file *f, int64_t *k, lahar_clock
     return f->failed ? -1 : 0;
 }
 
-/* Remove a checkpoint directory (its files, then itself). */
-static void coord_rm_ckpt_dir(const char *path)
+/* Remove a directory and what it holds (checkpoints/ holds NNNNNN/ directories of files). 0, or -1
+ * with errno set when the directory itself could not be removed. */
+static int coord_rm_ckpt_dir(const char *path)
 {
     DIR *d = opendir(path);
     if (d) {
@@ -780,11 +781,12 @@ static void coord_rm_ckpt_dir(const char *path)
                 continue;
             char p[4400];
             snprintf(p, sizeof p, "%.4000s/%.255s", path, e->d_name);
-            unlink(p);
+            if (unlink(p) != 0)
+                coord_rm_ckpt_dir(p);
         }
         closedir(d);
     }
-    rmdir(path);
+    return rmdir(path);
 }
 
 /* The checkpoints in OUT/checkpoints: the step indices of the complete ones (NNNNNN holding
@@ -1238,17 +1240,8 @@ static int coord_clear_outdir(const char *outdir, int overwrite)
     snprintf(path, sizeof path, "%s/" LAHAR_CKPT_DIR, outdir);
     DIR *d = opendir(path);
     if (d && overwrite) {
-        struct dirent *e;
-        while ((e = readdir(d)) != NULL) {
-            if (e->d_name[0] == '.')
-                continue;
-            char p[4400];
-            snprintf(p, sizeof p, "%.4000s/%.255s", path, e->d_name);
-            if (unlink(p) != 0)
-                coord_rm_ckpt_dir(p);
-        }
         closedir(d);
-        if (rmdir(path) != 0) {
+        if (coord_rm_ckpt_dir(path) != 0) {
             fprintf(stderr, "lahar: --overwrite: cannot remove %s: %s\n", path, strerror(errno));
             return -1;
         }
