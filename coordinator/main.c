@@ -172,7 +172,7 @@ static int check_memory(const char *cmd, const lahar_case *cs, const lahar_estim
     return -1;
 }
 
-/* The DEM engine the case names must exist in this build (dem_node/dem_engine_registry.c): said at
+/* The DEM engine the case names must exist in this build (dem_node/engines/dem_engine_registry.c): said at
  * validation, with the case's file and line, not when the DEM node starts. */
 static int check_dem_engine(const lahar_case *cs)
 {

@@ -307,7 +307,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
     return rc;
 }
 
-/* Mark the last snapshot of the files this node writes (common/output.h). */
+/* Mark the last snapshot of the files this node writes (common/io/output.h). */
 static void sph_node_mark_last(const sph_node *s, const char *name, const char *text)
 {
     lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", name, text);
@@ -685,7 +685,7 @@ static void sph_node_crossing_report(const sph_node *s, int64_t k, double t, lah
     sph_node_crossing_message(s, k, t, u->text, sizeof u->text);
 }
 
-/* The particle checks of common/instability.h on the state after step k (time t): every
+/* The particle checks of common/protocol/instability.h on the state after step k (time t): every
  * position, velocity and density finite, and rho / rho0 within stability.density_band. One
  * streaming pass counts the failures (a sum: the same for any thread count); only when there are
  * some, a serial pass names the worst: the non-finite particle of lowest id, else the one
@@ -831,7 +831,7 @@ static int sph_node_probes_sample(sph_node *s, int64_t k, double t)
     return lahar_gauge_output_write(s->gauges, k + 1, t, s->probes.value, s->probes.due);
 }
 
-/* ---- checkpoints (common/checkpoint.h) -------------------------------------------------------
+/* ---- checkpoints (common/io/checkpoint.h) -------------------------------------------------------
  * Everything step k + 1 reads of the state after step k, in the particles' current (sorted)
  * order: the particle arrays (incl. the rates of the last evaluation, which the first kick of
  * the next step uses, and the soil's stress and stress rate), the solver's counters (step: the

@@ -1,4 +1,4 @@
-# SPH solver core (brief E): kernels (common/kernel.c), particles, cell lists, WCSPH and the
+# SPH solver core (brief E): kernels (common/kernels/kernel.c), particles, cell lists, WCSPH and the
 # SPH-DEM coupling (sph_node/sph_*.c), tested at library level without processes.
 add_executable(test_kernel ${LAHAR_TEST_DIR}/test_kernel.c)
 target_link_libraries(test_kernel PRIVATE lahar_common)

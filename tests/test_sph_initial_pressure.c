@@ -10,7 +10,7 @@
  *  - the pressure of those densities by the solver's own EOS (sph_fluid_pressure) is
  *    rho0 g (h - y) to 1e-9 of rho0 g H (round trip);
  *  - initial_pressure: none (the default) keeps rho0 exactly; the option survives the scene
- *    message (common/scene_msg.c); a misspelt value is refused with the closest name.
+ *    message (common/protocol/scene_msg.c); a misspelt value is refused with the closest name.
  * usage: test_sph_initial_pressure TMP_DIR */
 #include <math.h>
 #include <stdio.h>

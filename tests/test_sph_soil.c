@@ -1,4 +1,4 @@
-/* SPH soil (sph_node/sph_soil.h) against closed forms:
+/* SPH soil (sph_node/soil/sph_soil.h) against closed forms:
  *  1. return mapping (Bui 2008 section 3.3): a stress beyond the Drucker-Prager surface is scaled
  *     back onto it (|f| < 1e-12 of the stress scale) with I1 and the direction of s kept; a
  *     tensile stress of a cohesionless soil goes to zero; with cohesion to the apex

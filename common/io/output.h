@@ -93,7 +93,7 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
 int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, const double *p, const int *due);
 void lahar_gauge_output_close(lahar_gauge_output *o);
 
-/* Checkpoints (common/checkpoint.h): a writer hands its buffered stream rows to the file before
+/* Checkpoints (common/io/checkpoint.h): a writer hands its buffered stream rows to the file before
  * its node writes a checkpoint, so that rows up to the checkpoint survive a kill. 0 or -1. */
 int lahar_body_output_sync(lahar_body_output *o);
 int lahar_gauge_output_sync(lahar_gauge_output *o);

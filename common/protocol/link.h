@@ -1,4 +1,4 @@
-/* The lahar link layer: typed messages over a transport (common/transport.h), in frames of at
+/* The lahar link layer: typed messages over a transport (common/protocol/transport.h), in frames of at
  * most LAHAR_FRAME_PAYLOAD bytes (one UDP datagram each), with reassembly, duplicate removal and
  * receiver-driven repair: whoever waits for a message NACKs its sender (10 ms, doubling to
  * 200 ms) and the sender re-publishes from the copies it keeps of its last few messages per
@@ -105,7 +105,7 @@ void lahar_link_poll(lahar_link *l, int timeout_ms);
 /* Seconds spent inside wait/poll since creation (the "wait time" of a node). */
 double lahar_link_wait_seconds(const lahar_link *l);
 
-/* Authenticated runs (common/auth.h): from this call on, every frame sent carries a MAC under
+/* Authenticated runs (common/protocol/auth.h): from this call on, every frame sent carries a MAC under
  * key, and frames heard without a valid one are dropped. Call before the link sends or hears. */
 typedef struct {
     uint64_t frames_rejected; /* no MAC or a wrong one: forged, altered, or another key */

@@ -10,7 +10,7 @@
 typedef struct lahar_dem_engine lahar_dem_engine; /* opaque, owned by the implementation */
 
 /* An instability of the bodies that made advance() fail (the DEM node turns it into the
- * report of common/instability.h: what, which body, where, when). */
+ * report of common/protocol/instability.h: what, which body, where, when). */
 typedef struct {
     char what[48];        /* "non-finite state", "runaway", "overlap" */
     int body, other;      /* the body (the first of a pair), the other one or -1 */

@@ -1,5 +1,5 @@
 /* LCM behind the transport table: udpm:// (processes, multicast inside a private network
- * namespace, see common/netns.h) and memq:// (threads of one process). */
+ * namespace, see common/protocol/netns.h) and memq:// (threads of one process). */
 #include "transport.h"
 #include <lcm/lcm.h>
 #include <pthread.h>

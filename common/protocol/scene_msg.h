@@ -13,7 +13,7 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
                               int64_t run_id, lahar_scene_t *m);
 void lahar_scene_msg_release(lahar_scene_t *m);
 
-/* Build a case from a decoded scene (deep copy); release with lahar_case_free (common/case.h).
+/* Build a case from a decoded scene (deep copy); release with lahar_case_free (common/io/case.h).
  * Returns 0, or -1 with a message in err (malformed scene). */
 int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen);
 

@@ -1,7 +1,7 @@
 /* Message authentication for runs across machines: a shared secret key (32 bytes, written as 64
  * hex digits in a file only its owner reads) with which every frame carries a MAC (libsodium's
  * crypto_auth, HMAC-SHA-512-256) over its header (run id, sender, step, type, sequence number,
- * framing) and payload (common/link.c). The runs lahar keeps in its own network namespace need
+ * framing) and payload (common/protocol/link.c). The runs lahar keeps in its own network namespace need
  * none. */
 #ifndef LAHAR_AUTH_H
 #define LAHAR_AUTH_H

@@ -1,5 +1,5 @@
-/* Probes (case section probes:, lahar_probe in common/scene.h): pressure probes and water-level
- * gauges, sampled by the SPH node after each step, written to OUT/gauges.h5 (common/output.h).
+/* Probes (case section probes:, lahar_probe in common/scene/scene.h): pressure probes and water-level
+ * gauges, sampled by the SPH node after each step, written to OUT/gauges.h5 (common/io/output.h).
  *
  * A level gauge (kind: level) reads the height above the floor of the water column standing on the
  * floor along a vertical line, as a wire (resistance or capacitance) wave gauge does, with the

@@ -24,7 +24,7 @@ typedef struct {
     double restitution; /* normal coefficient of restitution e in (0, 1] */
     double friction;    /* Coulomb coefficient mu >= 0; soil: mu_phi against DEM surfaces (Trujillo-Vela et al. 2020 eq. 24) */
     lahar_contact_model model; /* LAHAR_CONTACT_SOIL: an SPH soil (model: soil), not a DEM contact law */
-    /* soil only (model: soil; sph_node/sph_soil.h): elastic-perfectly plastic Drucker-Prager matched
+    /* soil only (model: soil; sph_node/soil/sph_soil.h): elastic-perfectly plastic Drucker-Prager matched
      * to Mohr-Coulomb; young and poisson above are its elastic constants */
     double friction_angle;  /* phi, radians (case: degrees) */
     double cohesion;        /* c, Pa */
@@ -68,7 +68,7 @@ typedef struct {
 /* A region of SPH particles created on a lattice of spacing dx (sph.dx). The lattice of a block
  * has its points at lo + (i + 1/2) dx, i = 0 .. floor((hi - lo)/dx) - 1 per axis (z = 0, one
  * layer in 2D); a point becomes a particle when it lies inside the region
- * (lahar_particle_block_contains, common/shape_build.h). For a box the region is [lo, hi); for a
+ * (lahar_particle_block_contains, common/geometry/shape_build.h). For a box the region is [lo, hi); for a
  * polygon or a closed mesh lo/hi are its bounding box (the loader computes them). */
 typedef enum {
     LAHAR_BLOCK_BOX = 0,     /* axis-aligned box [lo, hi), 2D or 3D */
@@ -102,7 +102,7 @@ typedef struct {
 /* Weakly compressible SPH and the SPH-DEM coupling (section sph: of a case; every key is
  * documented in cases/dem_drop_3d.yaml). Together with lahar_case.sph_dx (particle spacing) and
  * lahar_case.sph_density (rest density) this is everything the SPH node needs (sph_params of
- * sph_node/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
+ * sph_node/fluid/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
 typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
@@ -110,7 +110,7 @@ typedef enum { LAHAR_SPH_WALL_PRESSURE_PENALTY = 0, LAHAR_SPH_WALL_PRESSURE_GHOS
 typedef enum { LAHAR_SPH_PENALTY_STEP = 0, LAHAR_SPH_PENALTY_ACOUSTIC = 1 } lahar_sph_penalty_stiffness;
 
 typedef struct {
-    char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernel.h) */
+    char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernels/kernel.h) */
     double h_over_dx;      /* smoothing length h = h_over_dx dx (default 1.3) */
     double c0;             /* m/s, numerical speed of sound (default 10 U_ref, see the example) */
     lahar_sph_eos eos;     /* default linear (Trujillo-Vela et al. 2020 eq. 3); tait: Canelas et al. 2015 eq. 19 */
@@ -127,24 +127,24 @@ typedef struct {
     double sps_cs;         /* Smagorinsky constant (default 0.12) */
     double halo;           /* m, coupling halo eps (Trujillo-Vela et al. 2020 eq. 14; default dx/2) */
     double kappa;          /* coupling range in units of h (default: the kernel's support radius) */
-    lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/sph_coupling.h) */
+    lahar_sph_wall_viscous wall_viscous; /* wall viscous model (sph_node/coupling/sph_coupling.h) */
     lahar_sph_initial_pressure initial_pressure; /* block densities at t = 0: rest (none, default) or
                                                    hydrostatic per block (lahar_sph_node_fill) */
     lahar_sph_wall_pressure wall_pressure; /* wall pressure term: penalty only (default, Trujillo-Vela et al. 2020
-                                              eq. 15) or ghost layers (sph_node/sph_coupling.h) */
+                                              eq. 15) or ghost layers (sph_node/coupling/sph_coupling.h) */
     lahar_sph_penalty_stiffness penalty_stiffness; /* K_n = 0.1 m_min / dt^2 of Trujillo-Vela et al. 2020 eq. 15 with the
                                               step's dt (step, default) or the acoustic step
                                               cfl h / c0 (acoustic: independent of the step) */
     lahar_sph_wall_pressure soil_wall_stress; /* the soil's wall term: penalty + friction spring only
                                                  (default, Trujillo-Vela et al. 2020 eq. 15, 22-27) or ghost layers
-                                                 carrying the soil stress (sph_node/sph_coupling.h) */
+                                                 carrying the soil stress (sph_node/coupling/sph_coupling.h) */
     double shifting;       /* particle shifting A: dr = -A h^2 grad C per step (Lind et al. 2012),
-                              confined flows only; default 0 = off (sph_node/sph_fluid.c) */
+                              confined flows only; default 0 = off (sph_node/fluid/sph_fluid.c) */
     int shifting_density;  /* 1: the shift changes the density as the continuity equation would (keeps
-                              the total volume of a closed box); default 0 (sph_node/sph_fluid.c) */
+                              the total volume of a closed box); default 0 (sph_node/fluid/sph_fluid.c) */
     double background_pressure; /* Pa, p_b: default 0. Without transport_velocity it is added to the
                               EOS pressure in the momentum equation; with it, it drives the transport
-                              velocity only (Adami et al. 2013); sph_node/sph_fluid.h */
+                              velocity only (Adami et al. 2013); sph_node/fluid/sph_fluid.h */
     int transport_velocity; /* 1: transport-velocity formulation (Adami, Hu & Adams 2013), confined
                               water-only flows without bodies; default 0 */
     int body_layers;       /* N > 0: the particles within N dx of every sphere (3D) or disc (2D) body's
@@ -152,7 +152,7 @@ typedef struct {
                               instead of the lattice (lahar_case_block_lattice); default 0 */
 } lahar_sph_options;
 
-/* A probe (section probes: of a case; sph_node/sph_probes.h samples it, OUT/gauges.h5).
+/* A probe (section probes: of a case; sph_node/probes/sph_probes.h samples it, OUT/gauges.h5).
  * kind LAHAR_PROBE_LEVEL: a water-level gauge, the vertical line (the last axis, along gravity)
  * from x (the floor under the gauge: x[dim - 1] = floor) up to `top`; it reads the height of the
  * free surface above the floor (sph_probes.h). The other fields are for pressure probes:
@@ -184,7 +184,7 @@ typedef struct {
     } metric[16];
 } lahar_check;
 
-/* Instability checks (section stability: of a case, see common/instability.h and cases/README.md).
+/* Instability checks (section stability: of a case, see common/protocol/instability.h and cases/README.md).
  * The loader fills every default. */
 typedef struct {
     double density_band[2]; /* SPH: every particle keeps rho / rho0 in [lo, hi] (default [0.5, 2]) */

@@ -397,7 +397,7 @@ static void read_time(reader *r, yaml_node_t *root, yaml_node_t *n, lahar_case *
         rmap_fail(&m, "forces_interval", "must be >= 0 s (got %g); 0 records every step", c->forces_interval);
 }
 
-/* A model: soil material (an SPH soil, sph_node/sph_soil.h): elastic constants, Mohr-Coulomb
+/* A model: soil material (an SPH soil, sph_node/soil/sph_soil.h): elastic constants, Mohr-Coulomb
  * strength (angles in degrees in the case, radians in lahar_material), k_h for seepage and mu_phi
  * against DEM surfaces (friction, default tan(friction_angle)). */
 static void read_soil_material(rmap *m, lahar_material *mat, const char *const *dem_only)
@@ -593,7 +593,7 @@ static void read_dem(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
-/* The instability checks (common/instability.h); defaults when the section is absent. */
+/* The instability checks (common/protocol/instability.h); defaults when the section is absent. */
 static void read_stability(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"density_band", "max_overlap", "dt_collapse", NULL};
@@ -1217,11 +1217,11 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
 
 /* --- sph: the fluid, its particle blocks and the coupling ------------------------------------ */
 
-/* The solver core does not have these yet (sph_node/sph_fluid.h): a case asking for them is
+/* The solver core does not have these yet (sph_node/fluid/sph_fluid.h): a case asking for them is
  * rejected instead of silently running without them. Flip when the solver grows them. */
 #define LAHAR_SPH_HAVE_SHEPARD 1
 #define LAHAR_SPH_HAVE_SPS 1
-/* the coupling (sph_node/sph_coupling.h) uses eps = dx/2 and the kernel's support */
+/* the coupling (sph_node/coupling/sph_coupling.h) uses eps = dx/2 and the kernel's support */
 #define LAHAR_SPH_HAVE_HALO 0
 #define LAHAR_SPH_HAVE_KAPPA 0
 
@@ -2145,7 +2145,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     const double h = o->h_over_dx * dx;
     if (!kd)
-        rmap_fail(&m, "kernel", "the kernel table (common/kernel.h) has no '%s'", o->kernel);
+        rmap_fail(&m, "kernel", "the kernel table (common/kernels/kernel.h) has no '%s'", o->kernel);
     else if (!(o->h_over_dx >= 0.5 && o->h_over_dx <= 4.0))
         rmap_fail(&m, "h_over_dx", "must be in [0.5, 4] (got %g); h = h_over_dx dx, 1.0-1.5 is usual", o->h_over_dx);
     else if (!(o->gamma >= 1))
@@ -2270,7 +2270,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_fail(&m, "c0", "must be > 0 m/s (got %g); about 10 x the largest expected flow speed", o->c0);
         return;
     }
-    /* background pressure p_b (sph_node/sph_fluid.h): default 0, or rho0 c0^2 with the transport
+    /* background pressure p_b (sph_node/fluid/sph_fluid.h): default 0, or rho0 c0^2 with the transport
      * velocity (Adami et al. 2013 take p_b = p0 = rho0 c0^2) */
     o->background_pressure = rmap_num(&m, "background_pressure", 0,
                                       o->transport_velocity ? c->sph_density * o->c0 * o->c0 : 0.0, "1e4");
@@ -2358,7 +2358,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
-/* probes: [{name, kind, position, body, size, rate}, ...] (lahar_probe, common/scene.h). A fluid
+/* probes: [{name, kind, position, body, size, rate}, ...] (lahar_probe, common/scene/scene.h). A fluid
  * probe must lie in the box of the bodies and blocks and outside every body; a body probe within
  * sph.dx of the body's swept surface (it is projected onto it, and the outward normal stored). A
  * level gauge (kind: level) gives the horizontal position only, inside the box; gravity must act
@@ -2673,7 +2673,7 @@ static void read_check(reader *r, yaml_node_t *n, lahar_case *c)
     c->check.enabled = 1;
     yaml_node_t *mn = rmap_get(&m, "metrics");
     if (!mn)
-        return; /* the reference's default metric and bound apply (common/check.c) */
+        return; /* the reference's default metric and bound apply (coordinator/check/check.c) */
     if (rmap_open(r, mn, "check.metrics", &mm) != 0)
         return;
     int nm = (int)(mn->data.mapping.pairs.top - mn->data.mapping.pairs.start);

@@ -1,4 +1,4 @@
-/* `lahar check` references of the SPH soil (sph_node/sph_soil.h; cases/README.md).
+/* `lahar check` references of the SPH soil (sph_node/soil/sph_soil.h; cases/README.md).
  *
  * soil_geostatic: a soil layer at rest under gravity, laterally confined (periodic sides or
  * frictionless walls), loaded by its own weight from a stress-free start. One-dimensional

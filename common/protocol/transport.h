@@ -1,5 +1,5 @@
 /* The byte transport under the lahar protocol: a small table of function pointers so that the
- * link layer (common/link.h) does not care whether messages travel as UDP multicast between
+ * link layer (common/protocol/link.h) does not care whether messages travel as UDP multicast between
  * processes (LCM udpm://) or between threads of one process (LCM memq://, fanned out by an
  * in-process hub). Both implementations sit on liblcm; only the link layer calls this. */
 #ifndef LAHAR_TRANSPORT_H

@@ -9,7 +9,7 @@ int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair
                       char *err, size_t errlen)
 {
     if (a->model == LAHAR_CONTACT_SOIL || b->model == LAHAR_CONTACT_SOIL) {
-        /* an SPH soil (sph_node/sph_soil.h): no body is made of it (the case loader refuses one),
+        /* an SPH soil (sph_node/soil/sph_soil.h): no body is made of it (the case loader refuses one),
          * so this pair never meets; an inert law keeps the table complete */
         *out = (dem_pair_law){.model = LAHAR_CONTACT_LINEAR};
         return 0;
