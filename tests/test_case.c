@@ -552,7 +552,8 @@ static void test_cases_dir(const char *dir)
     struct dirent *de;
     while ((de = readdir(d)) && n < 256) {
         size_t l = strlen(de->d_name);
-        if (l > 5 && strcmp(de->d_name + l - 5, ".yaml") == 0)
+        /* reference.yaml documents every key (all comments, lahar keys --yaml): not a case */
+        if (l > 5 && strcmp(de->d_name + l - 5, ".yaml") == 0 && strcmp(de->d_name, "reference.yaml") != 0)
             names[n++] = strdup(de->d_name);
     }
     closedir(d);
