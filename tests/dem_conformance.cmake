@@ -18,3 +18,15 @@ endfunction()
 lahar_dem_conformance_test(spheropoly "fast;netns;conformance;dem")
 # runs once lahar-dem lists the engine (built when liblammps-dev is present); skipped until then
 lahar_dem_conformance_test(lammps "fast;netns;conformance;dem")
+# the harness itself fails what it must fail: an executable that is no DEM engine, and an engine
+# whose loads differ from what the harness expects (as if it ignored LOADS)
+add_test(NAME dem_conformance_not_an_engine
+         COMMAND dem_conformance --work ${CMAKE_CURRENT_BINARY_DIR}/dem_conformance_not_an_engine -- /bin/false)
+set_tests_properties(dem_conformance_not_an_engine PROPERTIES LABELS "fast;netns;conformance" TIMEOUT 60
+                     PASS_REGULAR_EXPRESSION "FAIL handshake[^\n]*exited \\(status 1\\)[^\n]*\n0 passed, 1 failed")
+add_test(NAME dem_conformance_ignored_loads
+         COMMAND dem_conformance --self-test ignore-loads --work ${CMAKE_CURRENT_BINARY_DIR}/dem_conformance_ignored_loads
+                 -- $<TARGET_FILE:lahar-dem>)
+set_tests_properties(dem_conformance_ignored_loads PROPERTIES LABELS "fast;netns;conformance" TIMEOUT 180
+                     PASS_REGULAR_EXPRESSION "PASS step_status[^\n]*\nFAIL loads"
+                     REQUIRED_FILES "$<TARGET_FILE:lahar-dem>")
