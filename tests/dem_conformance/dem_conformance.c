@@ -119,6 +119,21 @@ static int engine_listed(const char *list, const char *name)
     return 0;
 }
 
+/* 1 if the engine's log says it does not know the engine asked for on its own command line
+ * (`lahar-dem --engine NAME` exits before the HELLO then). */
+static int log_says_unknown_engine(const char *dir)
+{
+    char path[1300], line[1024];
+    snprintf(path, sizeof path, "%s/engine.log", dir);
+    FILE *f = fopen(path, "r");
+    int found = 0;
+    while (f && !found && fgets(line, sizeof line, f))
+        found = strstr(line, "not a registered DEM engine") || strstr(line, "unknown DEM engine");
+    if (f)
+        fclose(f);
+    return found;
+}
+
 /* Every HDF5 file the engine wrote opens read-only (with HDF5's file lock and its open-for-writing
  * check): the engine closed its outputs. Returns the number of files, -1 if one does not open. */
 static int outputs_closed(const char *dir, char *bad, size_t n)
@@ -166,8 +181,8 @@ static int check_loads_session(conf *cf)
         conf_session_free(&s);
         return 77;
     }
-    if (rc != 0 && strstr(s.fail, "unknown DEM engine")) {
-        printf("SKIP %s\n", s.fail);
+    if (rc != 0 && (strstr(s.fail, "unknown DEM engine") || log_says_unknown_engine(dir))) {
+        printf("SKIP the executable does not know the engine '%s': %s\n", cf->engine, s.fail);
         conf_session_free(&s);
         return 77;
     }
