@@ -172,7 +172,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->h_over_dx = o->h_over_dx;
     prm->rho0 = c->sph_density;
     prm->c0 = o->c0;
-    prm->eos = o->eos == LAHAR_SPH_EOS_TAIT ? SPH_EOS_TAIT : SPH_EOS_LINEAR;
+    prm->eos = o->eos;
     prm->gamma = o->gamma;
     prm->mu = o->mu;
     prm->alpha = o->alpha;
@@ -186,12 +186,10 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->cfl = o->cfl;
     prm->cfl_force = o->cfl_force;
     prm->cfl_visc = o->cfl_visc;
-    prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
-    prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
-                                                                            : SPH_WALL_PRESSURE_PENALTY;
+    prm->wall_viscous = o->wall_viscous;
+    prm->wall_pressure = o->wall_pressure;
     prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
-    prm->soil_wall_stress = o->soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
-                                                                                  : SPH_WALL_PRESSURE_PENALTY;
+    prm->soil_wall_stress = o->soil_wall_stress;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;

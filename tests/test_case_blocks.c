@@ -33,17 +33,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static int failures, checks;
-#define CHECK(cond, ...)                                                                                           \
-    do {                                                                                                           \
-        checks++;                                                                                                  \
-        if (!(cond)) {                                                                                             \
-            failures++;                                                                                            \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                            \
-            printf(__VA_ARGS__);                                                                                   \
-            printf("\n");                                                                                          \
-        }                                                                                                          \
-    } while (0)
+#include "test_util.h"
 
 static lahar_particle_block polygon_block(const double (*p)[2], int n)
 {

@@ -395,7 +395,7 @@ static int64_t soil_on_plate(sph_fluid *f, lahar_body *plate, int nx, int ny, do
     prm.c0 = 10.0;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 0.0);
-    prm.soil_wall_stress = SPH_WALL_PRESSURE_GHOST;
+    prm.soil_wall_stress = LAHAR_SPH_WALL_PRESSURE_GHOST;
     char err[256];
     if (sph_fluid_init(f, &prm, (int64_t)nx * ny, err, sizeof err) != 0) {
         CHECK(0, "init: %s", err);

@@ -156,6 +156,30 @@ vec3 geom_face_normal(const lahar_shape *s, int f)
     return v3_normalize(n);
 }
 
+int geom_point_in_core(const lahar_shape *s, int convex, int dim, const double x[3], const double q[4], vec3 p)
+{
+    /* in the shape's frame (one rotation of p; fixed bodies: the same frame bit for bit) */
+    const vec3 pb = q_rotate_inv(q_load(q), v3_sub(p, v3_load(x)));
+    if (dim == 3) {
+        if (s->nf < 4 || !convex)
+            return 0;
+        for (int f = 0; f < s->nf; f++) {
+            vec3 a = v3_load(s->v[s->face_v[s->face_start[f]]]);
+            if (v3_dot(v3_sub(pb, a), geom_face_normal(s, f)) >= 0.0)
+                return 0;
+        }
+        return 1;
+    }
+    if (s->nv < 3 || s->ne != s->nv)
+        return 0;
+    int in = 0;
+    for (int e = 0; e < s->ne; e++) {
+        const double *a = s->v[s->e[e][0]], *b = s->v[s->e[e][1]];
+        in ^= geom_ray_crosses_edge(a[0], a[1], b[0], b[1], pb.x, pb.y);
+    }
+    return in;
+}
+
 /* World-frame polygon of face f into buf (at most cap vertices; larger faces are truncated, which
  * only the brute-force helpers here could hit: the DEM engine keeps its own world copies). */
 enum { GEOM_FACE_MAX = 64 };

@@ -62,6 +62,21 @@ double geom_body_core_distance(const lahar_shape *a, const double xa[3], const d
 /* Outward unit normal of face f (body frame), from Newell's method. */
 vec3 geom_face_normal(const lahar_shape *s, int f);
 
+/* 1 when the +x ray from (px, py) crosses the edge a-b of a polygon in the x-y plane (half-open in
+ * y, Franklin's rule, so that a ray through a vertex counts once): the even-odd test of every
+ * polygon in lahar (body cores, particle blocks) sums this over the edges. */
+static inline int geom_ray_crosses_edge(double ax, double ay, double bx, double by, double px, double py)
+{
+    return (ay > py) != (by > py) && px < ax + (py - ay) * (bx - ax) / (by - ay);
+}
+
+/* 1 when p lies inside the closed core of a shape placed at (x, q): in 3D a convex polyhedron
+ * (p behind every face plane; open or non-convex cores give 0), in 2D a closed ring of edges
+ * (ne == nv >= 3; even-odd rule in the x-y plane). The swept sphere is not part of it (distance to
+ * the core: geom_point_body_core). The one inside test of a body: the case loader's lattice cut,
+ * the SPH coupling's deep-inside test and the checks use it. */
+int geom_point_in_core(const lahar_shape *s, int convex, int dim, const double x[3], const double q[4], vec3 p);
+
 /* ---- Feature grid: a uniform grid over the features (vertices, edges, faces) of one shape, in
  * its own frame (body frame; world frame for fixed bodies), so that a query near a big terrain or
  * flume surface visits only the nearby features. Built once at setup; queries allocate nothing. */

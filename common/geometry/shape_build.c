@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geometry.h"
 #include "vec.h"
 
 #ifndef M_PI
@@ -1184,14 +1185,8 @@ void lahar_shape_to_principal(lahar_shape *s, const lahar_mass_props *mp)
 static int block_polygon_contains(const lahar_particle_block *b, const double x[3])
 {
     int inside = 0;
-    for (int i = 0, j = b->nvert - 1; i < b->nvert; j = i++) {
-        const double *a = b->vert[i], *c = b->vert[j];
-        if ((a[1] > x[1]) != (c[1] > x[1])) {
-            double xc = a[0] + (x[1] - a[1]) * (c[0] - a[0]) / (c[1] - a[1]);
-            if (x[0] < xc)
-                inside = !inside;
-        }
-    }
+    for (int i = 0, j = b->nvert - 1; i < b->nvert; j = i++)
+        inside ^= geom_ray_crosses_edge(b->vert[i][0], b->vert[i][1], b->vert[j][0], b->vert[j][1], x[0], x[1]);
     return inside;
 }
 

@@ -1766,18 +1766,6 @@ static double sph_reference_speed(const lahar_case *c)
     return fmax(sqrt(2.0 * g * H), vmax);
 }
 
-/* Even-odd test of x against the closed 2D ring of a body's core vertices (in ring order). */
-static int point_in_ring2d(const lahar_body *bd, vec3 x)
-{
-    int inside = 0, nv = bd->shape.nv;
-    for (int i = 0, j = nv - 1; i < nv; j = i++) {
-        vec3 a = geom_world_vertex(&bd->shape, bd->x, bd->q, i), c = geom_world_vertex(&bd->shape, bd->x, bd->q, j);
-        if ((a.y > x.y) != (c.y > x.y) && x.x < a.x + (x.y - a.y) * (c.x - a.x) / (c.y - a.y))
-            inside = !inside;
-    }
-    return inside;
-}
-
 int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
 {
     const lahar_shape *s = &bd->shape;
@@ -1786,19 +1774,7 @@ int lahar_body_contains(const lahar_body *bd, int dim, const double x[3])
     if (geom_point_body_core(s, bd->x, bd->q, p, &cp, &feat) < s->radius)
         return 1;
     /* the core's interior: geom_point_body_core measures to its boundary features only */
-    if (dim == 2 && s->nv >= 3 && s->ne == s->nv)
-        return point_in_ring2d(bd, p);
-    if (dim == 3 && bd->convex && s->nf >= 4) {
-        quat q = q_load(bd->q);
-        for (int f = 0; f < s->nf; f++) {
-            vec3 nf = q_rotate(q, geom_face_normal(s, f));
-            vec3 p0 = geom_world_vertex(s, bd->x, bd->q, s->face_v[s->face_start[f]]);
-            if (v3_dot(v3_sub(p, p0), nf) >= 0)
-                return 0;
-        }
-        return 1;
-    }
-    return 0;
+    return geom_point_in_core(s, bd->convex, dim, bd->x, bd->q, p);
 }
 
 /* The bodies a lattice point must stay out of, with the bounding sphere of each about its x to skip

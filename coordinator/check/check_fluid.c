@@ -79,43 +79,14 @@ static double fluid_core_dist(const lahar_case *c, const lahar_check_data *d, in
     return geom_point_body_core(&c->bodies[j].shape, x, q, p, cp, &feature);
 }
 
-/* 1 when p lies inside the closed convex core of body j (3D: a polyhedron of >= 4 faces, p
- * behind every face; 2D: a polygon of >= 3 edges, p on the same side of every edge as the
- * vertex mean). Tells a particle that went deep into a body from one merely far from
- * its surface (geom_point_body_core gives an unsigned distance). */
-static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
+/* 1 when p lies inside the closed core of body j at output k (geom_point_in_core). Tells a
+ * particle that went deep into a body from one merely far from its surface
+ * (geom_point_body_core gives an unsigned distance). */
+static int fluid_inside_core(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
 {
-    const lahar_shape *s = &c->bodies[j].shape;
     double x[3], q[4];
     fluid_pose(c, d, j, k, x, q);
-    if (!c->bodies[j].convex)
-        return 0;
-    if (c->dim == 3) {
-        if (s->nf < 4)
-            return 0;
-        for (int f = 0; f < s->nf; f++) {
-            vec3 n = q_rotate(q_load(q), geom_face_normal(s, f));
-            vec3 v0 = geom_world_vertex(s, x, q, s->face_v[s->face_start[f]]);
-            if (v3_dot(v3_sub(p, v0), n) >= 0.0)
-                return 0;
-        }
-        return 1;
-    }
-    if (s->ne < 3)
-        return 0;
-    /* an interior point: the vertex mean (fixed bodies keep world-frame vertices with x = 0) */
-    vec3 xc = v3(0, 0, 0);
-    for (int i = 0; i < s->nv; i++)
-        xc = v3_add(xc, geom_world_vertex(s, x, q, i));
-    xc = v3_scale(xc, 1.0 / s->nv);
-    for (int e = 0; e < s->ne; e++) {
-        vec3 a = geom_world_vertex(s, x, q, s->e[e][0]), b = geom_world_vertex(s, x, q, s->e[e][1]);
-        vec3 ab = v3_sub(b, a);
-        double sp = ab.x * (p.y - a.y) - ab.y * (p.x - a.x), sc = ab.x * (xc.y - a.y) - ab.y * (xc.x - a.x);
-        if (sp * sc <= 0.0)
-            return 0;
-    }
-    return 1;
+    return geom_point_in_core(&c->bodies[j].shape, c->bodies[j].convex, c->dim, x, q, p);
 }
 
 /* How deep p lies inside the swept solid of body j at body snapshot k (negative: outside):
@@ -123,7 +94,7 @@ static int fluid_inside_convex_core(const lahar_case *c, const lahar_check_data 
 static double fluid_depth(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p)
 {
     double dist = fluid_core_dist(c, d, j, k, p, NULL), R = c->bodies[j].shape.radius;
-    return fluid_inside_convex_core(c, d, j, k, p) ? R + dist : R - dist;
+    return fluid_inside_core(c, d, j, k, p) ? R + dist : R - dist;
 }
 
 /* Unit vector "up" (against gravity) and horizontal unit vectors e1 (and e2 in 3D). */
@@ -1098,7 +1069,7 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
         double x[3], q[4];
         fluid_pose(c, d, b, k, x, q);
         double core = geom_body_core_distance(&disc->shape, x, q, &floor_b->shape, floor_b->x, floor_b->q);
-        if (disc->shape.nv == 1 && fluid_inside_convex_core(c, d, fl, -1, v3_load(x)))
+        if (disc->shape.nv == 1 && fluid_inside_core(c, d, fl, -1, v3_load(x)))
             core = -fluid_core_dist(c, d, fl, -1, v3_load(x), NULL); /* centre inside the floor's core */
         gap = core - Rd - Rf;
         pen = fmax(pen, Rd - core); /* the disc's surface past the floor's core */

@@ -75,7 +75,7 @@ static double ghost_layers_curved(const kernel *k, int dim, double d, double dx,
     return g;
 }
 
-/* ---- SPH_WALL_PRESSURE_GHOST (sph_coupling.h) ----
+/* ---- LAHAR_SPH_WALL_PRESSURE_GHOST (sph_coupling.h) ----
  * A region of ghosts (volume V_g, pressure p_g = pbar_i + rho_i b.r_g, r_g = x_g - x_i, density
  * rho_i, moving with the wall) adds to particle i (Trujillo-Vela et al. 2020, eq. 2, symmetric pressure term, and eq. 1,
  * continuity):
@@ -176,33 +176,33 @@ static int ghost_tables(sph_coupling *c, double dx)
     return 0;
 }
 
-int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx)
+int sph_coupling_set_wall_pressure(sph_coupling *c, lahar_sph_wall_pressure mode, const double body_force[3], double dx)
 {
     c->pressure = mode;
     for (int a = 0; a < 3; a++)
         c->body_force[a] = body_force[a];
-    if (mode != SPH_WALL_PRESSURE_GHOST)
+    if (mode != LAHAR_SPH_WALL_PRESSURE_GHOST)
         return 0;
     if (ghost_tables(c, dx) != 0) {
-        c->pressure = SPH_WALL_PRESSURE_PENALTY;
+        c->pressure = LAHAR_SPH_WALL_PRESSURE_PENALTY;
         return -1;
     }
     return 0;
 }
 
-int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx)
+int sph_coupling_set_soil_wall(sph_coupling *c, lahar_sph_wall_pressure mode, const double gravity[3], double dx)
 {
     c->soil_pressure = mode;
     for (int a = 0; a < 3; a++)
         c->soil_g[a] = gravity[a];
-    if (mode != SPH_WALL_PRESSURE_GHOST)
+    if (mode != LAHAR_SPH_WALL_PRESSURE_GHOST)
         return 0;
     if (!c->soil_lw)
         c->soil_lw = calloc((size_t)c->pcap, sizeof *c->soil_lw);
     if (!c->soil_lw_on)
         c->soil_lw_on = calloc((size_t)c->pcap, 1);
     if (!c->soil_lw || !c->soil_lw_on || ghost_tables(c, dx) != 0) {
-        c->soil_pressure = SPH_WALL_PRESSURE_PENALTY;
+        c->soil_pressure = LAHAR_SPH_WALL_PRESSURE_PENALTY;
         return -1;
     }
     return 0;
@@ -428,7 +428,7 @@ double sph_coupling_body_halfspace_factor(const sph_coupling *c, int b, double d
 }
 
 int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bodies, const kernel *k, double dx,
-                      double m_sph, double mu, sph_wall_viscous viscous, int64_t particle_cap)
+                      double m_sph, double mu, lahar_sph_wall_viscous viscous, int64_t particle_cap)
 {
     memset(c, 0, sizeof *c);
     c->dim = dim;
@@ -586,37 +586,6 @@ static vec3 coupling_soil_tangential(const sph_coupling *c, int64_t id, int b, v
     return v3_scale(d, -kn);                            /* eq. 25 */
 }
 
-/* 1 when p lies inside the closed core: a convex polyhedron (all face planes) in 3D, a closed
- * polygon (crossing number in the x-y plane) in 2D. Open or non-convex 3D cores: 0. */
-static int inside_core(const lahar_body *body, const double x[3], const double q[4], vec3 p, int dim)
-{
-    const lahar_shape *s = &body->shape;
-    /* in the shape's frame (one rotation of p; fixed bodies: the same frame bit for bit) */
-    const vec3 pb = q_rotate_inv(q_load(q), v3_sub(p, v3_load(x)));
-    if (dim == 3) {
-        if (s->nf < 4 || !body->convex)
-            return 0;
-        for (int f = 0; f < s->nf; f++) {
-            vec3 a = v3_load(s->v[s->face_v[s->face_start[f]]]);
-            if (v3_dot(v3_sub(pb, a), geom_face_normal(s, f)) >= 0.0)
-                return 0;
-        }
-        return 1;
-    }
-    if (s->nv < 3 || s->ne != s->nv)
-        return 0;
-    int in = 0;
-    for (int e = 0; e < s->ne; e++) {
-        vec3 a = v3_load(s->v[s->e[e][0]]), b = v3_load(s->v[s->e[e][1]]);
-        if ((a.y > pb.y) != (b.y > pb.y)) {
-            double xc = a.x + (pb.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if (pb.x < xc)
-                in = !in;
-        }
-    }
-    return in;
-}
-
 void sph_coupling_mark(sph_coupling *c, const sph_cells *cells, int64_t n, const lahar_body_state *states)
 {
     c->near_valid = 0;
@@ -750,7 +719,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
                                                                        &core, NULL)
                                            : geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
-                int inside = inside_core(body, bx, bq, xi, c->dim); /* deep inside: far from the surface */
+                int inside = geom_point_in_core(&body->shape, body->convex, c->dim, bx, bq, xi); /* deep inside: far from the surface */
                 if (dc - R >= support && !inside)
                     continue;
                 if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
@@ -777,7 +746,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                                    v3_add(v3_load(bv), v3_cross(v3_load(bw), v3_sub(xs, xb))));
                 double dv = fmax(d, 0.5 * c->eps); /* the viscous term's distance, kept off zero */
                 double coef;
-                if (c->viscous == SPH_WALL_VISCOUS_HALFSPACE)
+                if (c->viscous == LAHAR_SPH_WALL_HALFSPACE)
                     coef = 2.0 * c->mu / p->rho[i] * sph_coupling_body_halfspace_factor(c, b, dv);
                 else /* eq. 17 as printed */
                     coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
@@ -788,7 +757,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                  * the friction cap */
                 vec3 fg = v3(0, 0, 0);
                 double fgn = 0.0;
-                if (p->phase[i] != 0 && c->soil_pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->sig[0]) {
+                if (p->phase[i] != 0 && c->soil_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !cross && p->sig[0]) {
                     if (!have_sbar) {
                         ghost_soil_sigbar(c, p, i, sbar);
                         for (int a = 0; a < SPH_NSTRESS; a++)
@@ -813,7 +782,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 }
                 vec3 f = v3_add(v3_add(fn, ft), fg);
                 gd[ns] = -1.0;
-                if (c->pressure == SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
+                if (c->pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
                     double drw;
                     if (pbar != pbar)
                         pbar = ghost_pbar(c, p, i);

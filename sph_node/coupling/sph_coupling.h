@@ -9,7 +9,7 @@
  *   delta = eps - d, eps = dx/2 the halo (eq. 14)
  *   F_n  = K_n delta n when delta > 0, K_n = 0.1 m_min / dt^2 (eq. 15)
  *   u_rel = u_i - v_dem - w_dem x (x_s - x_dem) (eq. 16; the surface velocity of the body)
- *   F_t  = m_i a_tau, the viscous force of the virtual particle (eq. 17-18, see sph_wall_viscous)
+ *   F_t  = m_i a_tau, the viscous force of the virtual particle (eq. 17-18, see lahar_sph_wall_viscous)
  *   F on the particle = F_n + F_t (eq. 19), on the body -F (eq. 20) at x_s, torque
  *   (x_s - x_dem) x (-F) (eq. 21, printed F x r: the usual r x F is used).
  * A particle closer to the core than R, or inside a closed convex core, has crossed the body's
@@ -24,30 +24,27 @@
 #include "scene.h"
 #include "sph_particles.h"
 
-/* The wall viscous force (virtual particle term). */
-typedef enum {
-    /* Default. The Morris (1997) viscous operator summed over ghost layers behind the body's
-     * surface, at depths s_k = (k + 1/2) dx (the mirror image of the fluid lattice), with the
-     * no-slip ghost velocity extrapolated as in Morris et al. (1997):
-     * u_ghost - u_wall = -(s/d)(u_i - u_wall). Then
-     *   a_tau = (2 mu_i / rho_i) G(d) u_rel,
-     *   G(d) = sum_k (1 + s_k/d) dx int_layer W'(r)/r r^2/(r^2 + eta^2) dA
-     * which is the "readjusted normalising constant" idea of eq. 18 made exact for a flat wall:
-     * the single virtual particle carries the whole missing neighbourhood. G is tabulated at setup
-     * over d in [eps/2, kappa h] (d is clamped to eps/2 below). */
-    SPH_WALL_VISCOUS_HALFSPACE = 0,
-    /* Eq. 17 as printed: a_tau = 4 m_i/(3 h^D) (2 mu_i)/(2 rho_i)^2 u_rel/d W'(d)/W(0, h). Its
-     * factor disagrees with eq. 18 (2/(3 h^D W(0,h))) and neither gives the wall shear of a
-     * Poiseuille flow (tests/test_sph_poiseuille.c reports its error): kept for comparison. */
-    SPH_WALL_VISCOUS_PAPER = 1,
-} sph_wall_viscous;
+/* The wall viscous force (virtual particle term), lahar_sph_wall_viscous (common/scene/scene.h):
+ * LAHAR_SPH_WALL_HALFSPACE (default): the Morris (1997) viscous operator summed over ghost layers
+ *   behind the body's surface, at depths s_k = (k + 1/2) dx (the mirror image of the fluid
+ *   lattice), with the no-slip ghost velocity extrapolated as in Morris et al. (1997):
+ *   u_ghost - u_wall = -(s/d)(u_i - u_wall). Then
+ *     a_tau = (2 mu_i / rho_i) G(d) u_rel,
+ *     G(d) = sum_k (1 + s_k/d) dx int_layer W'(r)/r r^2/(r^2 + eta^2) dA
+ *   which is the "readjusted normalising constant" idea of eq. 18 made exact for a flat wall:
+ *   the single virtual particle carries the whole missing neighbourhood. G is tabulated at setup
+ *   over d in [eps/2, kappa h] (d is clamped to eps/2 below).
+ * LAHAR_SPH_WALL_PAPER: eq. 17 as printed: a_tau = 4 m_i/(3 h^D) (2 mu_i)/(2 rho_i)^2 u_rel/d
+ *   W'(d)/W(0, h). Its factor disagrees with eq. 18 (2/(3 h^D W(0,h))) and neither gives the wall
+ *   shear of a Poiseuille flow (tests/test_sph_poiseuille.c reports its error): kept for comparison. */
 
-/* The wall pressure term: what, besides the penalty force of eq. 15, holds the fluid off a body.
+/* The wall pressure term, lahar_sph_wall_pressure (common/scene/scene.h): what, besides the penalty
+ * force of eq. 15, holds the fluid off a body.
  * PENALTY (default): Trujillo-Vela et al. 2020 as printed, K_n delta n only. A particle in the second row from a
  *   wall (d > eps) misses the kernel neighbours behind the wall and nothing replaces them, so the
  *   first rows carry it with a pressure rise: hydrostatic pressures near a floor read 4-6 % high.
  * GHOST: the penalty force plus the pressure and continuity terms of Trujillo-Vela et al. 2020, eq. 1-2 summed over
- *   ghost layers behind the surface, the same layers as SPH_WALL_VISCOUS_HALFSPACE (depths
+ *   ghost layers behind the surface, the same layers as LAHAR_SPH_WALL_HALFSPACE (depths
  *   s_k = (k + 1/2) dx, continuous along the wall, moving with it). The ghost pressure is
  *   extrapolated hydrostatically (Adami, Hu & Adams 2012, eq. 27, wall at rest) from pbar_i, the
  *   Shepard mean of the pressures around particle i carried to x_i:
@@ -66,7 +63,6 @@ typedef enum {
  *   pressure gradient is outside this model (validated: tanks at rest only). Measured (tests/
  *   test_sph_hydrostatic.c, cases/README.md): tank at rest, wall force and pressure L2 within
  *   0.7 % in 2D and 3D, against 1-6 % and 3-15 % with the penalty alone. */
-typedef enum { SPH_WALL_PRESSURE_PENALTY = 0, SPH_WALL_PRESSURE_GHOST = 1 } sph_wall_pressure;
 #define SPH_COUPLING_WTAB 48
 #define SPH_COUPLING_QTAB 24
 
@@ -93,11 +89,11 @@ typedef struct {
     double m_min;              /* eq. 15 */
     double kn;                 /* K_n of the last evaluation */
     double mu;                 /* fluid dynamic viscosity */
-    sph_wall_viscous viscous;
+    lahar_sph_wall_viscous viscous;
     double gtab[SPH_COUPLING_GTAB + 1], gtab_d0, gtab_dd; /* G(d) on d = d0 + k dd */
     double **gtab_body;        /* per body: G(d) of a disc/sphere (one core point), layers curved
                                   with its surface; NULL entries (and NULL): the flat gtab */
-    sph_wall_pressure pressure;  /* sph_coupling_set_wall_pressure; default penalty only */
+    lahar_sph_wall_pressure pressure;  /* sph_coupling_set_wall_pressure; default penalty only */
     double kn_dt;                /* > 0: K_n = 0.1 m_min / kn_dt^2 whatever the step (sph.penalty_stiffness:
                                     acoustic, kn_dt = cfl h / c0); 0 (default): the step's dt, eq. 15
                                     as printed. With the step's dt the penalty spring's period stays
@@ -112,7 +108,7 @@ typedef struct {
     double *wtab, wtab_dd;       /* GHOST: wall table (sph_coupling.c) on d = gtab_d0 + k wtab_dd */
     double *qtab, qtab_dd;       /* GHOST: corner table on d = gtab_d0 + k qtab_dd */
     const sph_cells *cells;      /* GHOST: the fluid's cells (borrowed), for the ghosts' pressure */
-    sph_wall_pressure soil_pressure; /* sph_coupling_set_soil_wall; default penalty + spring only */
+    lahar_sph_wall_pressure soil_pressure; /* sph_coupling_set_soil_wall; default penalty + spring only */
     double soil_g[3];            /* the soil's gravity (its ghost stress extrapolation) */
     double (*soil_lw)[9];        /* soil GHOST: per particle, the ghosts' share of the velocity
                                     gradient (L_ab at 3a + b) of the last evaluation */
@@ -154,7 +150,7 @@ typedef struct {
  * m_min = min(particle mass m_sph, masses of free bodies) (eq. 15), dynamic viscosity mu, for
  * particle_cap particles. Returns 0 or -1 (out of memory). */
 int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bodies, const kernel *k, double dx,
-                      double m_sph, double mu, sph_wall_viscous viscous, int64_t particle_cap);
+                      double m_sph, double mu, lahar_sph_wall_viscous viscous, int64_t particle_cap);
 void sph_coupling_free(sph_coupling *c);
 
 /* Add the coupling forces (eq. 19) to the particle accelerations p->ax.. (divided by the
@@ -190,13 +186,13 @@ void sph_coupling_set_periodic(sph_coupling *c, const int periodic[3], const dou
  * history for the particle cap of the coupling. Returns 0 or -1 (out of memory). */
 int sph_coupling_enable_soil(sph_coupling *c, double mu_phi);
 
-/* Choose the wall pressure term (default SPH_WALL_PRESSURE_PENALTY) with the fluid's body force b
+/* Choose the wall pressure term (default LAHAR_SPH_WALL_PRESSURE_PENALTY) with the fluid's body force b
  * (m/s^2) and the particle spacing dx; GHOST tabulates its integrals here (a fraction of a second
  * in 3D). Returns 0 or -1 (out of memory). */
-int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, const double body_force[3], double dx);
+int sph_coupling_set_wall_pressure(sph_coupling *c, lahar_sph_wall_pressure mode, const double body_force[3], double dx);
 
-/* The soil's wall term (default SPH_WALL_PRESSURE_PENALTY: the penalty force of eq. 15 and the
- * friction spring of eq. 22-27 only). GHOST: the ghost layers of SPH_WALL_PRESSURE_GHOST (the same
+/* The soil's wall term (default LAHAR_SPH_WALL_PRESSURE_PENALTY: the penalty force of eq. 15 and the
+ * friction spring of eq. 22-27 only). GHOST: the ghost layers of LAHAR_SPH_WALL_PRESSURE_GHOST (the same
  * tables) carry a stress for the soil particles too, in the spirit of Bui et al. (2008, section
  * 4.2, boundary particles whose stress is the soil's) and Adami, Hu & Adams (2012, eq. 27):
  *   sigma_g = sigmabar_i - rho_i g.(x_g - x_i) I,
@@ -234,7 +230,7 @@ int sph_coupling_set_wall_pressure(sph_coupling *c, sph_wall_pressure mode, cons
  * a = 2, dx 10 mm, no change at rest: not kept), and the concave-corner correction of the water
  * is not applied to the soil (the quadrant behind floor and wall counts twice).
  * Returns 0 or -1 (out of memory). */
-int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const double gravity[3], double dx);
+int sph_coupling_set_soil_wall(sph_coupling *c, lahar_sph_wall_pressure mode, const double gravity[3], double dx);
 
 /* Before sph_coupling_apply, with the cells sorted for the particles' current positions: marks,
  * per particle, the bodies whose box (fixed: the world box of the swept shape; moving: the
@@ -244,7 +240,7 @@ int sph_coupling_set_soil_wall(sph_coupling *c, sph_wall_pressure mode, const do
  * body) with 32 bodies or more or a periodic axis. One apply uses the marks, then they lapse. */
 void sph_coupling_mark(sph_coupling *c, const sph_cells *cells, int64_t n, const lahar_body_state *states);
 
-/* G(d) of the half-space wall model (see SPH_WALL_VISCOUS_HALFSPACE), for tests. */
+/* G(d) of the half-space wall model (see LAHAR_SPH_WALL_HALFSPACE), for tests. */
 double sph_coupling_halfspace_factor(const sph_coupling *c, double d);
 /* The same for body b: its curved table when it is a disc or sphere, else the flat one. */
 double sph_coupling_body_halfspace_factor(const sph_coupling *c, int b, double d);

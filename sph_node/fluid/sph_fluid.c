@@ -140,7 +140,7 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
         for (int a = 0; a < 3; a++)
             gs[a] = f->prm.periodic[a] ? 0.0 : f->prm.soil_mat.gravity[a];
         if (sph_coupling_set_soil_wall(&f->cpl, f->prm.soil_wall_stress, gs, f->prm.dx) != 0 ||
-            (f->prm.soil_wall_stress == SPH_WALL_PRESSURE_GHOST && sph_soil_keep_gradient(&f->soil) != 0)) {
+            (f->prm.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST && sph_soil_keep_gradient(&f->soil) != 0)) {
             sph_coupling_free(&f->cpl);
             return -1;
         }
@@ -167,7 +167,7 @@ void sph_fluid_free(sph_fluid *f)
 
 double sph_fluid_pressure(const sph_params *prm, double rho)
 {
-    if (prm->eos == SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 */
+    if (prm->eos == LAHAR_SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 */
         return prm->rho0 * prm->c0 * prm->c0 / prm->gamma * (pow(rho / prm->rho0, prm->gamma) - 1.0);
     return prm->c0 * prm->c0 * (rho - prm->rho0); /* Trujillo-Vela et al. 2020, eq. 3 */
 }

@@ -66,7 +66,6 @@
 #include "sph_particles.h"
 #include "sph_soil.h"
 
-typedef enum { SPH_EOS_LINEAR = 0, SPH_EOS_TAIT = 1 } sph_eos;
 
 typedef struct {
     int dim;
@@ -75,7 +74,7 @@ typedef struct {
     double h_over_dx;       /* smoothing length h = h_over_dx dx (default 1.3 when 0) */
     double rho0;            /* rest density */
     double c0;              /* numerical speed of sound */
-    sph_eos eos;
+    lahar_sph_eos eos;
     double gamma;           /* Tait exponent (default 7 when 0) */
     double mu;              /* dynamic viscosity, Pa s */
     double alpha;           /* Monaghan artificial viscosity, 0 = off */
@@ -84,11 +83,11 @@ typedef struct {
     double cfl, cfl_force, cfl_visc; /* defaults 0.25, 0.25, 0.125 when 0 */
     int periodic[3];        /* 1: axis periodic with period [lo, hi) */
     double lo[3], hi[3];
-    sph_wall_viscous wall_viscous;
-    sph_wall_pressure wall_pressure; /* default penalty only (Trujillo-Vela et al. 2020 eq. 15); sph_coupling.h */
+    lahar_sph_wall_viscous wall_viscous;
+    lahar_sph_wall_pressure wall_pressure; /* default penalty only (Trujillo-Vela et al. 2020 eq. 15); sph_coupling.h */
     int penalty_acoustic;   /* 1: K_n of eq. 15 with the acoustic step cfl h / c0, not the step's dt
                                (sph_coupling.kn_dt); 0 (default): the step's dt as printed */
-    sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
+    lahar_sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
     int shepard_every;      /* Shepard density filter every N steps (Canelas et al. 2015, eq. 5), 0 = off */
     double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
     int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */
