@@ -5,15 +5,11 @@
 # step when dt_max is forced to the DEM's stable dt. Speed is never asserted.
 set(LAHAR_BENCH_OUT ${CMAKE_CURRENT_BINARY_DIR}/bench_quick)
 set(LAHAR_BENCH_QUICK_CASES poiseuille_2d,dam_break_2d,soil_block_incline_2d)
-add_test(NAME bench_quick
-  COMMAND sh -c "rm -rf \"$1\" && \"$0\" bench --quick --cases $3 -o \"$1\" && \"$2\" \"$4\" \"$1\" pareto,overhead,subcycle $3"
-          $<TARGET_FILE:lahar> ${LAHAR_BENCH_OUT} ${LAHAR_BENCH_PYTHON} ${LAHAR_BENCH_QUICK_CASES}
-          ${LAHAR_TEST_DIR}/test_bench_output.py)
-set_tests_properties(bench_quick PROPERTIES LABELS "slow;netns;bench" TIMEOUT 600
-  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_BENCH_PYTHON}")
+lahar_test(bench_quick COMMAND sh -c "rm -rf \"$1\" && \"$0\" bench --quick --cases $3 -o \"$1\" && \"$2\" \"$4\" \"$1\" pareto,overhead,subcycle $3" $<TARGET_FILE:lahar> ${LAHAR_BENCH_OUT} ${LAHAR_BENCH_PYTHON} ${LAHAR_BENCH_QUICK_CASES} ${LAHAR_TEST_DIR}/test_bench_output.py
+  LABELS slow netns bench TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_BENCH_PYTHON}")
 
 # The converged solution the bench measures an experiment case's error against (Richardson
 # extrapolation, or the finest run when the sweep does not converge monotonically), on synthetic
 # sweeps with a known limit and order.
-add_test(NAME bench_converged_reference COMMAND ${LAHAR_BENCH_PYTHON} ${LAHAR_TEST_DIR}/test_bench_converged.py)
-set_tests_properties(bench_converged_reference PROPERTIES LABELS "fast;bench" TIMEOUT 60)
+lahar_test(bench_converged_reference COMMAND ${LAHAR_BENCH_PYTHON} ${LAHAR_TEST_DIR}/test_bench_converged.py
+  LABELS fast bench TIMEOUT 60)

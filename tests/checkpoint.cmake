@@ -5,11 +5,8 @@
 # network namespace (label netns) or --in-process.
 # checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
 function(lahar_checkpoint_test name labels)
-  add_test(NAME checkpoint_${name}
-           COMMAND bash ${LAHAR_TEST_DIR}/checkpoint_runs.sh ${name} $<TARGET_FILE_DIR:lahar>
-                   ${CMAKE_SOURCE_DIR}/tools ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/checkpoint_${name})
-  set_tests_properties(checkpoint_${name} PROPERTIES LABELS "${labels}" TIMEOUT 180
-                       REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
+    lahar_test(checkpoint_${name} COMMAND bash ${LAHAR_TEST_DIR}/checkpoint_runs.sh ${name} $<TARGET_FILE_DIR:lahar> ${CMAKE_SOURCE_DIR}/tools ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/checkpoint_${name}
+    LABELS ${labels} TIMEOUT 180 PROPERTIES REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
 endfunction()
 lahar_checkpoint_test(water "slow;netns;checkpoint")
 lahar_checkpoint_test(dem "fast;netns;checkpoint")

@@ -4,11 +4,8 @@
 # counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR (runs --in-process; `processes` runs the nodes as
 # processes in lahar's own private network namespace: label netns).
 function(lahar_counters_test name labels)
-  add_test(NAME counters_${name}
-           COMMAND bash ${LAHAR_TEST_DIR}/counters_runs.sh ${name} $<TARGET_FILE_DIR:lahar>
-                   ${CMAKE_SOURCE_DIR}/tools ${CMAKE_CURRENT_BINARY_DIR}/counters_${name})
-  set_tests_properties(counters_${name} PROPERTIES LABELS "${labels}" TIMEOUT 180
-                       REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
+    lahar_test(counters_${name} COMMAND bash ${LAHAR_TEST_DIR}/counters_runs.sh ${name} $<TARGET_FILE_DIR:lahar> ${CMAKE_SOURCE_DIR}/tools ${CMAKE_CURRENT_BINARY_DIR}/counters_${name}
+    LABELS ${labels} TIMEOUT 180 PROPERTIES REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
 endfunction()
 lahar_counters_test(water_only "fast;counters")
 lahar_counters_test(soil_water "fast;counters")

@@ -1,38 +1,25 @@
 # Protocol, coordinator and nodes (brief C): common/protocol/link.c, common/protocol/transport.c, common/protocol/netns.c,
 # coordinator/, dem_node/dem_node.c, sph_node/. The run tests need `unshare` of user + network
 # namespaces and nft (label netns); each multicast run happens in a private namespace.
-add_executable(test_coupling_clock ${LAHAR_TEST_DIR}/test_coupling_clock.c)
-target_link_libraries(test_coupling_clock PRIVATE lahar_coord)
-add_test(NAME coupling_clock COMMAND test_coupling_clock)
-set_tests_properties(coupling_clock PROPERTIES LABELS "fast;coupling")
+lahar_test(coupling_clock PROGRAM test_coupling_clock SOURCES test_coupling_clock.c
+  LIBS lahar_coord LABELS fast coupling)
 
-add_executable(test_coupling_link ${LAHAR_TEST_DIR}/test_coupling_link.c)
-target_link_libraries(test_coupling_link PRIVATE lahar_common)
-add_test(NAME coupling_link COMMAND test_coupling_link)
-set_tests_properties(coupling_link PROPERTIES LABELS "fast;coupling" TIMEOUT 60)
+lahar_test(coupling_link PROGRAM test_coupling_link SOURCES test_coupling_link.c
+  LABELS fast coupling TIMEOUT 60)
 
-add_executable(test_coupling_msg ${LAHAR_TEST_DIR}/test_coupling_msg.c)
-target_link_libraries(test_coupling_msg PRIVATE lahar_common)
-add_test(NAME coupling_msg COMMAND test_coupling_msg)
-set_tests_properties(coupling_msg PROPERTIES LABELS "fast;coupling")
+lahar_test(coupling_msg PROGRAM test_coupling_msg SOURCES test_coupling_msg.c LABELS fast coupling)
 
-add_executable(test_coupling_scene ${LAHAR_TEST_DIR}/test_coupling_scene.c)
-target_link_libraries(test_coupling_scene PRIVATE lahar_common)
-add_test(NAME coupling_scene COMMAND test_coupling_scene ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR})
-set_tests_properties(coupling_scene PROPERTIES LABELS "fast;coupling")
+lahar_test(coupling_scene PROGRAM test_coupling_scene SOURCES test_coupling_scene.c
+  ARGS ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR} LABELS fast coupling)
 
-add_executable(test_sph_particles ${LAHAR_TEST_DIR}/test_sph_particles.c)
-target_link_libraries(test_sph_particles PRIVATE lahar_sph)
-add_test(NAME sph_particles COMMAND test_sph_particles)
-set_tests_properties(sph_particles PROPERTIES LABELS "fast;coupling")
+lahar_test(sph_particles PROGRAM test_sph_particles SOURCES test_sph_particles.c
+  LIBS lahar_sph LABELS fast coupling)
 
 # coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 function(lahar_coupling_run_test name labels)
-  add_test(NAME coupling_${name}
-           COMMAND bash ${LAHAR_TEST_DIR}/coupling_runs.sh ${name} $<TARGET_FILE_DIR:lahar>
-                   ${CMAKE_SOURCE_DIR}/tools ${CMAKE_CURRENT_BINARY_DIR}/coupling_${name})
-  set_tests_properties(coupling_${name} PROPERTIES LABELS "${labels}" TIMEOUT 180
-                       DEPENDS "" REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
+    lahar_test(coupling_${name} COMMAND bash ${LAHAR_TEST_DIR}/coupling_runs.sh ${name} $<TARGET_FILE_DIR:lahar> ${CMAKE_SOURCE_DIR}/tools ${CMAKE_CURRENT_BINARY_DIR}/coupling_${name}
+    LABELS ${labels} TIMEOUT 180
+    PROPERTIES REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
 endfunction()
 lahar_coupling_run_test(inprocess_both "fast;coupling")
 lahar_coupling_run_test(processes "fast;netns;coupling")

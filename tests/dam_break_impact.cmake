@@ -4,7 +4,5 @@
 # sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 (the case's level gauges)
 # within 0.05 H (mean over t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
 # measured values: cases/README.md "Lobovsky dam break".
-add_test(NAME sph_dam_break_lobovsky_2d
-  COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/lobovsky_check.py $<TARGET_FILE:lahar>
-          ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d)
-set_tests_properties(sph_dam_break_lobovsky_2d PROPERTIES LABELS "sph;validation;slow" TIMEOUT 300)
+lahar_test(sph_dam_break_lobovsky_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/lobovsky_check.py $<TARGET_FILE:lahar> ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d
+  LABELS sph validation slow TIMEOUT 300)

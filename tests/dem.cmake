@@ -3,8 +3,7 @@ function(lahar_dem_test name label)
   add_executable(${name} ${LAHAR_TEST_DIR}/${name}.c ${LAHAR_TEST_DIR}/dem_test_util.c)
   target_include_directories(${name} PRIVATE ${LAHAR_TEST_DIR})
   target_link_libraries(${name} PRIVATE lahar_dem)
-  add_test(NAME ${name} COMMAND ${name})
-  set_tests_properties(${name} PROPERTIES LABELS "${label};dem" TIMEOUT 300)
+    lahar_test(${name} COMMAND ${name} LABELS ${label} dem TIMEOUT 300)
 endfunction()
 
 lahar_dem_test(test_geometry fast)
@@ -25,8 +24,7 @@ target_link_libraries(lahar_dem_pile PUBLIC lahar_dem)
 add_executable(test_dem_noalloc ${LAHAR_TEST_DIR}/test_dem_noalloc.c)
 target_link_libraries(test_dem_noalloc PRIVATE lahar_dem_pile
   -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
-add_test(NAME test_dem_noalloc COMMAND test_dem_noalloc)
-set_tests_properties(test_dem_noalloc PROPERTIES LABELS "fast;dem" TIMEOUT 300)
+lahar_test(test_dem_noalloc COMMAND test_dem_noalloc LABELS fast dem TIMEOUT 300)
 
 # Benchmarks (tests/bench/, not ctest tests: they print a table and never fail on time).
 # `cmake --build <dir> --target bench` builds and runs bench_dem with its default sizes.

@@ -18,8 +18,8 @@ foreach(t ${LAHAR_FUZZ_TARGETS})
   target_include_directories(fuzz_${t}_replay PRIVATE ${LAHAR_FUZZ_DIR})
   target_compile_definitions(fuzz_${t}_replay PRIVATE LAHAR_FUZZ_CASE_PATH="${CMAKE_SOURCE_DIR}/cases/fuzz.yaml")
   target_link_libraries(fuzz_${t}_replay PRIVATE lahar_common)
-  add_test(NAME fuzz_${t}_replay COMMAND fuzz_${t}_replay ${LAHAR_FUZZ_${t}_SEEDS} ${LAHAR_FUZZ_DIR}/regressions/${t})
-  set_tests_properties(fuzz_${t}_replay PROPERTIES LABELS "fast;fuzz")
+    lahar_test(fuzz_${t}_replay COMMAND fuzz_${t}_replay ${LAHAR_FUZZ_${t}_SEEDS} ${LAHAR_FUZZ_DIR}/regressions/${t}
+    LABELS fast fuzz)
 endforeach()
 
 # the message seeds: tests/fuzz/make_seeds.c (rerun and commit when a message type changes)

@@ -8,18 +8,16 @@
 # soil + M g sin(theta); the first impact between the frictionless dam-break front on the slope
 # and a rigid block sliding with mu_phi = tan 26 deg. Measured values: cases/README.md ("Granular
 # impact").
-add_test(NAME soil_granular_impact_3d
+lahar_test(soil_granular_impact_3d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_impact_3d.yaml
-          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_impact_3d dx=0.05 end=1.2 threads=2)
+          ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_impact_3d dx=0.05 end=1.2 threads=2
+  LABELS slow validation soil TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 # The same with no soil-bed friction (mu_phi = 0 on every DEM surface): the sand arrives unbraked and
 # the check must fail on its peak (measured 3243 N against an estimate of 631 N at dx 50 mm, 45 deg;
 # the case itself: 439 N against 487 N). Shows that the peak metric catches broken friction.
-add_test(NAME soil_granular_impact_no_friction_fails_3d
+lahar_test(soil_granular_impact_no_friction_fails_3d
   COMMAND sh ${LAHAR_TEST_DIR}/impact_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_impact_3d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_impact_no_friction_3d materials.sand.friction=0
-          -- dx=0.05 end=1.2 threads=2)
-set_tests_properties(soil_granular_impact_no_friction_fails_3d PROPERTIES ENVIRONMENT
-  "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON};EXPECT_FAIL=peak_to_load_estimate_log;LAHAR_CHECK_NO_PLOT=1")
-set_tests_properties(soil_granular_impact_3d PROPERTIES ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
-set_tests_properties(soil_granular_impact_3d soil_granular_impact_no_friction_fails_3d PROPERTIES
-  LABELS "slow;validation;soil" TIMEOUT 600)
+          -- dx=0.05 end=1.2 threads=2
+  LABELS slow validation soil TIMEOUT 600
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}" EXPECT_FAIL=peak_to_load_estimate_log LAHAR_CHECK_NO_PLOT=1)

@@ -10,5 +10,5 @@ add_dependencies(bench bench_sph_table)
 # No allocation inside the SPH step in the steady state: malloc & co. wrapped by the linker.
 add_executable(test_sph_noalloc ${LAHAR_TEST_DIR}/test_sph_noalloc.c)
 target_link_libraries(test_sph_noalloc PRIVATE lahar_sph -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
-add_test(NAME sph_noalloc COMMAND test_sph_noalloc)
-set_tests_properties(sph_noalloc PROPERTIES LABELS "fast;perf;sph" TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=2")
+lahar_test(sph_noalloc COMMAND test_sph_noalloc LABELS fast perf sph TIMEOUT 120
+  ENVIRONMENT "OMP_NUM_THREADS=2")

@@ -3,11 +3,9 @@
 # marked and at the failing step) and the safe settings finish. The sweeps that find the limits
 # run on demand: tests/stress/run_stress.sh [--full] (README.md "Stability limits").
 function(lahar_stress_test name)
-  add_test(NAME stress_${name}
-           COMMAND /usr/bin/python3 ${LAHAR_TEST_DIR}/stress/stress.py ci ${name}
-                   --lahar $<TARGET_FILE:lahar> --out ${CMAKE_CURRENT_BINARY_DIR}/stress_${name})
-  set_tests_properties(stress_${name} PROPERTIES LABELS "slow;stress" TIMEOUT 120
-                       REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
+    lahar_test(stress_${name} COMMAND /usr/bin/python3 ${LAHAR_TEST_DIR}/stress/stress.py ci ${name} --lahar $<TARGET_FILE:lahar> --out ${CMAKE_CURRENT_BINARY_DIR}/stress_${name}
+    LABELS slow stress TIMEOUT 120
+    PROPERTIES REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")
 endfunction()
 lahar_stress_test(density_band)
 lahar_stress_test(dt_collapse)
@@ -16,7 +14,4 @@ lahar_stress_test(runaway)
 lahar_stress_test(soil_wall)
 lahar_stress_test(stable)
 
-add_executable(test_instability ${LAHAR_TEST_DIR}/test_instability.c)
-target_link_libraries(test_instability PRIVATE lahar_common)
-add_test(NAME stress_instability_report COMMAND test_instability)
-set_tests_properties(stress_instability_report PROPERTIES LABELS "fast;stress")
+lahar_test(stress_instability_report PROGRAM test_instability SOURCES test_instability.c LABELS fast stress)

@@ -9,20 +9,14 @@ set(LAHAR_VALIDATION_DIR ${CMAKE_CURRENT_BINARY_DIR}/validation)
 
 # name, script arguments after LAHAR CASE OUT
 function(lahar_validation_test name case)
-  add_test(NAME validation_${name}
-    COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/${case}.yaml
-            ${LAHAR_VALIDATION_DIR}/${name} ${ARGN})
-  set_tests_properties(validation_${name} PROPERTIES LABELS "validation;slow" TIMEOUT 600
-    ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+    lahar_test(validation_${name} COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/${case}.yaml ${LAHAR_VALIDATION_DIR}/${name} ${ARGN}
+    LABELS validation slow TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 endfunction()
 
 # Poiseuille (Trujillo-Vela et al. 2020, section 5.1): 20 and 40 particles across H, steady L2 <= 1 % and <= 0.5 %,
 # plate force <= 1 %, both errors fall with resolution.
-add_test(NAME validation_poiseuille_2d
-  COMMAND sh ${LAHAR_TEST_DIR}/validation_poiseuille.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml
-          ${LAHAR_VALIDATION_DIR}/poiseuille_2d)
-set_tests_properties(validation_poiseuille_2d PROPERTIES LABELS "validation;slow" TIMEOUT 600
-  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+lahar_test(validation_poiseuille_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_poiseuille.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml ${LAHAR_VALIDATION_DIR}/poiseuille_2d
+  LABELS validation slow TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 
 # Dam breaks: run without losing a particle or letting one into a wall, written for ParaView
 # (particles and bodies in one XDMF whose every dataset exists).
@@ -84,10 +78,7 @@ lahar_validation_test(lid_driven_cavity_2d lid_driven_cavity_2d dx=0.025 threads
 # threads (tests/validation_taylor_green.sh). At 100 x 100, the case as it is (~25 s CPU): the
 # case's 1 % (measured 0.61 %), L2 <= 0.20 (0.143), mean density within 1.5 % (0.91 %).
 # cases/README.md "Taylor-Green vortex".
-add_test(NAME validation_taylor_green_2d
-  COMMAND sh ${LAHAR_TEST_DIR}/validation_taylor_green.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/taylor_green_2d.yaml
-          ${LAHAR_VALIDATION_DIR}/taylor_green_2d ${LAHAR_OUTPUT_PYTHON})
-set_tests_properties(validation_taylor_green_2d PROPERTIES LABELS "validation;slow" TIMEOUT 600
-  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+lahar_test(validation_taylor_green_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_taylor_green.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/taylor_green_2d.yaml ${LAHAR_VALIDATION_DIR}/taylor_green_2d ${LAHAR_OUTPUT_PYTHON}
+  LABELS validation slow TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 lahar_validation_test(taylor_green_2d_100 taylor_green_2d "velocity_l2_rel_error<=0.20"
   "density_mean_rel_change<=0.015")
