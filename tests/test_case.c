@@ -598,7 +598,7 @@ static void test_cases_dir(const char *dir)
 }
 
 /* The default c0 (10 U_ref) counts the moving bodies: a 20 m/s boulder into still, shallow water
- * (free fall over 0.5 m: 3.1 m/s) must give c0 = 200 m/s, not 31 (README "Stability limits": a
+ * (free fall over 0.5 m: 3.1 m/s) must give c0 = 200 m/s, not 31 (docs/stability.md: a
  * body faster than c0 outruns the water's pressure wave and crosses it). A spinning disc counts
  * its rim: |w| (r_core + radius). Fixed bodies do not count. */
 static void test_default_c0_bodies(const char *tmpdir)

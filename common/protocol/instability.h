@@ -1,7 +1,7 @@
 /* A numerical instability caught by a node or the coordinator: WHAT went wrong, WHERE (a particle
  * or a body: id, name, position) and WHEN (step, time), with the offending value and its limit.
  *
- * The checks (see README.md "Stability limits" and cases/README.md `stability:`):
+ * The checks (see docs/stability.md and cases/README.md `stability:`):
  *   SPH node   non-finite particle state, density outside stability.density_band, a particle
  *              through a DEM surface (the coupling's crossing count)
  *   DEM node   non-finite or runaway body state, a body-body overlap beyond

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Liveness under load and what a fault costs, measured (README.md "Reliability", docs/bench/liveness.md).
+# Liveness under load and what a fault costs, measured (docs/reliability.md, docs/bench/liveness.md).
 #
 #   tests/stress/liveness_load.sh BIN_DIR WORK_DIR [options]
 #     --load N        busy processes put on the machine for the loaded phases (default 8)
