@@ -11,75 +11,48 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
     snprintf(dst, LAHAR_NAME_MAX, "%s", src ? src : "");
 }
 
-/* The kernel string points into o (keep o alive while m is used). */
-static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
+/* The fields a message carries under the same name as the in-memory case, listed once and copied
+ * both ways by the same macros: NUM fields have the same type on both sides, FLAG fields are
+ * booleans sent as int8, CODE fields small integers (enums, counts) sent as int8. A field added to
+ * a .lcm type and to scene.h is added here once. */
+#define SPH_NUM_FIELDS(X) X(h_over_dx) X(c0) X(gamma) X(mu) X(alpha) X(delta) X(cfl) X(cfl_force) X(cfl_visc) \
+    X(shepard_interval) X(shifting) X(background_pressure) X(sps_cs) X(halo) X(kappa)
+#define SPH_FLAG_FIELDS(X) X(shifting_density) X(transport_velocity) X(sps)
+#define SPH_CODE_FIELDS(X) X(eos) X(body_layers) X(wall_viscous) X(initial_pressure) X(wall_pressure) \
+    X(penalty_stiffness) X(soil_wall_stress)
+#define SPH_ARRAY_FIELDS(X) X(body_force) X(lo) X(hi)
+#define MATERIAL_NUM_FIELDS(X) X(density) X(young) X(poisson) X(kn) X(kt_ratio) X(restitution) X(friction) \
+    X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
+#define MATERIAL_CODE_FIELDS(X) X(model)
+
+#define TO_MSG_NUM(f) to->f = from->f;
+#define TO_MSG_FLAG(f) to->f = (int8_t)(from->f != 0);
+#define TO_MSG_CODE(f) to->f = (int8_t)from->f;
+#define FROM_MSG_FLAG(f) to->f = from->f != 0;
+#define FROM_MSG_CODE(f) to->f = from->f;
+#define COPY_ARRAY(f) memcpy(to->f, from->f, sizeof to->f);
+
+/* The kernel string points into from (keep it alive while to is used). */
+static void scene_sph_to_msg(const lahar_sph_options *from, lahar_sph_options_t *to)
 {
-    m->kernel = (char *)o->kernel;
-    m->h_over_dx = o->h_over_dx;
-    m->c0 = o->c0;
-    m->eos = (int8_t)o->eos;
-    m->gamma = o->gamma;
-    m->mu = o->mu;
-    m->alpha = o->alpha;
-    m->delta = o->delta;
-    m->cfl = o->cfl;
-    m->cfl_force = o->cfl_force;
-    m->cfl_visc = o->cfl_visc;
-    memcpy(m->body_force, o->body_force, sizeof m->body_force);
+    to->kernel = (char *)from->kernel;
+    SPH_NUM_FIELDS(TO_MSG_NUM)
+    SPH_FLAG_FIELDS(TO_MSG_FLAG)
+    SPH_CODE_FIELDS(TO_MSG_CODE)
+    SPH_ARRAY_FIELDS(COPY_ARRAY)
     for (int a = 0; a < 3; a++)
-        m->periodic[a] = (int8_t)(o->periodic[a] != 0);
-    memcpy(m->lo, o->lo, sizeof m->lo);
-    memcpy(m->hi, o->hi, sizeof m->hi);
-    m->shepard_interval = o->shepard_interval;
-    m->shifting = o->shifting;
-    m->shifting_density = (int8_t)(o->shifting_density != 0);
-    m->background_pressure = o->background_pressure;
-    m->transport_velocity = (int8_t)(o->transport_velocity != 0);
-    m->body_layers = (int8_t)o->body_layers;
-    m->sps = (int8_t)(o->sps != 0);
-    m->sps_cs = o->sps_cs;
-    m->halo = o->halo;
-    m->kappa = o->kappa;
-    m->wall_viscous = (int8_t)o->wall_viscous;
-    m->initial_pressure = (int8_t)o->initial_pressure;
-    m->wall_pressure = (int8_t)o->wall_pressure;
-    m->penalty_stiffness = (int8_t)o->penalty_stiffness;
-    m->soil_wall_stress = (int8_t)o->soil_wall_stress;
+        to->periodic[a] = (int8_t)(from->periodic[a] != 0);
 }
 
-static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *o)
+static void scene_sph_from_msg(const lahar_sph_options_t *from, lahar_sph_options *to)
 {
-    scene_copy_name(o->kernel, m->kernel);
-    o->h_over_dx = m->h_over_dx;
-    o->c0 = m->c0;
-    o->eos = (lahar_sph_eos)m->eos;
-    o->gamma = m->gamma;
-    o->mu = m->mu;
-    o->alpha = m->alpha;
-    o->delta = m->delta;
-    o->cfl = m->cfl;
-    o->cfl_force = m->cfl_force;
-    o->cfl_visc = m->cfl_visc;
-    memcpy(o->body_force, m->body_force, sizeof o->body_force);
+    scene_copy_name(to->kernel, from->kernel);
+    SPH_NUM_FIELDS(TO_MSG_NUM)
+    SPH_FLAG_FIELDS(FROM_MSG_FLAG)
+    SPH_CODE_FIELDS(FROM_MSG_CODE)
+    SPH_ARRAY_FIELDS(COPY_ARRAY)
     for (int a = 0; a < 3; a++)
-        o->periodic[a] = m->periodic[a] != 0;
-    memcpy(o->lo, m->lo, sizeof o->lo);
-    memcpy(o->hi, m->hi, sizeof o->hi);
-    o->shepard_interval = m->shepard_interval;
-    o->shifting = m->shifting;
-    o->shifting_density = m->shifting_density != 0;
-    o->background_pressure = m->background_pressure;
-    o->transport_velocity = m->transport_velocity != 0;
-    o->body_layers = m->body_layers;
-    o->sps = m->sps != 0;
-    o->sps_cs = m->sps_cs;
-    o->halo = m->halo;
-    o->kappa = m->kappa;
-    o->wall_viscous = (lahar_sph_wall_viscous)m->wall_viscous;
-    o->initial_pressure = (lahar_sph_initial_pressure)m->initial_pressure;
-    o->wall_pressure = (lahar_sph_wall_pressure)m->wall_pressure;
-    o->penalty_stiffness = (lahar_sph_penalty_stiffness)m->penalty_stiffness;
-    o->soil_wall_stress = (lahar_sph_wall_pressure)m->soil_wall_stress;
+        to->periodic[a] = from->periodic[a] != 0;
 }
 
 int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
@@ -136,24 +109,11 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->rate = a->rate;
     }
     for (int i = 0; i < c->nmaterial; i++) {
-        const lahar_material *a = &c->materials[i];
-        lahar_material_t *b = &m->materials[i];
-        b->name = (char *)a->name;
-        b->density = a->density;
-        b->young = a->young;
-        b->poisson = a->poisson;
-        b->kn = a->kn;
-        b->kt_ratio = a->kt_ratio;
-        b->restitution = a->restitution;
-        b->friction = a->friction;
-        b->model = (int8_t)a->model;
-        b->friction_angle = a->friction_angle;
-        b->cohesion = a->cohesion;
-        b->dilatancy = a->dilatancy;
-        b->permeability = a->permeability;
-        b->damping = a->damping;
-        b->av_alpha = a->av_alpha;
-        b->av_beta = a->av_beta;
+        const lahar_material *from = &c->materials[i];
+        lahar_material_t *to = &m->materials[i];
+        to->name = (char *)from->name;
+        MATERIAL_NUM_FIELDS(TO_MSG_NUM)
+        MATERIAL_CODE_FIELDS(TO_MSG_CODE)
     }
     for (int i = 0; i < c->nbody; i++) {
         const lahar_body *a = &c->bodies[i];
@@ -298,24 +258,11 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         goto oom;
     c->nmaterial = m->nmaterial;
     for (int i = 0; i < m->nmaterial; i++) {
-        const lahar_material_t *a = &m->materials[i];
-        lahar_material *b = &c->materials[i];
-        scene_copy_name(b->name, a->name);
-        b->density = a->density;
-        b->young = a->young;
-        b->poisson = a->poisson;
-        b->kn = a->kn;
-        b->kt_ratio = a->kt_ratio;
-        b->restitution = a->restitution;
-        b->friction = a->friction;
-        b->model = (lahar_contact_model)a->model;
-        b->friction_angle = a->friction_angle;
-        b->cohesion = a->cohesion;
-        b->dilatancy = a->dilatancy;
-        b->permeability = a->permeability;
-        b->damping = a->damping;
-        b->av_alpha = a->av_alpha;
-        b->av_beta = a->av_beta;
+        const lahar_material_t *from = &m->materials[i];
+        lahar_material *to = &c->materials[i];
+        scene_copy_name(to->name, from->name);
+        MATERIAL_NUM_FIELDS(TO_MSG_NUM)
+        MATERIAL_CODE_FIELDS(FROM_MSG_CODE)
     }
     c->nbody = m->nbody;
     for (int i = 0; i < m->nbody; i++) {
