@@ -1,4 +1,4 @@
-# `lahar bench` (tools/bench.py, brief BENCH): the --quick preset on two validation cases plus the
+# `lahar bench` (tools/bench.py): the --quick preset on two validation cases plus the
 # overhead (processes over LCM in a private namespace: label netns) and subcycling scenes, then
 # tests/test_bench_output.py checks the CSVs, PNGs and summary.md it wrote: columns, particles x
 # steps / wall, the error column against each run's check.json, n ~ dx^-D, one DEM substep per

@@ -1,4 +1,4 @@
-# Work counters and "nothing computed that a scene does not need" (issue 4, brief COUNTERS):
+# Work counters and "nothing computed that a scene does not need":
 # summary.json "work" (coordinator/README.md) against independent counts, a scene of water and
 # fixed bodies without a DEM node, output fields not asked for not computed.
 # counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR (runs --in-process; `processes` runs the nodes as

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# "Nothing computed that a scene does not need" (issue 4): the work counters of summary.json
+# "Nothing computed that a scene does not need": the work counters of summary.json
 # ("work", coordinator/README.md) against independent counts, through `lahar run --in-process`.
 #
 #   counters_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# SPH-DEM coupling over the protocol, through `lahar run` (brief G): the SPH node's WCSPH solver,
+# SPH-DEM coupling over the protocol, through `lahar run`: the SPH node's WCSPH solver,
 # LOADS / BODY_STATE between the nodes, the force stream and contacts.h5.
 #
 #   coupling_sph_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR

@@ -1,4 +1,4 @@
-# DEM engine and geometry tests (brief A). `fast` ones also run under the sanitizers in CI.
+# DEM engine and geometry tests. `fast` ones also run under the sanitizers in CI.
 function(lahar_dem_test name label)
   add_executable(${name} ${LAHAR_TEST_DIR}/${name}.c ${LAHAR_TEST_DIR}/dem_test_util.c)
   target_include_directories(${name} PRIVATE ${LAHAR_TEST_DIR})

@@ -1,4 +1,4 @@
-# Granular flow impact on a wall (issue 5, Trujillo-Vela et al. 2020 section 5.3; brief IMPACT): `lahar check` on
+# Granular flow impact on a wall (Trujillo-Vela et al. 2020 section 5.3): `lahar check` on
 # cases/granular_impact_3d.yaml at CI resolution, dx = 50 mm (360 particles; the paper's 12.5 mm is
 # 64 times the particles) over the full 1.8 m chute, in-process on 2 threads (~11 s each at load 3).
 # The case's metrics (reference granular_impact, coordinator/check/check_soil.c): no soil particle through the

@@ -1,4 +1,4 @@
-# HDF5/XDMF writers, the SWMR force stream, `lahar check` evaluation, tools/ (brief D).
+# HDF5/XDMF writers, the SWMR force stream, `lahar check` evaluation, tools/.
 # Python parts need python3 with h5py/numpy (Debian's python3-h5py): prefer /usr/bin/python3,
 # where Debian installs them (tools/*.py also re-exec themselves there when h5py is missing).
 set(LAHAR_OUTPUT_TEST_DIR ${CMAKE_BINARY_DIR}/test_output_data)

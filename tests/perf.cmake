@@ -1,4 +1,4 @@
-# SPH speed (brief PERF, issue 4 "Speed targets").
+# SPH speed.
 # The SPH benchmark (tests/bench/bench_sph.c): 80k-particle 2D and 100k-particle 3D dam breaks on
 # 1 and 2 threads, run by the `bench` target after the DEM table (never a pass/fail; it prints a table).
 add_executable(bench_sph EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_sph.c)

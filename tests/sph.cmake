@@ -1,4 +1,4 @@
-# SPH solver core (brief E): kernels (common/kernels/kernel.c), particles, cell lists, WCSPH and the
+# SPH solver core: kernels (common/kernels/kernel.c), particles, cell lists, WCSPH and the
 # SPH-DEM coupling (sph_node/sph_*.c), tested at library level without processes.
 lahar_test(sph_kernel PROGRAM test_kernel SOURCES test_kernel.c LABELS fast sph)
 
@@ -20,7 +20,7 @@ lahar_test(sph_hydrostatic3d PROGRAM test_sph_hydrostatic3d SOURCES test_sph_hyd
 lahar_test(sph_couette PROGRAM test_sph_couette SOURCES test_sph_couette.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 
-# SPS turbulence (brief L): nu_t of a uniform shear, zero force of a constant stress, a shear wave
+# SPS turbulence: nu_t of a uniform shear, zero force of a constant stress, a shear wave
 # against the analytic divergence, a dam break that stays stable.
 lahar_test(sph_sps PROGRAM test_sph_sps SOURCES test_sph_sps.c LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 

@@ -1,4 +1,4 @@
-# sph.initial_pressure (brief M): hydrostatic block densities against the inverse EOS (linear, Tait).
+# sph.initial_pressure: hydrostatic block densities against the inverse EOS (linear, Tait).
 lahar_test(sph_initial_pressure PROGRAM test_sph_initial_pressure SOURCES test_sph_initial_pressure.c
   LIBS lahar_sph ARGS ${CMAKE_CURRENT_BINARY_DIR} LABELS fast sph)
 

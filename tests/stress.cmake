@@ -1,4 +1,4 @@
-# Stability stress suite (issue 4), the short version: an unstable setting is caught (exit 1,
+# Stability stress suite, the short version: an unstable setting is caught (exit 1,
 # status "unstable", what/where/when in summary.json and on stderr, the final snapshots readable,
 # marked and at the failing step) and the safe settings finish. The sweeps that find the limits
 # run on demand: tests/stress/run_stress.sh [--full] (README.md "Stability limits").

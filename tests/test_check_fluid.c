@@ -7,7 +7,7 @@
  *  - poiseuille: H = 0.1, a = 1e-4, rho = 1000, mu = 0.1 (Trujillo-Vela et al. 2020 section 5.1), 20 particles
  *    across; velocity x 1.02 -> steady_l2_rel_error 0.02; plate force x 1.03 -> 0.03;
  *  - cylinder_array: c = 0.1 (K = 24.83), uniform velocity giving U_s exactly; U x 1.06 fails;
- *    the table's interpolation and low-c asymptote (7.981 at c = 0.01, shared/reference/01);
+ *    the table's interpolation and low-c asymptote (7.981 at c = 0.01);
  *  - sphere_array: Zick & Homsy's table, its interpolation and the dilute series (lookup only);
  *  - hydrostatic: 2D tank, h = 0.3 m, p = rho g (h - y), wall forces rho g h^2/2; wall force
  *    x 1.02 and pressure x 1.05 fail; 3D tank of planes (wetted widths per wall), a wall at 0.97

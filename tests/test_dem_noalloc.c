@@ -1,4 +1,4 @@
-/* advance() allocates nothing in the steady state (dem_engine.h contract, brief I).
+/* advance() allocates nothing in the steady state (dem_engine.h contract).
  *
  * This binary is linked with -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free, so
  * every call the engine (a static library linked into it) makes to these functions goes through

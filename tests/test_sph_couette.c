@@ -1,4 +1,4 @@
-/* Transient plane Couette flow (shared/reference/05_analytic_fluid_checks.txt 5.2, Morris et al.
+/* Transient plane Couette flow (Morris et al.
  * 1997 eq. 22): fluid at rest between two DEM plates H = 0.1 m apart, nu = 1e-4 (rho = 1000,
  * mu = 0.1), periodic in x; at t = 0 the upper plate starts moving along x at V0 = 1.25e-3 m/s.
  * The upper plate is a PRESCRIBED body whose pose and velocity are passed to the coupling as body

@@ -1,5 +1,4 @@
-/* 2D hydrostatic water column in a tank of three fixed DEM walls (issue 3, "Hydrostatic tank";
- * shared/reference/05_analytic_fluid_checks.txt 5.6): width W, water depth H = N dx, rho0 = 1000,
+/* 2D hydrostatic water column in a tank of three fixed DEM walls (the hydrostatic closed form): width W, water depth H = N dx, rho0 = 1000,
  * g = 9.81, linear EOS with c0 = 20 sqrt(g H), particles start on the lattice with the
  * hydrostatic density, Monaghan artificial viscosity damps the start-up waves.
  * After settling (t = 2 s), against p = rho0 g (H - y) and the force per unit width

@@ -3,10 +3,10 @@
  * mu = 0.1 (nu = 1e-4), periodic in x. The plates are 2D sphero-rectangles whose swept surfaces
  * lie at y = 0 and y = H; the fluid feels them only through the coupling of Trujillo-Vela et al. 2020 section 4.
  *
- * Reference: the series of shared/reference/05_analytic_fluid_checks.txt section 5.1 (Morris et al.
+ * Reference: the series of Morris et al.
  * 1997 eq. 21, Trujillo-Vela et al. 2020, eq. 28) at t = 2, 5, 10, 20 s and at t = 100 s (steady within 1e-4), and the
  * plate force of Trujillo-Vela et al. 2020, eq. 31 at y = 0 (steady: eq. 32, F = rho a H/2 l per plate, l = the period).
- * Bounds (issue 3): steady L2 relative velocity error <= 1 % with 20 particles across H, <= 0.5 %
+ * Bounds: steady L2 relative velocity error <= 1 % with 20 particles across H, <= 0.5 %
  * with 40; plate force within 1 % at steady state; transient profiles within 2 % (of u_max) and the
  * error falls with resolution. Also bitwise the same plate force with 1 and 2 threads. */
 #include <math.h>

@@ -1,4 +1,4 @@
-# Issue 3 validation cases end to end (brief J): `lahar check` on every case of cases/ with a
+# Validation cases end to end: `lahar check` on every case of cases/ with a
 # check: section, in-process, at a resolution that runs in CI; the test passes when `lahar check`
 # exits 0 (every metric of the case within its bound) and, where the issue asks more than the
 # case's metrics state, when the extra check.json values hold too (tests/validation_check.sh).
@@ -56,7 +56,7 @@ lahar_validation_test(sphere_array_3d_c0.216 sphere_array_3d c=0.216 dx=0.008333
 lahar_validation_test(sinking_disc_2d sinking_disc_2d dx=0.005
   "sink_distance>=0.1" "rotation_deg>=10" "final_speed_rel<=0.05" "rest_gap_rel<=1")
 
-# Hydrostatic tank (issue 3; cases/README.md "Validation results"): side wall force within 1 % of
+# Hydrostatic tank (cases/README.md "Validation results"): side wall force within 1 % of
 # rho g h^2 / 2 (x width in 3D) and particle pressures within 1 % (L2) of rho g (h - y), at dx =
 # 10 mm (20 rows), 2 s in 2D and 1 s in 3D (the tanks start at rest on their lattice, so this is
 # settled: max speed < 1 % of sqrt(g h)); also the free surface level within 5 % of h.

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Runs `lahar check` on an issue-3 case at a CI resolution: copies CASE to OUT/case.yaml with the
+# Runs `lahar check` on a validation case at a CI resolution: copies CASE to OUT/case.yaml with the
 # overrides applied (the case's check: bounds are left as they are), runs the check in-process and
 # exits with its status (0 = every metric within its bound). The main cases stay the single source
 # of the set-up; only the resolution, the duration and the cylinder radius change.

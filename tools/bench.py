@@ -113,7 +113,7 @@ BENCH = {
         error=["front_rel_error"], converged=FRONT_SERIES, target=0.05,
         error_note="surge front against the converged front of the dx sweep (Richardson; column 0.1 x 0.25 x 0.2 m "
                    "instead of the case's 0.3 m wide one); deviation from Martin & Moyce 1952 (n^2 = 2) beside it"),
-    # soil cases (issue 5): `families` names the settings that mean something for the scene (the
+    # soil cases: `families` names the settings that mean something for the scene (the
     # soil has no delta-SPH and no c0: its sound speed is the P-wave speed of its material)
     "soil_geostatic_2d": dict(
         file="soil_geostatic_2d.yaml", overrides={}, soil="sand",  # the 0.1 m period needs dx <= 0.0128

@@ -138,14 +138,14 @@ int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, 
 int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 
 /* Dimensionless drag K = F/(mu U) of a square array of cylinders at solid fraction c (Sangani &
- * Acrivos 1982 Table 1, shared/reference/01: ln K interpolated linearly in c between tabulated
+ * Acrivos 1982 Table 1: ln K interpolated linearly in c between tabulated
  * points, the low-c asymptote below c = 0.05); NAN outside (0, 0.75]. */
 double lahar_check_sangani_acrivos_K(double c);
 /* Zick & Homsy (1982) Table 2, simple cubic array of spheres (dilute series below c = 0.027); NAN outside (0, 0.5236]. */
 double lahar_check_zick_homsy_K(double c);
 
-/* Transient plane Poiseuille flow from rest (Morris et al. 1997 eq. 21, shared/reference/05
- * section 5.1): velocity at distance y from the lower wall of a channel of width H driven by
+/* Transient plane Poiseuille flow from rest (Morris et al. 1997 eq. 21
+ * ): velocity at distance y from the lower wall of a channel of width H driven by
  * the acceleration a, kinematic viscosity nu, time t; and the shear force per unit wall area on
  * one wall, rho nu du/dy at the wall (steady value rho a H / 2, Trujillo-Vela et al. 2020 eq. 31-32). */
 double lahar_check_poiseuille_u(double y, double t, double H, double a, double nu);

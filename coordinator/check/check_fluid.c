@@ -1,4 +1,4 @@
-/* `lahar check` references of the SPH cases (issue 3; table in check.c, names and metrics in
+/* `lahar check` references of the SPH cases (table in check.c, names and metrics in
  * cases/README.md). Each evaluator reads what it needs from the case (fluid properties from
  * sph:, the driving acceleration gravity + sph.body_force, periods, bodies' geometry) and from
  * the run's output (particles.h5 snapshots, bodies.h5 poses, forces.h5 rows), computes its
@@ -243,7 +243,7 @@ static int fluid_first_free(const lahar_case *c)
 
 /* ---------------------------------------------------------------- poiseuille ------------ */
 
-/* Series of shared/reference/05 section 5.1 (Morris et al. 1997 eq. 21), terms until the next
+/* Series of Morris et al. 1997 eq. 21, terms until the next
  * is below 1e-13 of the steady maximum (the terms decrease monotonically in n). */
 double lahar_check_poiseuille_u(double y, double t, double H, double a, double nu)
 {
@@ -478,7 +478,7 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
              "u along the driving acceleration, y from the lower plate's surface; plate force per unit plate length "
              "F/L = tau W, tau = rho nu du/dy at the wall");
     snprintf(r->note, sizeof r->note,
-             "plates %s (y = 0) and %s; u(y,t): transient series of shared/reference/05 section 5.1 (Morris et al. "
+             "plates %s (y = 0) and %s; u(y,t): transient series (Morris et al. "
              "1997 eq. 21); plate force: late-window mean along the flow vs tau(t) L W, steady tau = rho a H/2 "
              "(Trujillo-Vela et al. 2020 eq. 31-32)",
              c->bodies[lo].name, c->bodies[hi].name);
@@ -488,7 +488,7 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
 
 /* ---------------------------------------------------------------- cylinder array -------- */
 
-/* Sangani & Acrivos (1982) Table 1, square array, as in shared/reference/01. */
+/* Sangani & Acrivos (1982) Table 1, square array . */
 static const double sa_c[] = {0.05, 0.10, 0.20, 0.30, 0.40, 0.50, 0.60, 0.70, 0.75};
 static const double sa_K[] = {15.56, 24.83, 51.53, 102.90, 217.89, 532.55, 1.763e3, 1.352e4, 1.263e5};
 #define SA_N ((int)(sizeof sa_c / sizeof sa_c[0]))
@@ -497,7 +497,7 @@ double lahar_check_sangani_acrivos_K(double c)
 {
     if (!(c > 0.0) || c > sa_c[SA_N - 1])
         return NAN;
-    if (c < sa_c[0]) /* low-c asymptote (Hasimoto 1959, Sangani & Acrivos 1982), shared/reference/01 */
+    if (c < sa_c[0]) /* low-c asymptote (Hasimoto 1959, Sangani & Acrivos 1982) */
         return 4.0 * M_PI / (-0.5 * log(c) - 0.738 + c - 0.887 * c * c + 2.038 * c * c * c);
     int i = 0;
     while (i + 2 < SA_N && c > sa_c[i + 1])
@@ -561,7 +561,7 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
                                "solid fraction c", "K");
     if (pk >= 0)
         r->panel[pk].ylog = 1;
-    lahar_check_curve(r, pk, 0, "Sangani & Acrivos 1982 (shared/reference/01)");
+    lahar_check_curve(r, pk, 0, "Sangani & Acrivos 1982");
     for (int s = 0; s <= 150; s++) {
         double cc = 0.01 + (0.75 - 0.01) * s / 150.0;
         lahar_check_point(r, cc, lahar_check_sangani_acrivos_K(cc));
@@ -584,7 +584,7 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
     snprintf(r->convention, sizeof r->convention,
              "K = rho g L^2 / (mu U_s): F = rho g L^2 (driving force per cell and unit length, body force per fluid "
              "volume times the cell area), U_s = (1 - c) <u>_fluid the superficial velocity (Sangani & Acrivos 1982 "
-             "as reproduced by Basilisk, shared/reference/01)");
+             "as reproduced by Basilisk)");
     snprintf(r->note, sizeof r->note,
              "disc %s, r = %g m, L = %g m; K interpolated in ln K between tabulated c (low-c asymptote below 0.05); "
              "force balance: at steady state the disc carries the body force on the fluid, rho g (1 - c) L^2",
@@ -877,7 +877,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
     lahar_check_value(r, "t_last", p->t[kl]);
     snprintf(r->note, sizeof r->note,
              "floor %s; h from the free-surface level (mean column top + dx/2); wall force: late-window mean, worst "
-             "side wall, reference rho g h^2/2 per unit width (shared/reference/05 section 5.6)",
+             "side wall, reference rho g h^2/2 per unit width",
              c->bodies[floor_j].name);
     snprintf(r->title, sizeof r->title, "hydrostatic: h = %.4g m, worst wall force error %.3g %%", h, 100.0 * werr);
     return 0;
@@ -885,7 +885,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
 
 /* ---------------------------------------------------------------- floating box ---------- */
 
-/* A free box floating in water (shared/reference/05 section 5.6): draft = free-surface level -
+/* A free box floating in water: draft = free-surface level -
  * lowest point of the box's swept surface, averaged over the late window of the snapshots;
  * reference rho_b h / rho_f with rho_b the box material's density, h its height along gravity
  * (core extent + 2 sweep radius; rounded corners of radius R change the displaced area by

@@ -294,7 +294,7 @@ int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar
 }
 
 /* granular_collapse: a soil column against a fixed wall released to one side onto a fixed floor
- * (Bui et al. 2008 aluminium bars; shared/reference/04a gives the material, not the deposit).
+ * (Bui et al. 2008 aluminium bars; the published parameters give the material, not the deposit).
  * The wall (x_wall) and the floor (y_floor) are the left and bottom edges of the column's lattice
  * cells at t = 0 (the column stands in the corner). Reported (last
  * snapshot): run-out L_f (the front: the rightmost soil particle + dx/2, from the wall; and where
@@ -460,7 +460,7 @@ int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d
     lahar_check_value(r, "friction_angle_deg", phi_deg);
     lahar_check_value(r, "L0_m", L0);
     lahar_check_value(r, "H0_m", H0);
-    snprintf(r->note, sizeof r->note, "no published run-out in shared/reference/04a: run-out and profile reported only");
+    snprintf(r->note, sizeof r->note, "no published run-out for this set-up: run-out and profile reported only");
     snprintf(r->convention, sizeof r->convention, "run-out from the wall to the front (rightmost particle + dx/2); "
              "slope fitted to the column tops between 10 %% and 90 %% of the height at the wall");
     return 0;

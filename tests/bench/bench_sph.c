@@ -1,4 +1,4 @@
-/* SPH step cost (issue 4, "Speed targets"): dam breaks built through the solver core (sph_fluid
+/* SPH step cost : dam breaks built through the solver core (sph_fluid
  * API; the tank walls are fixed DEM bodies seen through the coupling of sph_coupling.h), stepped
  * N times on 1 and 2 threads from the same initial state. Prints one table row per case and
  * thread count: particles, steps, wall time, CPU time (all threads), particle-steps per second, speed-up over 1 thread,

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Stability stress suite (issue 4): sweeps that find the solver's limits and report, per setting,
+# Stability stress suite: sweeps that find the solver's limits and report, per setting,
 # how the run ended and what caught a failure. See tests/stress/stress.py and README.md
 # ("Stability limits").
 #   tests/stress/run_stress.sh                 short sweeps (coarse, a few minutes on 2 cores)

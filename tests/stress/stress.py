@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Stability stress suite (issue 4): sweeps that find the limits of the solver, and the CI checks
+"""Stability stress suite: sweeps that find the limits of the solver, and the CI checks
 that an unstable setting is caught (exit 1, status "unstable", what/where/when, a readable final
 snapshot) while a stable one finishes.
 
