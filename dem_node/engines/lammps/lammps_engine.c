@@ -286,17 +286,30 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
         return -1;
     }
     double h = dt / (double)n;
-    for (int k = 0; k < e->nfree; k++) {
-        const lahar_body_load *l = loads ? &loads[e->body_of_free[k]] : NULL;
-        for (int a = 0; a < 3; a++) {
-            e->load_f[k][a] = l ? l->force[a] : 0.0;
-            e->load_t[k][a] = l ? l->torque[a] : 0.0;
-            e->acc_f[k][a] = e->acc_t[k][a] = 0.0;
-        }
-        if (e->dim == 2) e->load_f[k][2] = e->load_t[k][0] = e->load_t[k][1] = 0.0;
-    }
     /* a new substep length needs LAMMPS' init (the integrator and the walls keep dt) */
     int pre = !e->initialized || h != e->h_last;
+    /* `run pre no` skips the setup: the first half kick uses the forces left by the last substep
+     * of the previous run, with the previous load in them; they get the new load instead (with
+     * `pre yes` the setup's force evaluation calls the callback, which applies it) */
+    int nlocal = lammps_extract_setting(e->lmp, "nlocal");
+    int *id = lammps_extract_atom(e->lmp, "id");
+    double **f = lammps_extract_atom(e->lmp, "f"), **tq = lammps_extract_atom(e->lmp, "torque");
+    for (int i = 0; i < nlocal; i++) {
+        int k = id[i] - 1;
+        const lahar_body_load *l = loads ? &loads[e->body_of_free[k]] : NULL;
+        for (int a = 0; a < 3; a++) {
+            double lf = l ? l->force[a] : 0.0, lt = l ? l->torque[a] : 0.0;
+            if (e->dim == 2 && a == 2) lf = 0.0;
+            if (e->dim == 2 && a < 2) lt = 0.0;
+            if (!pre) {
+                f[i][a] += lf - e->load_f[k][a];
+                tq[i][a] += lt - e->load_t[k][a];
+            }
+            e->load_f[k][a] = lf;
+            e->load_t[k][a] = lt;
+            e->acc_f[k][a] = e->acc_t[k][a] = 0.0;
+        }
+    }
     if (h != e->h_last) lmp_cmd(e, "timestep %.17g", h);
     e->h_last = h;
     e->step_start = *(int64_t *)lammps_extract_global(e->lmp, "ntimestep");
