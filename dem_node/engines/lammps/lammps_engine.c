@@ -232,7 +232,9 @@ static int count_and_check(lahar_dem_engine *e, char *err, size_t errlen)
                 e->ncontacts++;
                 double lim = e->max_overlap * fmin(e->radius[k], wl->radius);
                 if (ov > lim) {
-                    set_fault(e, "overlap", b, wl->body, s->x, ov, lim);
+                    double cp[3]; /* the middle of the overlap */
+                    for (int a = 0; a < 3; a++) cp[a] = s->x[a] - wl->n[a] * (e->radius[k] - 0.5 * ov);
+                    set_fault(e, "overlap", b, wl->body, cp, ov, lim);
                     snprintf(err, errlen, "lammps engine: overlap %g m of body %d with wall %d exceeds %g m by substep %ld",
                              ov, b, wl->body, lim, e->substep);
                     return -1;
@@ -262,7 +264,9 @@ static int count_and_check(lahar_dem_engine *e, char *err, size_t errlen)
             double lim = e->max_overlap * fmin(e->radius[ki], e->radius[kj]);
             if (ov > lim) {
                 int a = bi < bj ? bi : bj, b = bi < bj ? bj : bi;
-                set_fault(e, "overlap", a, b, st[a].x, ov, lim);
+                double cp[3], u = (e->radius[ki] - 0.5 * ov) / d; /* the middle of the overlap */
+                for (int c = 0; c < 3; c++) cp[c] = x[i][c] + (x[j][c] - x[i][c]) * u;
+                set_fault(e, "overlap", a, b, cp, ov, lim);
                 snprintf(err, errlen, "lammps engine: overlap %g m of bodies %d and %d exceeds %g m by substep %ld", ov,
                          a, b, lim, e->substep);
                 return -1;
