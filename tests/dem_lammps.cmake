@@ -6,6 +6,12 @@ target_include_directories(test_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
 target_link_libraries(test_dem_lammps PRIVATE lahar_dem)
 add_test(NAME test_dem_lammps COMMAND test_dem_lammps)
 set_tests_properties(test_dem_lammps PROPERTIES LABELS "fast;dem;lammps" TIMEOUT 300 SKIP_RETURN_CODE 77)
+if(LAHAR_SANITIZE)
+  # OpenMPI's start-up state (MPI_Init inside liblammps) is suppressed in tests/lsan.supp by library;
+  # that needs full stacks and the MCA components still loaded at exit to name them
+  set_tests_properties(test_dem_lammps PROPERTIES ENVIRONMENT
+    "OMPI_MCA_mca_base_component_disable_dlclose=1;PMIX_MCA_mca_base_component_disable_dlclose=1;ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0;LSAN_OPTIONS=suppressions=${LAHAR_TEST_DIR}/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
+endif()
 
 # A coupled run through `lahar run` (processes, private network namespace): a disc sinking in water
 # onto the floor, lammps vs spheropoly (dem_lammps_coupled.sh says why the tolerance). ~20 s.

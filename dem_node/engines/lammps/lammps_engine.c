@@ -461,9 +461,8 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
     /* everything LAMMPS could refuse is checked before LAMMPS starts (no exceptions in this build) */
     if (c->checkpoint_interval > 0.0 || c->resume) {
         snprintf(err, errlen,
-                 "%s: the lammps engine cannot write bitwise checkpoints (LAMMPS' restart does not keep the "
-                 "neighbour order of the contact history): remove the checkpoint: section or use dem.engine: "
-                 "spheropoly",
+                 "%s: checkpoint: the lammps engine has no bitwise checkpoint/restart (lahar resume could not "
+                 "continue the run bit for bit): remove the checkpoint: section or use dem.engine: spheropoly",
                  c->path);
         return NULL;
     }
