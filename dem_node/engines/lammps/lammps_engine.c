@@ -333,14 +333,19 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
 
 /* ---- setup -------------------------------------------------------------------------------------- */
 
-/* Largest stable substep: dem_dt_safety x the shortest contact period over the classes and what
- * they may meet, the rule of spheropoly (dem_node/README.md "Step size"): m* = m/2 against free
- * bodies, m against walls; Hertz at the impact speed of a fall across the scene. */
-static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c, const dem_pair_law *laws)
+/* Largest stable substep: the rule every engine uses (dem_stable_dt, dem_contact.h), on the
+ * scene's bodies (walls with their sweep radius, as spheropoly), so that both engines take the
+ * same substeps. */
+static double stable_dt_of(const lahar_case *c, const dem_pair_law *laws, char *err, size_t errlen)
 {
     double safety = c->dem_dt_safety > 0.0 ? c->dem_dt_safety : 0.02;
     vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
     double vmax = 0.0;
+    dem_step_body *sb = malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof *sb);
+    if (!sb) {
+        snprintf(err, errlen, "lammps engine: out of memory");
+        return 0.0;
+    }
     for (int i = 0; i < c->nbody; i++) {
         const lahar_body *b = &c->bodies[i];
         for (int k = 0; k < b->shape.nv; k++) {
@@ -348,32 +353,17 @@ static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c, const
             lo = v3(fmin(lo.x, w.x), fmin(lo.y, w.y), fmin(lo.z, w.z));
             hi = v3(fmax(hi.x, w.x), fmax(hi.y, w.y), fmax(hi.z, w.z));
         }
-        if (b->motion == LAHAR_MOTION_FREE)
-            vmax = fmax(vmax, v3_norm(v3_load(b->v)) + v3_norm(v3_load(b->w)) * b->shape.radius);
+        /* a sphere's bounding radius about its centre is its radius */
+        double v = v3_norm(v3_load(b->v)) + v3_norm(v3_load(b->w)) * b->shape.radius;
+        if (v > vmax) vmax = v;
+        sb[i] = (dem_step_body){.material = b->material, .free = b->motion == LAHAR_MOTION_FREE,
+                                .radius = b->shape.radius, .mass = b->mass};
     }
     double extent = c->nbody > 0 ? v3_norm(v3_sub(hi, lo)) : 0.0;
-    double vimpact = vmax + sqrt(2.0 * v3_norm(v3_load(c->gravity)) * extent) + 1.0;
-    double period = DBL_MAX, rmax_free = 0.0;
-    for (int k = 0; k < e->nfree; k++) rmax_free = fmax(rmax_free, e->radius[k]);
-    for (int k = 0; k < e->nfree; k++) {
-        int ma = c->bodies[e->body_of_free[k]].material;
-        if (e->nfree >= 2)
-            for (int j = 0; j < c->nmaterial; j++) {
-                int used = 0;
-                for (int l = 0; l < e->nfree && !used; l++) used = c->bodies[e->body_of_free[l]].material == j;
-                if (!used) continue;
-                double p = dem_contact_period(&laws[ma * c->nmaterial + j], 0.5 * e->mass[k],
-                                              fmax(e->radius[k], rmax_free), vimpact);
-                period = fmin(period, p);
-            }
-        for (int w = 0; w < e->nwall; w++) {
-            double p = dem_contact_period(&laws[ma * c->nmaterial + e->walls[w].material], e->mass[k], e->radius[k],
-                                          vimpact);
-            period = fmin(period, p);
-        }
-    }
-    if (period == DBL_MAX) period = c->dt_max > 0.0 ? c->dt_max / safety : 1.0;
-    return safety * period;
+    double dt = dem_stable_dt(sb, c->nbody, laws, c->nmaterial, dem_impact_speed(vmax, v3_norm(v3_load(c->gravity)), extent),
+                              safety, c->dt_max);
+    free(sb);
+    return dt;
 }
 
 static void lmp_destroy(lahar_dem_engine *e)
@@ -608,7 +598,12 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
             }
         }
     }
-    e->dt_stable = stable_dt_of(e, c, laws);
+    e->dt_stable = stable_dt_of(c, laws, err, errlen);
+    if (!(e->dt_stable > 0.0)) {
+        free(tmat);
+        free(tmass);
+        goto fail;
+    }
 
     /* ---- LAMMPS ---- */
     const char *args[] = {"lahar-dem", "-log", "none", "-screen", "none", "-nocite"};
