@@ -158,6 +158,12 @@ double dem_impact_speed(double vmax, double gravity, double extent)
     return vmax + sqrt(2.0 * gravity * extent) + 1.0;
 }
 
+long dem_substeps(double dt, double dt_stable)
+{
+    double r = dt / dt_stable;
+    return r <= 1.0 ? 1 : (long)ceil(r);
+}
+
 double dem_stable_dt(const dem_step_body *bodies, int nbody, const dem_pair_law *laws, int nmat, double vimpact,
                      double safety, double dt_max)
 {

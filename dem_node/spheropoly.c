@@ -909,8 +909,7 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
         snprintf(err, errlen, "spheropoly: step %g must be positive", dt);
         return -1;
     }
-    double r = dt / e->dt_stable;
-    int n = r <= 1.0 ? 1 : (int)ceil(r);
+    int n = (int)dem_substeps(dt, e->dt_stable);
     double h = dt / n;
     for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
     for (int k = 0; k < n; k++) {

@@ -3,9 +3,11 @@
  *  - a sphere / a disc bouncing on a plane / segment: rebound / impact speed = the case's e, 1 %,
  *    linear and Hertz;
  *  - two spheres of different sizes colliding head-on: momentum kept (1e-12), relative speed
- *    reversed times e (1 %);
+ *    reversed times e (1 %); Hertz, in coupling steps of changing length, as spheropoly (1e-9);
  *  - a constant load (lahar_body_load): v = F t / m, omega = T t / I (1e-9), reported force = F;
- *  - the same bounce as the spheropoly engine (trajectory within 1 % of the drop height);
+ *  - the same bounce as the spheropoly engine (trajectory; with coupling steps of changing
+ *    length, which make the engine init LAMMPS again, the rebound as spheropoly's to 1e-9);
+ *  - oblique impacts: sliding against the Coulomb impulse, sticking against spheropoly;
  *  - what the engine cannot hold is refused at create, naming the body.
  * Exit 77 (ctest SKIP) when lahar was built without liblammps. */
 #include <math.h>
@@ -64,6 +66,10 @@ static void free_fall(void)
     dem_test_case_free(&c);
 }
 
+/* Coupling steps of changing length (each third one 0.73 long: another substep length, which
+ * makes the lammps engine init LAMMPS again) when set. */
+static int alt_steps = 0;
+
 /* Sphere (3D) or disc (2D) thrown at a wall with speed v0, no gravity: rebound speed / v0. */
 static double bounce(int dim, lahar_contact_model model, double e_req, const char *engine, double *traj_out, int ntraj)
 {
@@ -92,7 +98,7 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
     double h = 20.0 * ops->stable_dt(e), vout = 0.0;
     int touched = 0;
     for (int k = 0; k < 100000; k++) {
-        if (ops->advance(e, h, NULL, err, sizeof err) < 0) {
+        if (ops->advance(e, alt_steps && k % 3 == 2 ? 0.73 * h : h, NULL, err, sizeof err) < 0) {
             dem_test_check(0, "advance: %s", err);
             break;
         }
@@ -134,6 +140,63 @@ static void bounces(void)
     for (int k = 0; k < NT; k++) worst = fmax(worst, fabs(a[k] - b[k])), lowest = fmin(lowest, a[k]);
     dem_test_check(lowest < 0.12 && a[NT - 1] > lowest, "the compared trajectory goes through the contact (lowest centre %g m)", lowest);
     dem_test_abs("Hertz bounce: lammps vs spheropoly trajectory (m, drop gap 0.01 m)", worst, 0.0, 1e-4);
+    /* coupling steps of changing length: LAMMPS is initialised again at each change (its
+     * `timestep` between runs does not reach the integrator), the wall fixes of Hertz walls are
+     * made anew (fix wall/gran would convert the Tsuji coefficient again); the rebound stays that
+     * of spheropoly with the same steps (it differs from e by the time discretisation only) */
+    alt_steps = 1;
+    for (int hz = 0; hz < 2; hz++) {
+        lahar_contact_model model = hz ? LAHAR_CONTACT_HERTZ : LAHAR_CONTACT_LINEAR;
+        double el = bounce(3, model, 0.6, "lammps", NULL, 0), es = bounce(3, model, 0.6, "spheropoly", NULL, 0);
+        char what[128];
+        snprintf(what, sizeof what, "%s bounce, steps of changing length: lammps e as spheropoly's",
+                 hz ? "Hertz" : "linear");
+        dem_test_rel(what, el, es, 1e-9);
+        snprintf(what, sizeof what, "%s bounce, steps of changing length: e = 0.6", hz ? "Hertz" : "linear");
+        dem_test_rel(what, el, 0.6, 0.01);
+    }
+    alt_steps = 0;
+}
+
+/* Two Hertz spheres colliding in coupling steps of changing length: relative rebound speed
+ * as spheropoly's (1e-9) and e (1 %). */
+static void two_spheres_hertz_changing_steps(void)
+{
+    const double g0[3] = {0, 0, 0};
+    double e_eng[2];
+    for (int eng = 0; eng < 2; eng++) {
+        lahar_case c;
+        dem_test_case_init(&c, 3, g0, 2);
+        c.dem_dt_safety = 0.001;
+        int m = dem_test_material(&c, "rock", LAHAR_CONTACT_HERTZ, 2500.0, 0, 1e9, 0.3, 0.6, 0.3);
+        const double xa[3] = {-0.11, 0, 0}, xb[3] = {0.2, 0, 0};
+        int a = dem_test_sphere(&c, "a", m, 0.1, xa, LAHAR_MOTION_FREE);
+        int b = dem_test_sphere(&c, "b", m, 0.2, xb, LAHAR_MOTION_FREE);
+        c.bodies[a].v[0] = 1.0;
+        c.bodies[b].v[0] = -0.5;
+        const lahar_dem_engine_ops *ops = lahar_dem_engine_find(eng ? "spheropoly" : "lammps");
+        char err[512];
+        lahar_dem_engine *e = ops->create(&c, err, sizeof err);
+        if (!e) {
+            dem_test_check(0, "create: %s", err);
+            return;
+        }
+        double h = 20.0 * ops->stable_dt(e);
+        int touched = 0;
+        lahar_body_state sa, sb;
+        for (int k = 0; k < 100000; k++) {
+            ops->advance(e, k % 3 == 2 ? 0.73 * h : h, NULL, err, sizeof err);
+            if (ops->ncontacts(e) > 0) touched = 1;
+            if (touched && ops->ncontacts(e) == 0) break;
+        }
+        ops->get_state(e, a, &sa);
+        ops->get_state(e, b, &sb);
+        e_eng[eng] = (sb.v[0] - sa.v[0]) / 1.5;
+        ops->destroy(e);
+        dem_test_case_free(&c);
+    }
+    dem_test_rel("two Hertz spheres, steps of changing length: lammps e as spheropoly's", e_eng[0], e_eng[1], 1e-9);
+    dem_test_rel("two Hertz spheres, steps of changing length: e = 0.6", e_eng[0], 0.6, 0.01);
 }
 
 static void two_spheres(void)
@@ -398,6 +461,7 @@ int main(void)
     constant_load();
     resting();
     two_spheres();
+    two_spheres_hertz_changing_steps();
     bounces();
     loads_both_engines(2);
     oblique_impacts();

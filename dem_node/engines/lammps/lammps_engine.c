@@ -50,6 +50,13 @@ struct lahar_dem_engine {
     double (*load_f)[3], (*load_t)[3]; /* per free body, constant over the coupling step */
     double (*acc_f)[3], (*acc_t)[3];   /* contact + external, summed over the substeps */
     double (*rep_f)[3], (*rep_t)[3];   /* the report of the last step (time average) */
+    double (*last_f)[3], (*last_t)[3]; /* contact force and torque of the last substep */
+    int have_last;
+    /* fixes made again before every init after the first (see lmp_advance): the Hertz walls
+     * and, after them, the stateless fixes that must follow the walls in post_force order */
+    int nrefix, caprefix;
+    char (*refix_id)[32];
+    char (*refix_cmd)[1024];
     int *ncontact_body, ncontacts;
     double dt_stable, h_last, max_overlap;
     int64_t step_start;
@@ -102,6 +109,25 @@ static void lmp_cmd(lahar_dem_engine *e, const char *fmt, ...)
     lammps_command(e->lmp, e->cmd);
 }
 
+/* Issue a fix command and keep it for lmp_refix (id: the fix's ID). */
+static void lmp_keep_fix(lahar_dem_engine *e, const char *id, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(e->cmd, sizeof e->cmd, fmt, ap);
+    va_end(ap);
+    if (e->nrefix < e->caprefix) {
+        snprintf(e->refix_id[e->nrefix], sizeof e->refix_id[0], "%s", id);
+        snprintf(e->refix_cmd[e->nrefix], sizeof e->refix_cmd[0], "%s", e->cmd);
+        e->nrefix++;
+    }
+    lammps_command(e->lmp, e->cmd);
+}
+
+/* Make the kept fixes again, in their order (they carry no state LAMMPS would lose: a Hertz wall's
+ * tangential springs restart, see README.md) and hand fix external its callback again. */
+static void lmp_refix(lahar_dem_engine *e);
+
 static int is_sphere(const lahar_shape *s)
 {
     return s->nv == 1 && s->ne == 0 && s->nf == 0 && s->radius > 0.0 &&
@@ -148,6 +174,20 @@ static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double *
     const double h = e->h_last;
     for (int i = 0; i < nlocal; i++) {
         int k = ids[i] - 1;
+        if (setup && e->have_last) {
+            /* the setup of `run pre yes` evaluated the contacts again with the full-step velocity;
+             * the step goes on with the forces of the last substep (half-step velocity in the
+             * dashpots), as velocity Verlet does and spheropoly does */
+            for (int a = 0; a < 3; a++) {
+                f[i][a] = e->last_f[k][a];
+                tq[i][a] = e->last_t[k][a];
+            }
+        }
+        if (!setup)
+            for (int a = 0; a < 3; a++) {
+                e->last_f[k][a] = f[i][a];
+                e->last_t[k][a] = tq[i][a];
+            }
         for (int a = 0; a < 3; a++) {
             fext[i][a] = e->load_f[k][a];
             tq[i][a] += e->load_t[k][a];
@@ -159,6 +199,7 @@ static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double *
         }
         /* orientation, not tracked by LAMMPS for spheres: at post_force omega is the half-step
          * value, the exact rotation of the step exp(h omega) (as spheropoly does for spheres) */
+        e->have_last = 1;
         lahar_body_state *s = &e->st[e->body_of_free[k]];
         vec3 w = v3(om[i][0], om[i][1], om[i][2]);
         double wn = v3_norm(w);
@@ -276,6 +317,13 @@ static int count_and_check(lahar_dem_engine *e, char *err, size_t errlen)
     return 0;
 }
 
+static void lmp_refix(lahar_dem_engine *e)
+{
+    for (int i = 0; i < e->nrefix; i++) lmp_cmd(e, "unfix %s", e->refix_id[i]);
+    for (int i = 0; i < e->nrefix; i++) lammps_command(e->lmp, e->refix_cmd[i]);
+    lammps_set_fix_external_callback(e->lmp, "lahar_ext", lmp_callback, e);
+}
+
 static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loads, char *err, size_t errlen)
 {
     e->has_fault = 0;
@@ -283,15 +331,20 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
         snprintf(err, errlen, "lammps engine: bad step dt = %g", dt);
         return -1;
     }
-    long n = (long)ceil(dt / e->dt_stable - 1e-12);
-    if (n < 1) n = 1;
+    long n = dem_substeps(dt, e->dt_stable);
     if (n > 100000000L) {
         snprintf(err, errlen, "lammps engine: step %g s needs %ld substeps of %g s", dt, n, e->dt_stable);
         return -1;
     }
     double h = dt / (double)n;
-    /* a new substep length needs LAMMPS' init (the integrator and the walls keep dt) */
+    /* A new substep length needs LAMMPS' init (`run pre yes`): in this version the `timestep`
+     * command between runs does not reach the fixes and the pair style, which keep dt from their
+     * init. The setup of such a run evaluates the forces again with the full-step velocity; the
+     * callback puts back those of the last substep (velocity Verlet goes on unchanged). And
+     * fix wall/gran converts the Tsuji restitution into its damping coefficient in init(), again
+     * at every init: the Hertz wall fixes are made anew before every init after the first. */
     int pre = !e->initialized || h != e->h_last;
+    if (pre && e->initialized && e->nrefix > 0) lmp_refix(e);
     /* `run pre no` skips the setup: the first half kick uses the forces left by the last substep
      * of the previous run, with the previous load in them; they get the new load instead (with
      * `pre yes` the setup's force evaluation calls the callback, which applies it) */
@@ -384,6 +437,10 @@ static void lmp_destroy(lahar_dem_engine *e)
     free(e->acc_t);
     free(e->rep_f);
     free(e->rep_t);
+    free(e->last_f);
+    free(e->last_t);
+    free(e->refix_id);
+    free(e->refix_cmd);
     free(e->ncontact_body);
     free(e);
 }
@@ -481,11 +538,16 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
     e->acc_t = calloc(nb, sizeof *e->acc_t);
     e->rep_f = calloc(nb, sizeof *e->rep_f);
     e->rep_t = calloc(nb, sizeof *e->rep_t);
+    e->caprefix = c->nbody * LMP_MAX_TYPES + 8 < 4096 ? c->nbody * LMP_MAX_TYPES + 8 : 4096;
+    e->refix_id = calloc((size_t)e->caprefix, sizeof *e->refix_id);
+    e->refix_cmd = calloc((size_t)e->caprefix, sizeof *e->refix_cmd);
+    e->last_f = calloc(nb, sizeof *e->last_f);
+    e->last_t = calloc(nb, sizeof *e->last_t);
     e->ncontact_body = calloc(nb, sizeof(int));
     int nm = c->nmaterial > 0 ? c->nmaterial : 1;
     laws = calloc((size_t)nm * (size_t)nm, sizeof *laws);
     if (!e->free_of_body || !e->body_of_free || !e->type_of_free || !e->mass || !e->radius || !e->inertia ||
-        !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t ||
+        !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t || !e->last_f || !e->last_t || !e->refix_id || !e->refix_cmd ||
         !e->ncontact_body || !laws)
         goto oom;
     for (int a = 0; a < c->nmaterial; a++)
@@ -697,21 +759,35 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
         lmp_cmd(e, "region lahar_w%d plane %.17g %.17g %.17g %.17g %.17g %.17g side in", w, wl->p[0], wl->p[1], wl->p[2],
                 wl->n[0], wl->n[1], wl->n[2]);
         for (int t = 0; t < e->ntype; t++) {
-            law_coeffs(&laws[tmat[t] * c->nmaterial + wl->material], tmass[t], coeff, sizeof coeff, err, errlen, "");
+            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + wl->material];
+            law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
+            if (law->model == LAHAR_CONTACT_HERTZ) continue; /* after the linear ones, below */
             lmp_cmd(e, "fix lahar_w%d_%d lahar_t%d wall/gran/region granular %s region lahar_w%d", w, t + 1, t + 1,
                     coeff, w);
         }
     }
+    for (int w = 0; w < e->nwall; w++) {
+        const lmp_wall *wl = &e->walls[w];
+        for (int t = 0; t < e->ntype; t++) {
+            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + wl->material];
+            if (law->model != LAHAR_CONTACT_HERTZ) continue;
+            law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
+            char id[32];
+            snprintf(id, sizeof id, "lahar_w%d_%d", w, t + 1);
+            lmp_keep_fix(e, id, "fix %s lahar_t%d wall/gran/region granular %s region lahar_w%d", id, t + 1, coeff, w);
+        }
+    }
     free(tmat);
     free(tmass);
-    lmp_cmd(e, "fix lahar_ext all external pf/callback 1 1");
+    lmp_keep_fix(e, "lahar_ext", "fix lahar_ext all external pf/callback 1 1");
     lammps_set_fix_external_callback(e->lmp, "lahar_ext", lmp_callback, e);
     vec3 gv = v3(c->gravity[0], c->gravity[1], c->dim == 3 ? c->gravity[2] : 0.0);
     double g = v3_norm(gv);
     if (g > 0.0)
-        lmp_cmd(e, "fix lahar_g all gravity %.17g vector %.17g %.17g %.17g", g, gv.x / g, gv.y / g, gv.z / g);
-    lmp_cmd(e, c->dim == 3 ? "fix lahar_nve all nve/sphere" : "fix lahar_nve all nve/sphere disc");
-    if (c->dim == 2) lmp_cmd(e, "fix lahar_2d all enforce2d");
+        lmp_keep_fix(e, "lahar_g", "fix lahar_g all gravity %.17g vector %.17g %.17g %.17g", g, gv.x / g, gv.y / g,
+                     gv.z / g);
+    lmp_keep_fix(e, "lahar_nve", c->dim == 3 ? "fix lahar_nve all nve/sphere" : "fix lahar_nve all nve/sphere disc");
+    if (c->dim == 2) lmp_keep_fix(e, "lahar_2d", "fix lahar_2d all enforce2d");
     lmp_cmd(e, "thermo_style custom step");
     lmp_cmd(e, "thermo 0");
     free(laws);
