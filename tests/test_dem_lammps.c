@@ -315,9 +315,13 @@ static void loads_both_engines(int dim)
 {
     const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
     lahar_case c;
-    dem_test_case_init(&c, dim, g, 1);
+    dem_test_case_init(&c, dim, g, 2);
     int m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2650.0, 1e5, 0, 0, 0.3, 0.5);
     const double x[3] = {0.05, 0.14, dim == 3 ? 0.2 : 0};
+    /* a wall far below (its fix is part of every init) */
+    const double a[3] = {-5, 0, 0}, b[3] = {5, 0, 0}, centre[3] = {0, 0, 0}, n[3] = {0, 0, 1}, size[2] = {10, 10};
+    if (dim == 2) dem_test_segment(&c, "ground", m, a, b, 0.002);
+    else dem_test_plane(&c, "floor", m, centre, n, size, 0.002);
     int s = dem_test_sphere(&c, "disc", m, 0.0125, x, LAHAR_MOTION_FREE);
     const lahar_dem_engine_ops *ol = lahar_dem_engine_find("lammps"), *os = lahar_dem_engine_find("spheropoly");
     char err[1024];
