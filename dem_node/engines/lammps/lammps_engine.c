@@ -124,8 +124,8 @@ static void lmp_keep_fix(lahar_dem_engine *e, const char *id, const char *fmt, .
     lammps_command(e->lmp, e->cmd);
 }
 
-/* Make the kept fixes again, in their order (they carry no state LAMMPS would lose: a Hertz wall's
- * tangential springs restart, see README.md) and hand fix external its callback again. */
+/* Make the kept fixes again, in their order, and hand fix external its callback again. The only
+ * state lost: the tangential springs of the Hertz wall contacts (README.md "Step"). */
 static void lmp_refix(lahar_dem_engine *e);
 
 static int is_sphere(const lahar_shape *s)
@@ -538,16 +538,13 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
     e->acc_t = calloc(nb, sizeof *e->acc_t);
     e->rep_f = calloc(nb, sizeof *e->rep_f);
     e->rep_t = calloc(nb, sizeof *e->rep_t);
-    e->caprefix = c->nbody * LMP_MAX_TYPES + 8 < 4096 ? c->nbody * LMP_MAX_TYPES + 8 : 4096;
-    e->refix_id = calloc((size_t)e->caprefix, sizeof *e->refix_id);
-    e->refix_cmd = calloc((size_t)e->caprefix, sizeof *e->refix_cmd);
     e->last_f = calloc(nb, sizeof *e->last_f);
     e->last_t = calloc(nb, sizeof *e->last_t);
     e->ncontact_body = calloc(nb, sizeof(int));
     int nm = c->nmaterial > 0 ? c->nmaterial : 1;
     laws = calloc((size_t)nm * (size_t)nm, sizeof *laws);
     if (!e->free_of_body || !e->body_of_free || !e->type_of_free || !e->mass || !e->radius || !e->inertia ||
-        !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t || !e->last_f || !e->last_t || !e->refix_id || !e->refix_cmd ||
+        !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t || !e->last_f || !e->last_t ||
         !e->ncontact_body || !laws)
         goto oom;
     for (int a = 0; a < c->nmaterial; a++)
@@ -659,6 +656,15 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
                 goto fail;
             }
         }
+    }
+    /* room for the kept fixes: every wall x type (the Hertz ones are kept) and four more */
+    e->caprefix = e->nwall * e->ntype + 4;
+    e->refix_id = calloc((size_t)e->caprefix, sizeof *e->refix_id);
+    e->refix_cmd = calloc((size_t)e->caprefix, sizeof *e->refix_cmd);
+    if (!e->refix_id || !e->refix_cmd) {
+        free(tmat);
+        free(tmass);
+        goto oom;
     }
     e->dt_stable = stable_dt_of(c, laws, err, errlen);
     if (!(e->dt_stable > 0.0)) {
