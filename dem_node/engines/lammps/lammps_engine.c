@@ -340,9 +340,10 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
     /* A new substep length needs LAMMPS' init (`run pre yes`): in this version the `timestep`
      * command between runs does not reach the fixes and the pair style, which keep dt from their
      * init. The setup of such a run evaluates the forces again with the full-step velocity; the
-     * callback puts back those of the last substep (velocity Verlet goes on unchanged). And
-     * fix wall/gran converts the Tsuji restitution into its damping coefficient in init(), again
-     * at every init: the Hertz wall fixes are made anew before every init after the first. */
+     * callback puts back those of the last substep (velocity Verlet goes on unchanged). And an
+     * init changes the damping of a fix wall/gran with `damping tsuji` (measured: README.md
+     * "Step"; as if the restitution were converted to the coefficient again): the Hertz wall
+     * fixes are made anew before every init after the first. */
     int pre = !e->initialized || h != e->h_last;
     if (pre && e->initialized && e->nrefix > 0) lmp_refix(e);
     /* `run pre no` skips the setup: the first half kick uses the forces left by the last substep
