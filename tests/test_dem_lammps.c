@@ -1,7 +1,7 @@
 /* The LAMMPS DEM engine (dem_node/engines/lammps) against analytic references:
  *  - free fall: x(t) = x0 + v0 t + g t^2/2 (velocity Verlet is exact for a constant force), 1e-9;
  *  - a sphere / a disc bouncing on a plane / segment: rebound / impact speed = the case's e, 1 %,
- *    linear and Hertz;
+ *    linear and Hertz (both in 2D and 3D);
  *  - two spheres of different sizes colliding head-on: momentum kept (1e-12), relative speed
  *    reversed times e (1 %); Hertz, in coupling steps of changing length, as spheropoly (1e-9);
  *  - a constant load (lahar_body_load): v = F t / m, omega = T t / I (1e-9), reported force = F;
@@ -130,6 +130,8 @@ static void bounces(void)
         dem_test_rel(what, bounce(3, LAHAR_CONTACT_HERTZ, eh[i], "lammps", NULL, 0), eh[i], 0.01);
         snprintf(what, sizeof what, "2D linear disc on a segment e = %g", el[i]);
         dem_test_rel(what, bounce(2, LAHAR_CONTACT_LINEAR, el[i], "lammps", NULL, 0), el[i], 0.01);
+        snprintf(what, sizeof what, "2D Hertz disc on a segment e = %g", eh[i]);
+        dem_test_rel(what, bounce(2, LAHAR_CONTACT_HERTZ, eh[i], "lammps", NULL, 0), eh[i], 0.01);
     }
     /* the same bounce with both engines: same law, same substeps */
     enum { NT = 400 }; /* approach ~125 steps, contact ~35 */
