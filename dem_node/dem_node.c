@@ -435,9 +435,10 @@ int lahar_dem_node_run(const lahar_dem_node_options *o)
     double t0 = 0.0;
     int at_output0 = 1;
     err[0] = '\0';
-    d.ops = lahar_dem_engine_find(d.ns.scene.dem_engine);
+    const char *engine_name = o->engine ? o->engine : d.ns.scene.dem_engine; /* lahar-dem --engine wins */
+    d.ops = lahar_dem_engine_find(engine_name);
     if (!d.ops)
-        snprintf(err, sizeof err, "unknown DEM engine '%s' (known: %s)", d.ns.scene.dem_engine, lahar_dem_engine_names());
+        snprintf(err, sizeof err, "unknown DEM engine '%s' (known: %s)", engine_name, lahar_dem_engine_names());
     else if (dem_node_alloc(&d) != 0)
         snprintf(err, sizeof err, "out of memory");
     else if (!(d.engine = d.ops->create(&d.ns.scene, err, sizeof err)))

@@ -37,6 +37,7 @@ int lahar_node_parse_args(int argc, char **argv, const char *prog, const char *a
     o->threads = 0;
     o->join_wait_s = 0.0;
     o->auth_key_path = getenv(LAHAR_AUTH_ENV);
+    o->engine = NULL;
     static const struct option opts[] = {
         {"lcm-url", required_argument, NULL, 'u'}, {"run-id", required_argument, NULL, 'r'},
         {"threads", required_argument, NULL, 't'}, {"wait", required_argument, NULL, 'w'},

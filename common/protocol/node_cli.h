@@ -13,6 +13,8 @@ typedef struct {
     int threads;         /* OpenMP threads of the node's loops; 0 = OpenMP's default */
     double join_wait_s;  /* how long to wait for the coordinator's HELLO (0: 30 s) */
     const char *auth_key_path; /* authenticated run (common/protocol/auth.h): key file, or NULL */
+    const char *engine;  /* DEM node only (lahar-dem --engine): engine used instead of the case's
+                            dem.engine; NULL: the case's */
 } lahar_node_options;
 
 /* Parse a node's command line into o (URL default: $LCM_DEFAULT_URL, else LAHAR_NETNS_URL).

@@ -1,5 +1,6 @@
 /* Contact laws (see dem_contact.h and dem_node/README.md for the formulas and conventions). */
 #include "dem_contact.h"
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -150,4 +151,50 @@ vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn,
         *xi = kt > 0.0 ? v3_scale(f, -1.0 / kt) : v3(0.0, 0.0, 0.0);
     }
     return f;
+}
+
+double dem_impact_speed(double vmax, double gravity, double extent)
+{
+    return vmax + sqrt(2.0 * gravity * extent) + 1.0;
+}
+
+long dem_substeps(double dt, double dt_stable)
+{
+    double r = dt / dt_stable;
+    return r <= 1.0 ? 1 : (long)ceil(r);
+}
+
+double dem_stable_dt(const dem_step_body *bodies, int nbody, const dem_pair_law *laws, int nmat, double vimpact,
+                     double safety, double dt_max)
+{
+    int nfree = 0;
+    for (int i = 0; i < nbody; i++) nfree += bodies[i].free != 0;
+    /* per material: largest sweep radius, and whether free / non-free bodies use it (O(N nmat)) */
+    double period = DBL_MAX;
+    for (int j = 0; j < nmat; j++) {
+        double rj = 0.0;
+        int has_free = 0, has_fixed = 0;
+        for (int i = 0; i < nbody; i++) {
+            if (bodies[i].material != j) continue;
+            rj = fmax(rj, bodies[i].radius);
+            if (bodies[i].free) has_free = 1;
+            else has_fixed = 1;
+        }
+        if (!has_free && !has_fixed) continue;
+        for (int k = 0; k < nbody; k++) {
+            const dem_step_body *g = &bodies[k];
+            if (!g->free) continue;
+            const dem_pair_law *law = &laws[g->material * nmat + j];
+            double rstar = fmax(g->radius, rj); /* largest R* gives the shortest Hertz contact */
+            for (int side = 0; side < 2; side++) {
+                if (side == 0 && !(has_free && nfree >= 2)) continue;
+                if (side == 1 && !has_fixed) continue;
+                double mstar = side == 0 ? 0.5 * g->mass : g->mass;
+                double p = dem_contact_period(law, mstar, rstar, vimpact);
+                if (p < period) period = p;
+            }
+        }
+    }
+    if (period == DBL_MAX) period = dt_max > 0.0 ? dt_max / safety : 1.0;
+    return safety * period;
 }

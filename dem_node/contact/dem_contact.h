@@ -39,6 +39,22 @@ double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot,
  * Hertz duration 2.868266 (m*^2/(R* E*^2 v))^(1/5) (reference 06 sec. 6.1) at impact speed v. */
 double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, double v_impact);
 
+/* The engines' stable step (dem_node/README.md "Step size"): safety x the shortest contact period
+ * of every free body against every material it may meet, m* = m/2 against free bodies (when there
+ * are two or more), m against the others, R* the larger of the body's sweep radius and the largest
+ * one of that material, Hertz at the impact speed v_impact = v_max + sqrt(2 |g| L) + 1 m/s
+ * (dem_impact_speed: L the scene diagonal, v_max the fastest initial body). When no free body can
+ * meet anything: dt_max (safety x 1 s when dt_max is 0). laws: nmat x nmat. */
+typedef struct {
+    int material, free;
+    double radius, mass; /* sweep radius, mass */
+} dem_step_body;
+double dem_impact_speed(double vmax, double gravity, double extent);
+/* Substeps of a coupling step dt: n = ceil(dt / dt_stable), at least 1 (each of length dt / n). */
+long dem_substeps(double dt, double dt_stable);
+double dem_stable_dt(const dem_step_body *bodies, int nbody, const dem_pair_law *laws, int nmat, double vimpact,
+                     double safety, double dt_max);
+
 /* Tangential force (world vector) from the spring xi (already rotated onto the tangent plane and
  * advanced by the tangential displacement of this step), the tangential relative velocity vt, the
  * normal force fn and the normal stiffness/damping. When the trial force exceeds mu fn the spring is

@@ -1,11 +1,17 @@
-/* The table of DEM engines selectable by name (`dem: engine:` in the case). To add an engine,
- * write its lahar_dem_engine_ops and list it here. */
+/* The table of DEM engines selectable by name (`dem: engine:` in the case, `lahar-dem --engine`).
+ * To add an engine, write its lahar_dem_engine_ops and list it here. */
 #include <string.h>
 #include "dem_engine.h"
 #include "spheropoly.h"
+#ifdef LAHAR_HAVE_LAMMPS
+#include "lammps_engine.h"
+#endif
 
 static const lahar_dem_engine_ops *const lahar_dem_engines[] = {
     &lahar_dem_spheropoly_ops,
+#ifdef LAHAR_HAVE_LAMMPS
+    &lahar_dem_lammps_ops,
+#endif
 };
 
 const lahar_dem_engine_ops *lahar_dem_engine_find(const char *name)
@@ -16,4 +22,11 @@ const lahar_dem_engine_ops *lahar_dem_engine_find(const char *name)
     return NULL;
 }
 
-const char *lahar_dem_engine_names(void) { return "spheropoly"; }
+const char *lahar_dem_engine_names(void)
+{
+#ifdef LAHAR_HAVE_LAMMPS
+    return "spheropoly, lammps";
+#else
+    return "spheropoly";
+#endif
+}

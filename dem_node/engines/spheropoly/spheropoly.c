@@ -909,8 +909,7 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
         snprintf(err, errlen, "spheropoly: step %g must be positive", dt);
         return -1;
     }
-    double r = dt / e->dt_stable;
-    int n = r <= 1.0 ? 1 : (int)ceil(r);
+    int n = (int)dem_substeps(dt, e->dt_stable);
     double h = dt / n;
     for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
     for (int k = 0; k < n; k++) {
@@ -1015,35 +1014,15 @@ static double stable_dt_of(const lahar_dem_engine *e, const lahar_case *c)
         if (v > vmax) vmax = v;
     }
     double extent = e->nbody > 0 ? v3_norm(v3_sub(hi, lo)) : 0.0;
-    double vimpact = vmax + sqrt(2.0 * v3_norm(e->g) * extent) + 1.0;
-    /* per material: largest sweep radius, and whether free / non-free bodies use it (O(N nmat)) */
-    double period = DBL_MAX;
-    for (int j = 0; j < e->nmat; j++) {
-        double rj = 0.0;
-        int has_free = 0, has_fixed = 0;
-        for (int i = 0; i < e->nbody; i++) {
-            const sp_geo *o = &e->geo[i];
-            if (o->material != j) continue;
-            rj = fmax(rj, o->radius);
-            if (o->motion == LAHAR_MOTION_FREE) has_free = 1;
-            else has_fixed = 1;
-        }
-        if (!has_free && !has_fixed) continue;
-        for (int k = 0; k < e->nfree; k++) {
-            const sp_geo *g = &e->geo[e->free_ids[k]];
-            const dem_pair_law *law = &e->laws[g->material * e->nmat + j];
-            double rstar = fmax(g->radius, rj); /* largest R* gives the shortest Hertz contact */
-            for (int side = 0; side < 2; side++) {
-                if (side == 0 && !(has_free && e->nfree >= 2)) continue;
-                if (side == 1 && !has_fixed) continue;
-                double mstar = side == 0 ? 0.5 * g->mass : g->mass;
-                double p = dem_contact_period(law, mstar, rstar, vimpact);
-                if (p < period) period = p;
-            }
-        }
-    }
-    if (period == DBL_MAX) period = c->dt_max > 0.0 ? c->dt_max / safety : 1.0;
-    return safety * period;
+    double vimpact = dem_impact_speed(vmax, v3_norm(e->g), extent);
+    dem_step_body *sb = malloc((size_t)(e->nbody > 0 ? e->nbody : 1) * sizeof *sb);
+    if (!sb) return 0.0; /* create reports it */
+    for (int i = 0; i < e->nbody; i++)
+        sb[i] = (dem_step_body){.material = e->geo[i].material, .free = e->geo[i].motion == LAHAR_MOTION_FREE,
+                                .radius = e->geo[i].radius, .mass = e->geo[i].mass};
+    double dt = dem_stable_dt(sb, e->nbody, e->laws, e->nmat, vimpact, safety, c->dt_max);
+    free(sb);
+    return dt;
 }
 
 static int build_topology(lahar_dem_engine *e, int i, const lahar_shape *s, char *err, size_t errlen)
@@ -1338,6 +1317,10 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         e->thr[t].cap = ccap;
     }
     e->dt_stable = stable_dt_of(e, c);
+    if (!(e->dt_stable > 0.0)) {
+        snprintf(err, errlen, "spheropoly: out of memory");
+        goto fail;
+    }
     if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;
     return e;
 fail:

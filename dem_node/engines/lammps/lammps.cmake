@@ -1,0 +1,20 @@
+# The LAMMPS DEM engine (dem.engine: lammps), built into lahar_dem when Debian's liblammps-dev is
+# installed (pkg-config liblammps) and LAHAR_LAMMPS is ON (default). Without it the rest builds,
+# test_dem_lammps reports SKIP and the LAMMPS run tests are disabled (tests/dem_lammps.cmake).
+option(LAHAR_LAMMPS "Build the LAMMPS DEM engine when liblammps is found" ON)
+set(LAHAR_HAVE_LAMMPS OFF)
+if(LAHAR_LAMMPS)
+  pkg_check_modules(LAMMPS IMPORTED_TARGET liblammps)
+endif()
+if(LAHAR_LAMMPS AND LAMMPS_FOUND)
+  target_sources(lahar_dem PRIVATE ${CMAKE_CURRENT_LIST_DIR}/lammps_engine.c)
+  target_include_directories(lahar_dem PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+  target_compile_definitions(lahar_dem PUBLIC LAHAR_HAVE_LAMMPS)
+  target_link_libraries(lahar_dem PUBLIC PkgConfig::LAMMPS)
+  message(STATUS "lahar: LAMMPS engine: built (liblammps ${LAMMPS_VERSION})")
+  set(LAHAR_HAVE_LAMMPS ON)
+elseif(LAHAR_LAMMPS)
+  message(STATUS "lahar: LAMMPS engine: not built (install liblammps-dev)")
+else()
+  message(STATUS "lahar: LAMMPS engine: not built (LAHAR_LAMMPS=OFF)")
+endif()

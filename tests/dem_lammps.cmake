@@ -1,0 +1,43 @@
+# The LAMMPS DEM engine (dem_node/engines/lammps): analytic checks of the engine, and a coupled run
+# with `lahar run` against the spheropoly engine. Without liblammps the tests exist and report
+# SKIP (exit 77), so a build without the engine says what it did not test.
+add_executable(test_dem_lammps ${LAHAR_TEST_DIR}/test_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
+target_include_directories(test_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
+target_link_libraries(test_dem_lammps PRIVATE lahar_dem)
+add_test(NAME test_dem_lammps COMMAND test_dem_lammps)
+set_tests_properties(test_dem_lammps PROPERTIES LABELS "fast;dem;lammps" TIMEOUT 300 SKIP_RETURN_CODE 77)
+# `lahar-dem --engine lammps` on a case that names spheropoly (lahar run --no-spawn and the node
+# started by hand in a private network namespace) against the same case run as usual; an unknown
+# --engine refused.
+add_test(NAME dem_lammps_engine_option
+         COMMAND bash ${LAHAR_TEST_DIR}/dem_lammps_engine_option.sh $<TARGET_FILE_DIR:lahar>
+                 ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_engine_option ${LAHAR_TEST_PYTHON})
+set_tests_properties(dem_lammps_engine_option PROPERTIES LABELS "fast;netns;lammps;coupling" TIMEOUT 300)
+if(NOT LAHAR_HAVE_LAMMPS)
+  set_tests_properties(dem_lammps_engine_option PROPERTIES DISABLED TRUE)
+endif()
+
+if(LAHAR_SANITIZE)
+  # OpenMPI's start-up state (MPI_Init inside liblammps) is suppressed in tests/lsan.supp by library;
+  # that needs full stacks and the MCA components still loaded at exit to name them
+  set_tests_properties(test_dem_lammps dem_lammps_engine_option PROPERTIES ENVIRONMENT
+    "OMPI_MCA_mca_base_component_disable_dlclose=1;PMIX_MCA_mca_base_component_disable_dlclose=1;ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0;LSAN_OPTIONS=suppressions=${LAHAR_TEST_DIR}/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
+endif()
+
+
+# A coupled run through `lahar run` (processes, private network namespace): a disc sinking in water
+# onto the floor, lammps vs spheropoly (dem_lammps_coupled.sh says why the tolerance). ~20 s.
+add_test(NAME dem_lammps_coupled
+         COMMAND sh ${LAHAR_TEST_DIR}/dem_lammps_coupled.sh $<TARGET_FILE:lahar> ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_coupled
+                 ${LAHAR_TEST_PYTHON})
+set_tests_properties(dem_lammps_coupled PROPERTIES LABELS "slow;netns;lammps;coupling" TIMEOUT 600)
+if(NOT LAHAR_HAVE_LAMMPS)
+  set_tests_properties(dem_lammps_coupled PROPERTIES DISABLED TRUE)
+endif()
+
+# Benchmark (not a test): per-substep cost of the lammps engine against spheropoly on a pile of
+# spheres in a box of planes; `cmake --build <dir> --target bench_dem_lammps`, then run
+# <dir>/bin/bench_dem_lammps (docs/bench/dem_lammps.md).
+add_executable(bench_dem_lammps EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
+target_include_directories(bench_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
+target_link_libraries(bench_dem_lammps PRIVATE lahar_dem)
