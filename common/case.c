@@ -2078,13 +2078,14 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                        "alpha", "delta", "cfl", "cfl_force", "cfl_visc", "body_force", "periodic",
                                        "shepard_interval", "sps", "sps_cs", "halo", "kappa", "wall_viscous",
                                        "initial_pressure", "wall_pressure", "penalty_stiffness", "soil_wall_stress", "shifting", "shifting_density", "background_pressure",
-                                       "transport_velocity", "body_layers", "blocks", NULL};
+                                       "transport_velocity", "body_layers", "scheme", "riemann_limiter", "blocks", NULL};
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
     static const char *const wall_names[] = {"halfspace", "paper", NULL};
     static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
     static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
     static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
+    static const char *const scheme_names[] = {"delta", "riemann", NULL};
     lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
@@ -2138,6 +2139,14 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                                                   LAHAR_SPH_PENALTY_STEP);
     o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(&m, "soil_wall_stress", wall_pressure_names, 0,
                                                              LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->scheme = (lahar_sph_scheme)rmap_enum(&m, "scheme", scheme_names, 0, LAHAR_SPH_SCHEME_DELTA);
+    o->riemann_limiter = rmap_num(&m, "riemann_limiter", 0, 3.0, "3");
+    if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN) { /* its own dissipation replaces delta-SPH and Monaghan's */
+        if (!rmap_get(&m, "delta"))
+            o->delta = 0.0;
+        if (!rmap_get(&m, "alpha"))
+            o->alpha = 0.0;
+    }
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);
@@ -2159,6 +2168,18 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_fail(&m, "alpha", "must be in [0, 1] (got %g); 0.01-0.1 is usual, 0 = off", o->alpha);
     else if (!(o->delta >= 0 && o->delta <= 1))
         rmap_fail(&m, "delta", "must be in [0, 1] (got %g); 0.1 is usual, 0 = off", o->delta);
+    else if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN && o->delta != 0.0)
+        rmap_fail(&m, "delta", "scheme: riemann carries its own density diffusion (Zhang et al. 2017); remove delta or "
+                  "set it to 0, or use scheme: delta");
+    else if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN && o->alpha != 0.0)
+        rmap_fail(&m, "alpha", "scheme: riemann carries its own dissipation (Zhang et al. 2017); remove alpha or set it "
+                  "to 0, or use scheme: delta");
+    else if (!(o->riemann_limiter >= 0 && o->riemann_limiter <= 100))
+        rmap_fail(&m, "riemann_limiter", "must be in [0, 100] (got %g); 3 as in Zhang et al. 2017, 0 = no limiter "
+                  "(the full acoustic dissipation)", o->riemann_limiter);
+    else if (rmap_get(&m, "riemann_limiter") && o->scheme != LAHAR_SPH_SCHEME_RIEMANN)
+        rmap_fail(&m, "riemann_limiter", "is the limiter of scheme: riemann, but the case uses scheme: delta; remove it "
+                  "or set scheme: riemann");
     else if (!(o->cfl > 0 && o->cfl <= 1))
         rmap_fail(&m, "cfl", "must be in (0, 1] (got %g)", o->cfl);
     else if (!(o->cfl_force > 0 && o->cfl_force <= 1))

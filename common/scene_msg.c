@@ -45,6 +45,8 @@ static void scene_sph_to_msg(const lahar_sph_options *o, lahar_sph_options_t *m)
     m->wall_pressure = (int8_t)o->wall_pressure;
     m->penalty_stiffness = (int8_t)o->penalty_stiffness;
     m->soil_wall_stress = (int8_t)o->soil_wall_stress;
+    m->scheme = (int8_t)o->scheme;
+    m->riemann_limiter = o->riemann_limiter;
 }
 
 static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *o)
@@ -80,6 +82,8 @@ static void scene_sph_from_msg(const lahar_sph_options_t *m, lahar_sph_options *
     o->wall_pressure = (lahar_sph_wall_pressure)m->wall_pressure;
     o->penalty_stiffness = (lahar_sph_penalty_stiffness)m->penalty_stiffness;
     o->soil_wall_stress = (lahar_sph_wall_pressure)m->soil_wall_stress;
+    o->scheme = (lahar_sph_scheme)m->scheme;
+    o->riemann_limiter = m->riemann_limiter;
 }
 
 int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
@@ -260,7 +264,7 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         so->initial_pressure < 0 || so->initial_pressure > LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC ||
         so->wall_pressure < 0 || so->wall_pressure > LAHAR_SPH_WALL_PRESSURE_GHOST || so->penalty_stiffness < 0 ||
         so->penalty_stiffness > LAHAR_SPH_PENALTY_ACOUSTIC || so->soil_wall_stress < 0 ||
-        so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST) {
+        so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST || so->scheme < 0 || so->scheme > LAHAR_SPH_SCHEME_RIEMANN) {
         snprintf(err, errlen, "malformed scene message (sph options)");
         return -1;
     }

@@ -193,6 +193,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->soil_wall_stress = o->soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
                                                                                   : SPH_WALL_PRESSURE_PENALTY;
     prm->shepard_every = o->shepard_interval;
+    prm->riemann = o->scheme == LAHAR_SPH_SCHEME_RIEMANN;
+    prm->riemann_eta = o->riemann_limiter;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;
     prm->background_pressure = o->background_pressure;

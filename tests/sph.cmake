@@ -15,6 +15,13 @@ target_link_libraries(test_sph_fluid PRIVATE lahar_sph)
 add_test(NAME sph_fluid COMMAND test_sph_fluid)
 set_tests_properties(sph_fluid PROPERTIES LABELS "fast;sph" TIMEOUT 120)
 
+# The Riemann scheme (sph.scheme: riemann, Zhang, Hu & Adams 2017): the pair's interface state against the
+# acoustic characteristics, the limiter, and a water hammer at rho0 c0 U with both schemes.
+add_executable(test_sph_riemann ${LAHAR_TEST_DIR}/test_sph_riemann.c)
+target_link_libraries(test_sph_riemann PRIVATE lahar_sph)
+add_test(NAME sph_riemann COMMAND test_sph_riemann)
+set_tests_properties(sph_riemann PROPERTIES LABELS "fast;sph" TIMEOUT 120)
+
 add_executable(test_sph_coupling ${LAHAR_TEST_DIR}/test_sph_coupling.c)
 target_link_libraries(test_sph_coupling PRIVATE lahar_sph)
 add_test(NAME sph_coupling COMMAND test_sph_coupling)
