@@ -132,6 +132,9 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
      * larger of c0 and the soil's sound speed) */
     if (f->prm.penalty_acoustic)
         f->cpl.kn_dt = f->prm.cfl * f->k.h / fmax(f->prm.c0, f->has_soil ? f->soil.cs : 0.0);
+    f->cpl.riemann = f->prm.riemann;
+    f->cpl.riemann_c0 = f->prm.c0;
+    f->cpl.riemann_eta = f->prm.riemann_eta;
     if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
         sph_coupling_free(&f->cpl);
         return -1;

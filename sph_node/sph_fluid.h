@@ -54,8 +54,9 @@
  *   their terms: with the mirrored ghost state of Zhang et al. 2017 section 3.4 (rho_g = rho_i,
  *   the wall's velocity, p_g extrapolated hydrostatically) the interface state without
  *   dissipation is the symmetric pressure (p_i + p_g)/2 and the wall's velocity, which are the
- *   ghost terms; the wall's limited dissipation rho_i beta u_n (u_n the approach speed) is not
- *   added (the penalty force of eq. 15 holds the particles off the wall).
+ *   ghost terms, plus the wall's limited dissipation: p_i + p_g becomes p_i + p_g + rho_i beta dU,
+ *   dU = -2 u_rel.n along the wall's normal (sph_riemann_wall_dissipation). The penalty force of
+ *   eq. 15 stays.
  *
  * Time integration: kick-drift-kick leapfrog, second order, one neighbour pass per step:
  *   v_h = v + dt/2 a;  rho_h = rho + dt/2 D;  x += dt v_h;

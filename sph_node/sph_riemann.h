@@ -40,4 +40,21 @@ static inline double sph_riemann_ustar(double ul, double ur, double pl, double p
     return 0.5 * (ul + ur) + (pl - pr) / (2.0 * rhobar * c);
 }
 
+/* The wall's share (Zhang et al. 2017, section 3.4): the ghost behind the wall mirrors particle i
+ * (rho_g = rho_i, p_g extrapolated from it, the normal velocity mirrored about the wall's), so
+ * along the wall's normal n (into the fluid) U_L - U_R = -2 u_rel.n, u_rel the particle's velocity
+ * relative to the wall. The interface pressure is 2 P* = p_i + p_g + rho_i beta (U_L - U_R): this
+ * returns the dissipation rho_i beta (U_L - U_R) added to p_i + p_g in the ghost terms
+ * (sph_coupling.c). */
+static inline double sph_riemann_wall_dissipation(double rho, double un, double c, double eta)
+{
+    const double du = -2.0 * un;
+    double beta = c;
+    if (eta > 0.0) {
+        const double b = eta * (du > 0.0 ? du : 0.0);
+        beta = b < c ? b : c;
+    }
+    return rho * beta * du;
+}
+
 #endif
