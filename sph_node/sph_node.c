@@ -191,6 +191,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
     prm->soil_wall_stress = o->soil_wall_stress;
     prm->shepard_every = o->shepard_interval;
+    prm->riemann = o->scheme == LAHAR_SPH_SCHEME_RIEMANN;
+    prm->riemann_eta = o->riemann_limiter;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;
     prm->background_pressure = o->background_pressure;

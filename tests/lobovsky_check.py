@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Dam break against Lobovsky et al. 2014 (H = 300 mm) at CI resolution.
 
-  lobovsky_check.py LAHAR OUT
+  lobovsky_check.py LAHAR OUT [PATH=VALUE ...]
+
+(PATH=VALUE: further overrides of the case, tools/case_override.py syntax, e.g. the Riemann scheme
+sph.scheme=riemann sph.alpha=~ sph.delta=~.)
 
 Runs cases/dam_break_lobovsky_2d.yaml at dx = 10 mm (1800 particles) to t = 1 s on one thread,
 then tools/compare_lobovsky.py --check against docs/references-data/lobovsky_2014_*.csv:
@@ -27,14 +30,14 @@ import case_override  # noqa: E402
 
 
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3:
         print(__doc__)
         return 2
-    lahar, out = sys.argv[1], sys.argv[2]
+    lahar, out, extra = sys.argv[1], sys.argv[2], sys.argv[3:]
     os.makedirs(out, exist_ok=True)
     yml = os.path.join(out, "dam_break_lobovsky_2d_dx10.yaml")
     if case_override.main(["case_override.py", os.path.join(HERE, "..", "cases", "dam_break_lobovsky_2d.yaml"), yml,
-                           "sph.dx=0.01"]):
+                           "sph.dx=0.01"] + extra):
         return 2
     run = os.path.join(out, "run")
     r = subprocess.run([lahar, "run", yml, "-o", run, "--in-process", "--threads", "1", "-q", "--overwrite"])

@@ -8,6 +8,10 @@ lahar_test(sph_poiseuille PROGRAM test_sph_poiseuille SOURCES test_sph_poiseuill
 lahar_test(sph_fluid PROGRAM test_sph_fluid SOURCES test_sph_fluid.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 
+# The Riemann scheme (sph.scheme: riemann, Zhang, Hu & Adams 2017): the pair's interface state against the
+# acoustic characteristics, the limiter, and a water hammer at rho0 c0 U with both schemes.
+lahar_test(sph_riemann PROGRAM test_sph_riemann SOURCES test_sph_riemann.c LIBS lahar_sph LABELS fast sph TIMEOUT 120)
+
 lahar_test(sph_coupling PROGRAM test_sph_coupling SOURCES test_sph_coupling.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 

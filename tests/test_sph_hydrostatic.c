@@ -9,7 +9,8 @@
  *     below the surface) within 1 % of rho0 g H (RMS) and 1.5 % (max);
  *   - no particle crossed a wall, the free surface stays level (height spread < dx/2) and the
  *     kinetic energy has decayed (|v|max < 1 % of sqrt(g H)).
- * usage: test_sph_hydrostatic [NY [T [ghost]]]. With "ghost" the walls carry the pressure of ghost
+ * usage: test_sph_hydrostatic [NY [T [ghost [riemann]]]] (riemann: sph.scheme riemann, Zhang et al. 2017,
+ * instead of the artificial viscosity; the same bounds). With "ghost" the walls carry the pressure of ghost
  * layers (LAHAR_SPH_WALL_PRESSURE_GHOST, sph_coupling.h) and the gauges start at dx/2 above the floor,
  * where the penalty wall alone reads +13 % of rho0 g H at 1.5 dx: the same bounds hold there; the
  * side walls then carry part of the weight (the ghosts beside a particle complete its vertical
@@ -52,6 +53,11 @@ int main(int argc, char **argv)
     prm.mu = 1e-3;
     prm.body_force[1] = -g;
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
+    if (argc > 4 && strcmp(argv[4], "riemann") == 0) { /* the Riemann scheme (sph_riemann.h): its own dissipation */
+        prm.riemann = 1;
+        prm.riemann_eta = 3.0;
+        prm.alpha = 0.0;
+    }
     if (ghost)
         prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
     sph_fluid f;

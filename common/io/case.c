@@ -2063,6 +2063,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
     static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
     static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
+    static const char *const scheme_names[] = {"delta", "riemann", NULL}; /* LAHAR_SPH_SCHEME_* */
     lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
@@ -2108,6 +2109,14 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                                                                   LAHAR_SPH_PENALTY_STEP);
     o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(&m, "soil_wall_stress", wall_pressure_names, 0,
                                                              LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->scheme = (lahar_sph_scheme)rmap_enum(&m, "scheme", scheme_names, 0, LAHAR_SPH_SCHEME_DELTA);
+    o->riemann_limiter = key_num(&m, "riemann_limiter");
+    if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN) { /* its own dissipation replaces delta-SPH and Monaghan's */
+        if (!rmap_get(&m, "delta"))
+            o->delta = 0.0;
+        if (!rmap_get(&m, "alpha"))
+            o->alpha = 0.0;
+    }
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);
@@ -2119,6 +2128,15 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     else if (rmap_get(&m, "gamma") && o->eos != LAHAR_SPH_EOS_TAIT)
         rmap_fail(&m, "gamma", "is the exponent of eos: tait, but the case uses eos: linear; remove gamma or set "
                   "eos: tait");
+    else if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN && o->delta != 0.0)
+        rmap_fail(&m, "delta", "scheme: riemann carries its own density diffusion (Zhang et al. 2017); remove delta or "
+                  "set it to 0, or use scheme: delta");
+    else if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN && o->alpha != 0.0)
+        rmap_fail(&m, "alpha", "scheme: riemann carries its own dissipation (Zhang et al. 2017); remove alpha or set it "
+                  "to 0, or use scheme: delta");
+    else if (rmap_get(&m, "riemann_limiter") && o->scheme != LAHAR_SPH_SCHEME_RIEMANN)
+        rmap_fail(&m, "riemann_limiter", "is the limiter of scheme: riemann, but the case uses scheme: delta; remove it "
+                  "or set scheme: riemann");
     else if (shep > 0 && !LAHAR_SPH_HAVE_SHEPARD)
         rmap_fail(&m, "shepard_interval", "the Shepard filter is not implemented yet; remove the key or set 0");
     else if (o->sps && !LAHAR_SPH_HAVE_SPS)

@@ -99,6 +99,7 @@ static const char *const wall_viscous_names[] = {"halfspace", "paper", NULL};
 static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
 static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
 static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
+static const char *const scheme_names[] = {"delta", "riemann", NULL};
 static const lahar_key sph_keys[] = {
     {"dx", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "particle spacing; it is the particle spacing"},
     {"density", LAHAR_KEY_NUMBER, 0, "1000", LOX, 0, 0, NULL, "kg/m^3", "rest density rho0 of the water"},
@@ -130,6 +131,8 @@ static const lahar_key sph_keys[] = {
     {"background_pressure", LAHAR_KEY_NUMBER, 0, "0 (transport_velocity: rho0 c0^2)", LO, 0, 0, NULL, "Pa", "background pressure p_b (Adami et al. 2013)"},
     {"transport_velocity", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "transport-velocity formulation (Adami et al. 2013): fully periodic water-only flows"},
     {"body_layers", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 8, NULL, "", "particles within N dx of sphere/disc bodies start on N concentric layers; 0 = the plain lattice, 2-3 usual"},
+    {"scheme", LAHAR_KEY_CHOICE, 0, "delta", 0, 0, 0, scheme_names, "", "delta: delta-SPH + artificial viscosity; riemann: the low-dissipation Riemann solver of Zhang, Hu & Adams 2017 (alpha and delta then 0)"},
+    {"riemann_limiter", LAHAR_KEY_NUMBER, 0, "3", LO | HI, 0, 100, NULL, "", "eta of the Riemann scheme's dissipation limiter beta = min(eta max(dU, 0), c0); 3 as in Zhang et al. 2017, 0 = no limiter (the full acoustic dissipation)"},
     {"blocks", LAHAR_KEY_LIST, 1, NULL, 0, 0, 0, NULL, "", "regions filled with particles (non-empty)"},
     END};
 

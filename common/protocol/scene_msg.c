@@ -16,10 +16,10 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
  * booleans sent as int8, CODE fields small integers (enums, counts) sent as int8. A field added to
  * a .lcm type and to scene.h is added here once. */
 #define SPH_NUM_FIELDS(X) X(h_over_dx) X(c0) X(gamma) X(mu) X(alpha) X(delta) X(cfl) X(cfl_force) X(cfl_visc) \
-    X(shepard_interval) X(shifting) X(background_pressure) X(sps_cs) X(halo) X(kappa)
+    X(shepard_interval) X(shifting) X(background_pressure) X(sps_cs) X(halo) X(kappa) X(riemann_limiter)
 #define SPH_FLAG_FIELDS(X) X(shifting_density) X(transport_velocity) X(sps)
 #define SPH_CODE_FIELDS(X) X(eos) X(body_layers) X(wall_viscous) X(initial_pressure) X(wall_pressure) \
-    X(penalty_stiffness) X(soil_wall_stress)
+    X(penalty_stiffness) X(soil_wall_stress) X(scheme)
 #define SPH_ARRAY_FIELDS(X) X(body_force) X(lo) X(hi)
 #define MATERIAL_NUM_FIELDS(X) X(density) X(young) X(poisson) X(kn) X(kt_ratio) X(restitution) X(friction) \
     X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
@@ -220,7 +220,7 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         so->initial_pressure < 0 || so->initial_pressure > LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC ||
         so->wall_pressure < 0 || so->wall_pressure > LAHAR_SPH_WALL_PRESSURE_GHOST || so->penalty_stiffness < 0 ||
         so->penalty_stiffness > LAHAR_SPH_PENALTY_ACOUSTIC || so->soil_wall_stress < 0 ||
-        so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST) {
+        so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST || so->scheme < 0 || so->scheme > LAHAR_SPH_SCHEME_RIEMANN) {
         snprintf(err, errlen, "malformed scene message (sph options)");
         return -1;
     }

@@ -108,6 +108,7 @@ typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sp
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;
 typedef enum { LAHAR_SPH_WALL_PRESSURE_PENALTY = 0, LAHAR_SPH_WALL_PRESSURE_GHOST = 1 } lahar_sph_wall_pressure;
 typedef enum { LAHAR_SPH_PENALTY_STEP = 0, LAHAR_SPH_PENALTY_ACOUSTIC = 1 } lahar_sph_penalty_stiffness;
+typedef enum { LAHAR_SPH_SCHEME_DELTA = 0, LAHAR_SPH_SCHEME_RIEMANN = 1 } lahar_sph_scheme;
 
 typedef struct {
     char kernel[LAHAR_NAME_MAX]; /* "cubic" (default), "quintic", "wendland2" (common/kernels/kernel.h) */
@@ -150,6 +151,10 @@ typedef struct {
     int body_layers;       /* N > 0: the particles within N dx of every sphere (3D) or disc (2D) body's
                               surface are placed on N layers concentric with it at (k + 1/2) dx
                               instead of the lattice (lahar_case_block_lattice); default 0 */
+    lahar_sph_scheme scheme; /* water's pressure and continuity terms: delta (default: delta-SPH +
+                              Monaghan viscosity) or riemann (Zhang, Hu & Adams 2017;
+                              sph_node/fluid/sph_riemann.h) */
+    double riemann_limiter; /* eta of the riemann scheme's dissipation limiter (default 3; 0 = none) */
 } lahar_sph_options;
 
 /* A probe (section probes: of a case; sph_node/probes/sph_probes.h samples it, OUT/gauges.h5).

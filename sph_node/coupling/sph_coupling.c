@@ -1,5 +1,6 @@
 /* SPH-DEM coupling (sph_coupling.h; Trujillo-Vela et al. 2020 section 4). */
 #include "sph_coupling.h"
+#include "sph_riemann.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -657,7 +658,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
         int nh = 0, hist_b[SPH_COUPLING_MAX_PER_PARTICLE];
         double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
         vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
-        double gd[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
+        double gd[SPH_COUPLING_MAX_PER_PARTICLE], gp[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
         double sbar[SPH_NSTRESS] = {0.0}, sown[SPH_NSTRESS] = {0.0}; /* soil ghosts (sph_coupling_set_soil_wall) */
         double lw[9] = {0.0}; /* their share of the velocity gradient */
         int have_sbar = 0;
@@ -786,7 +787,11 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                     double drw;
                     if (pbar != pbar)
                         pbar = ghost_pbar(c, p, i);
-                    f = v3_axpy(p->m[i], ghost_wall_accel(c, p->p[i], pbar, p->rho[i], dv, nrm, urel, &drw), f);
+                    /* the Riemann scheme adds this wall's dissipation to p_i (sph_riemann.h) */
+                    gp[ns] = c->riemann ? p->p[i] + sph_riemann_wall_dissipation(p->rho[i], v3_dot(urel, nrm), c->riemann_c0,
+                                                                                 c->riemann_eta)
+                                        : p->p[i];
+                    f = v3_axpy(p->m[i], ghost_wall_accel(c, gp[ns], pbar, p->rho[i], dv, nrm, urel, &drw), f);
                     drho_g += drw;
                     gn[ns] = nrm;
                     gd[ns] = dv;
@@ -810,7 +815,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                 if (s1 == s2 || gd[s1] < 0.0 || gd[s2] < 0.0 || fabs(v3_dot(gn[s1], gn[s2])) >= 0.1)
                     continue;
                 double drc;
-                vec3 fc = v3_scale(ghost_corner_accel(c, p->p[i], pbar, p->rho[i], gd[s1], gn[s1], gd[s2], gn[s2], gu[s1], gu[s2], &drc),
+                vec3 fc = v3_scale(ghost_corner_accel(c, gp[s1], pbar, p->rho[i], gd[s1], gn[s1], gd[s2], gn[s2], gu[s1], gu[s2], &drc),
                                    -p->m[i]);
                 drho_g -= drc;
                 /* eq. 20: wall s1 takes the reaction of the correction; of the half quadrant its

@@ -105,6 +105,9 @@ typedef struct {
                                     1994, J. Comput. Phys. 110:399; Monaghan & Kajtar 2009, Comput.
                                     Phys. Commun. 180:1811: constants from c0^2 or g H) */
     double body_force[3];        /* b of the ghost pressure extrapolation */
+    int riemann;                 /* GHOST with the water's Riemann scheme: the wall's dissipation
+                                    (sph_riemann.h) joins the ghost pressure; set by sph_fluid_init */
+    double riemann_c0, riemann_eta;
     double *wtab, wtab_dd;       /* GHOST: wall table (sph_coupling.c) on d = gtab_d0 + k wtab_dd */
     double *qtab, qtab_dd;       /* GHOST: corner table on d = gtab_d0 + k qtab_dd */
     const sph_cells *cells;      /* GHOST: the fluid's cells (borrowed), for the ghosts' pressure */

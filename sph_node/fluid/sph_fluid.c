@@ -1,5 +1,6 @@
 /* WCSPH solver core (sph_fluid.h). */
 #include "sph_fluid.h"
+#include "sph_riemann.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -131,6 +132,9 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
      * larger of c0 and the soil's sound speed) */
     if (f->prm.penalty_acoustic)
         f->cpl.kn_dt = f->prm.cfl * f->k.h / fmax(f->prm.c0, f->has_soil ? f->soil.cs : 0.0);
+    f->cpl.riemann = f->prm.riemann;
+    f->cpl.riemann_c0 = f->prm.c0;
+    f->cpl.riemann_eta = f->prm.riemann_eta;
     if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
         sph_coupling_free(&f->cpl);
         return -1;
@@ -219,6 +223,9 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
                  hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
                  hz = prm->periodic[2] || dim == 2 ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
+    /* Riemann scheme (sph_riemann.h): p_i itself (with p_b) and the limiter */
+    const int riem = prm->riemann;
+    const double pi_full = pri * rhoi * rhoi, reta = prm->riemann_eta;
     /* SPS stress of i over rho_i^2 (Canelas et al. 2015, eq. 10); unused when sps is 0 */
     double ti[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     double *const *tau = f->sps_tau;
@@ -244,13 +251,28 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
             const double ieta = 1.0 / (r2 + eta2), rsoft = r2 * ieta;
             /* continuity (Trujillo-Vela et al. 2020, eq. 1) and delta-SPH (sign: diffuses, see sph_fluid.h); x_ji = -x_ij,
              * v_ji.x_ji = v_ij.x_ij, and the diffusion term changes sign */
-            const double dev = ddelta * ((rhoi - rhoj) - (hx * rx + hy * ry + hz * rz)) * rsoft;
-            drhoi += volj * fij * (rhoi * vdotr + dev);
-            drho[j] += voli * fij * (rhoj * vdotr - dev);
-            /* pressure, symmetric (Trujillo-Vela et al. 2020, eq. 2), with Monaghan's Pi_ij > 0 when approaching
-             * (av = 0 without artificial viscosity): -m_i m_j (...) F_ij x_ij */
-            const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
-            const double gp = -mi * mj * (pri + pra[j] - pav) * fij;
+            double gp;
+            if (riem) {
+                /* Riemann scheme (sph_fluid.h, sph_riemann.h; Zhang, Hu & Adams 2017): along e_ij = -x_ij/r,
+                 * U_L - U_R = -v_ij.x_ij/r. Continuity 2 rho_i V_j (v_i - v*).grad_i W_ij =
+                 * rho_i V_j F_ij (v_ij.x_ij + (p_i - p_j - rho0 b.x_ij) r/(rhobar c0)); momentum
+                 * -m_i m_j 2 P* / (rho_i rho_j) F_ij x_ij */
+                const double pj = pra[j] * rhoj * rhoj, rhobar = 0.5 * (rhoi + rhoj);
+                const double du = r > 0.0 ? -vdotr / r : 0.0;
+                const double dpd = (pi_full - pj - c0 * c0 * (hx * rx + hy * ry + hz * rz)) * r / (rhobar * c0);
+                drhoi += volj * fij * rhoi * (vdotr + dpd);
+                drho[j] += voli * fij * rhoj * (vdotr - dpd);
+                const double ps = sph_riemann_pstar(pi_full, pj, rhobar, c0, du, reta);
+                gp = -mi * mj * 2.0 * ps / (rhoi * rhoj) * fij;
+            } else {
+                const double dev = ddelta * ((rhoi - rhoj) - (hx * rx + hy * ry + hz * rz)) * rsoft;
+                drhoi += volj * fij * (rhoi * vdotr + dev);
+                drho[j] += voli * fij * (rhoj * vdotr - dev);
+                /* pressure, symmetric (Trujillo-Vela et al. 2020, eq. 2), with Monaghan's Pi_ij > 0 when approaching
+                 * (av = 0 without artificial viscosity): -m_i m_j (...) F_ij x_ij */
+                const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
+                gp = -mi * mj * (pri + pra[j] - pav) * fij;
+            }
             /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij */
             const double gv = visci * volj * fij * rsoft;
             double Fx = gp * rx + gv * vx, Fy = gp * ry + gv * vy, Fz = dim == 3 ? gp * rz + gv * vz : 0.0;

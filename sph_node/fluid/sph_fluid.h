@@ -42,6 +42,22 @@
  *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
  *     hydrostatic bias that delta-SPH has (Canelas et al. 2015, section 3.3; test_sph_hydrostatic.c).
  *
+ * Riemann scheme (prm.riemann, case key sph.scheme: riemann; Zhang, Hu & Adams 2017, J. Comput. Phys.
+ *   335:605-620, section 3), instead of delta-SPH and Monaghan's viscosity (both must be 0): with
+ *   the pair's interface state U*, P* of sph_riemann.h (e_ij = -x_ij/r, U_L - U_R = -v_ij.x_ij/r),
+ *     drho_i/dt = 2 rho_i sum_j V_j (v_i - v*_ij) . grad_i W_ij,  v*_ij = v-bar_ij + (U* - U-bar) e_ij
+ *               = rho_i sum_j V_j F_ij (v_ij.x_ij + (p_i - p_j - rho0 b.x_ij) r / (rhobar c0))
+ *     dv_i/dt  = -2 sum_j m_j P*_ij / (rho_i rho_j) grad_i W_ij   (+ viscosity, SPS, coupling as above)
+ *   c = c0 for both EOS. The hydrostatic part rho0 b.x_ij of p_i - p_j is not diffused (as for
+ *   delta-SPH, Fourtakas et al. 2019; Zhang et al. 2017 have no gravity term in U*): otherwise the
+ *   term drives a column at rest off hydrostatics. The ghost walls (LAHAR_SPH_WALL_PRESSURE_GHOST) keep
+ *   their terms: with the mirrored ghost state of Zhang et al. 2017 section 3.4 (rho_g = rho_i,
+ *   the wall's velocity, p_g extrapolated hydrostatically) the interface state without
+ *   dissipation is the symmetric pressure (p_i + p_g)/2 and the wall's velocity, which are the
+ *   ghost terms, plus the wall's limited dissipation: p_i + p_g becomes p_i + p_g + rho_i beta dU,
+ *   dU = -2 u_rel.n along the wall's normal (sph_riemann_wall_dissipation). The penalty force of
+ *   eq. 15 stays.
+ *
  * Time integration: kick-drift-kick leapfrog, second order, one neighbour pass per step:
  *   v_h = v + dt/2 a;  rho_h = rho + dt/2 D;  x += dt v_h;
  *   predict v = v_h + dt/2 a, rho = rho_h + dt/2 D;  sort;  evaluate a, D at (x, v, rho);
@@ -97,6 +113,8 @@ typedef struct {
     double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
     sph_soil_material soil_mat;
+    int riemann;            /* 1: Riemann scheme (see "Riemann scheme" above; sph_riemann.h), 0: delta-SPH */
+    double riemann_eta;     /* its limiter eta (Zhang et al. 2017: 3), 0 = the full acoustic dissipation */
 } sph_params;
 
 typedef struct {
