@@ -47,3 +47,11 @@ add_executable(test_sph_split ${LAHAR_TEST_DIR}/test_sph_split.c)
 target_link_libraries(test_sph_split PRIVATE lahar_sph)
 add_test(NAME sph_split COMMAND test_sph_split)
 set_tests_properties(sph_split PROPERTIES LABELS "fast;sph" TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=2")
+
+# Open boundaries (sph_node/sph_inflow.h): discharge through an inlet against the Gumbel
+# hydrograph (Trujillo-Vela et al. 2020, eq. 36) and a CSV t,Q table, mass balance, outflow
+# counts, unique ids, the capacity error, a supercritical channel at its steady depth.
+add_executable(test_sph_inflow ${LAHAR_TEST_DIR}/test_sph_inflow.c)
+target_link_libraries(test_sph_inflow PRIVATE lahar_sph)
+add_test(NAME sph_inflow COMMAND test_sph_inflow)
+set_tests_properties(sph_inflow PROPERTIES LABELS "fast;sph" TIMEOUT 300)
