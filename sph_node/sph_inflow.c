@@ -17,7 +17,7 @@ double sph_inflow_velocity(const sph_inflow *fl, int k, double t)
     return in->def->kind == LAHAR_HYDRO_TABLE_Q ? v / in->area : v;
 }
 
-int sph_inflow_init(sph_inflow *fl, int dim, double dx, const double gravity[3], int ninlet, const lahar_inlet *inlets,
+int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const double gravity[3], int ninlet, const lahar_inlet *inlets,
                     int noutlet, const lahar_outlet *outlets, int has_domain, const double lo[3], const double hi[3],
                     double t_end, char *err, int errlen)
 {
@@ -87,6 +87,7 @@ int sph_inflow_init(sph_inflow *fl, int dim, double dx, const double gravity[3],
                      "on the section; raise inlets[%d].level to at least dx/2", k, d->name, d->level, dx, k);
             return -1;
         }
+        in->layers = d->layers > 0 ? d->layers : (int)ceil(support / dx - 1e-9);
         in->area = in->nslot * (dim == 3 ? dx * dx : dx);
         in->max_particles = d->max_particles;
         if (in->max_particles <= 0) {
@@ -104,7 +105,7 @@ int sph_inflow_init(sph_inflow *fl, int dim, double dx, const double gravity[3],
                     disp += (s == 0 || s == m ? 0.5 : 1.0) * h * fabs(sph_inflow_velocity(fl, k, t));
                 }
             }
-            const double rows = ceil(disp / dx) + d->layers + 2;
+            const double rows = ceil(disp / dx) + in->layers + 2;
             in->max_particles = (int64_t)ceil(1.1 * rows * in->nslot) + in->nslot;
         }
     }
@@ -160,7 +161,7 @@ static int inlet_row(sph_inflow *fl, sph_fluid *f, int k, double c, double t, ch
 static int inlet_rows(sph_inflow *fl, sph_fluid *f, int k, double t, char *err, int errlen)
 {
     sph_inlet *in = &fl->in[k];
-    const double dx = fl->dx, back = -in->def->layers * dx;
+    const double dx = fl->dx, back = -in->layers * dx;
     for (;;) {
         const double c = in->disp - (in->next_row + 0.5) * dx;
         if (c < back)

@@ -46,6 +46,7 @@ typedef struct {
     int64_t next_row;      /* rows created so far */
     int64_t created;       /* particles created (buffer particles included) */
     int64_t max_particles; /* limit of created (the case's inlets[k].max_particles or the estimate) */
+    int layers;            /* buffer rows (the case's, or ceil(kernel support / dx)) */
     double u;              /* velocity of the current step, m/s */
 } sph_inlet;
 
@@ -73,10 +74,11 @@ typedef struct {
     unsigned char *drop;    /* per particle (cap): marks of the removal pass */
 } sph_inflow;
 
-/* Set up the open boundaries (definitions borrowed: they must outlive fl). t_end: the end of the
+/* Set up the open boundaries (definitions borrowed: they must outlive fl). support: the kernel's
+ * support radius (the default buffer depth). t_end: the end of the
  * run (for the default max_particles). Returns 0, or -1 with a message in err (an inlet without
  * gravity, a level below one slot, a section shorter than dx). Allocates nothing per particle. */
-int sph_inflow_init(sph_inflow *fl, int dim, double dx, const double gravity[3], int ninlet, const lahar_inlet *inlets,
+int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const double gravity[3], int ninlet, const lahar_inlet *inlets,
                     int noutlet, const lahar_outlet *outlets, int has_domain, const double lo[3], const double hi[3],
                     double t_end, char *err, int errlen);
 /* Particles the open boundaries may add to the initial ones (the sum of the inlets' limits). */
@@ -95,5 +97,19 @@ double sph_inflow_velocity(const sph_inflow *fl, int k, double t);
 /* Mass of the domain particles (buffer particles excluded), summed in particle order. */
 double sph_inflow_domain_mass(const sph_inflow *fl, const sph_particles *p);
 void sph_inflow_free(sph_inflow *fl);
+
+/* The SPH node's side (sph_inflow_node.c). */
+#include "checkpoint.h"
+#include "scene.h"
+/* 1 when the case has inlets, outlets or a domain box. */
+int sph_inflow_case_wanted(const lahar_case *c);
+/* sph_inflow_init from the case (the kernel support of prm, the case's gravity and t_end). */
+int sph_inflow_setup_case(sph_inflow *fl, const lahar_case *c, const sph_params *prm, char *err, int errlen);
+/* The counters of a snapshot / summary (LAHAR_FLOW_NVAL values, names in common/output.h). */
+void sph_inflow_values(const sph_inflow *fl, const sph_particles *p, double *v);
+/* Store / load the open boundaries' state: the inlet marks of the p->n particles (p->n already
+ * set), the next id, the counters, each inlet's displacement, velocity, rows and particles
+ * created. 0 or -1 (message in f->err). */
+int sph_inflow_state_io(sph_inflow *fl, sph_particles *p, lahar_ckpt_file *f);
 
 #endif

@@ -79,7 +79,7 @@ static int channel_open(channel *ch, double dx, double h, double L, double c0, l
     in->n[0] = 1.0, in->n[1] = 0.0, in->n[2] = 0.0;
     in->level = h;
     in->layers = 3;
-    if (sph_inflow_init(&ch->fl, 2, dx, g, 1, in, noutlet, out, has_domain, lo, hi, t_end, err, errlen) != 0)
+    if (sph_inflow_init(&ch->fl, 2, dx, 2.0 * 1.41 * dx, g, 1, in, noutlet, out, has_domain, lo, hi, t_end, err, errlen) != 0)
         return -1;
     const int64_t cap = sph_inflow_capacity(&ch->fl) + extra_cap;
     if (sph_fluid_init(&ch->f, &prm, cap, err, errlen) != 0)
