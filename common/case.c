@@ -2840,14 +2840,24 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                     has_v + has_g + has_h ? "; it has more than one" : "");
             return;
         }
+        /* the buffer only moves forward (rows are created behind it): no backflow through an inlet */
         if (has_v) {
             in->kind = LAHAR_HYDRO_CONSTANT;
             in->velocity = rmap_num(&m, "velocity", 1, 0.0, "0.5");
+            if (!r->failed && !(in->velocity >= 0.0)) {
+                rmap_fail(&m, "velocity", "must be >= 0 (got %g m/s): the inflow along the inward normal", in->velocity);
+                return;
+            }
         } else if (has_g) {
             in->kind = LAHAR_HYDRO_GUMBEL;
             rmap_vec(&m, "gumbel", 3, in->gumbel, 1, "[35, 2, 3]");
             if (!r->failed && !(in->gumbel[1] > 0.0)) {
                 rmap_fail(&m, "gumbel", "beta_G (the second number) must be > 0 (got %g s)", in->gumbel[1]);
+                return;
+            }
+            if (!r->failed && !(in->gumbel[0] >= 0.0)) {
+                rmap_fail(&m, "gumbel", "a_G (the first number) must be >= 0 (got %g m): the inflow is along the inward "
+                          "normal", in->gumbel[0]);
                 return;
             }
         } else {
@@ -2865,6 +2875,12 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                 rmap_fail(&m, "hydrograph", "%s (paths are relative to the case file's directory)", err);
                 return;
             }
+            for (int k = 0; k < in->ntable; k++)
+                if (!(in->table_v[k] >= 0.0)) {
+                    rmap_fail(&m, "hydrograph", "%s: row %d (t = %g s) has a negative value %g; the inflow is along the "
+                              "inward normal (no backflow through an inlet)", full, k + 1, in->table_t[k], in->table_v[k]);
+                    return;
+                }
         }
     }
 }
