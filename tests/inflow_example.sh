@@ -24,5 +24,17 @@ with h5py.File(out + "/particles.h5", "r") as f:
     assert flow["entered"] == last["flow_entered"] and flow["removed_water"] == last["flow_removed_water"], \
         f"summary.json flow {flow} is not the last snapshot's counters"
     assert flow["entered"] > 500 and flow["removed_water"] > 500, f"little went through: {flow}"
+    # ids: unique in every snapshot, the created ones never reuse an id seen before
+    first = set(f["snapshots"][snaps[0]]["id"][()].tolist())
+    seen = set(first)
+    for s in snaps:
+        ids = f["snapshots"][s]["id"][()]
+        assert len(set(ids.tolist())) == len(ids), f"snapshot {s}: an id twice"
+        seen.update(ids.tolist())
+    # every id handed out shows up in some snapshot here (a particle needs 0.6 s to cross the channel)
+    assert max(seen) - min(seen) + 1 == len(seen), "ids are not the contiguous 0 .. created - 1"
+    # the ids handed out: the blocks' 0 .. nb - 1, then one per created particle
+    nb = int(sum(v < 0 for v in f["snapshots"][snaps[0]]["inlet"][()]))
+    assert max(seen) < nb + flow["created"], f"id {max(seen)} beyond the {nb} + {flow['created']} handed out"
 print(f"inflow_example: {len(snaps)} snapshots, counts {min(counts)}..{max(counts)}, flow {flow}")
 PY
