@@ -2766,10 +2766,24 @@ static int open_boundary_support(reader *r, yaml_node_t *n, const char *key, con
     return 0;
 }
 
+/* the path of a CSV key, relative to the case file's directory; 0 or -1 */
+static int inflow_csv(rmap *m, const char *key, char *full, size_t n)
+{
+    const char *file = rmap_str(m, key, 1, NULL, "inflow.csv");
+    if (m->r->failed)
+        return -1;
+    if (file[0] == '/')
+        snprintf(full, n, "%s", file);
+    else
+        snprintf(full, n, "%s%s", m->r->dir, file);
+    return 0;
+}
+
 static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const keys[] = {"name", "position", "edge", "edge2", "normal", "level", "velocity", "gumbel",
-                                       "hydrograph", "start", "end", "layers", "max_particles", NULL};
+    static const char *const keys[] = {"name", "position", "edge", "edge2", "normal", "level", "level_hydrograph",
+                                       "velocity", "gumbel", "hydrograph", "start", "end", "layers", "max_particles",
+                                       NULL};
     if (!n || r->failed)
         return;
     if (n->type != YAML_SEQUENCE_NODE) {
@@ -2804,7 +2818,38 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_name(&m, "name", 0, def, in->name);
         if (read_section(&m, dim, in->x0, in->e1, in->e2, in->n, "inward") != 0)
             return;
-        in->level = rmap_num(&m, "level", 1, 0.0, "0.1");
+        const int has_lt = rmap_get(&m, "level_hydrograph") != NULL;
+        if (has_lt && rmap_get(&m, "level")) {
+            rmap_fail(&m, "level_hydrograph", "give either level: H (constant) or level_hydrograph: FILE.csv (t,h), "
+                      "not both");
+            return;
+        }
+        in->level = has_lt ? 1.0 : rmap_num(&m, "level", 1, 0.0, "0.1");
+        if (has_lt) { /* a level table t,h: the level is its largest value (the slots of the section) */
+            char full[2048], err[1400];
+            if (inflow_csv(&m, "level_hydrograph", full, sizeof full) != 0)
+                return;
+            int kind = 0;
+            in->nlevel = lahar_hydrograph_read_csv(full, &kind, &in->level_t, &in->level_h, err, (int)sizeof err);
+            if (in->nlevel < 0) {
+                in->nlevel = 0;
+                rmap_fail(&m, "level_hydrograph", "%s (paths are relative to the case file's directory)", err);
+                return;
+            }
+            if (kind != LAHAR_HYDRO_TABLE_H) {
+                rmap_fail(&m, "level_hydrograph", "%s: the header must be `t,h` (a level table)", full);
+                return;
+            }
+            in->level = 0.0;
+            for (int k = 0; k < in->nlevel; k++) {
+                if (!(in->level_h[k] >= 0.0)) {
+                    rmap_fail(&m, "level_hydrograph", "%s: row %d (t = %g s) has a negative level %g m", full, k + 1,
+                              in->level_t[k], in->level_h[k]);
+                    return;
+                }
+                in->level = fmax(in->level, in->level_h[k]);
+            }
+        }
         in->t_start = rmap_num(&m, "start", 0, 0.0, "0.0");
         in->t_end = rmap_num(&m, "end", 0, 1e300, "15.0");
         const double layers = rmap_num(&m, "layers", 0, 0.0, "4");
@@ -2812,7 +2857,8 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
         if (r->failed)
             return;
         if (!(in->level > 0.0)) {
-            rmap_fail(&m, "level", "must be > 0 (got %g): the water depth above the section's lowest point, m", in->level);
+            rmap_fail(&m, in->nlevel ? "level_hydrograph" : "level", "must be > 0 (got %g%s): the water depth above the "
+                      "section's lowest point, m", in->level, in->nlevel ? " at most" : "");
             return;
         }
         if (!(in->t_end > in->t_start)) {
@@ -2861,18 +2907,18 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                 return;
             }
         } else {
-            const char *file = rmap_str(&m, "hydrograph", 1, NULL, "inflow.csv");
-            if (r->failed)
-                return;
             char full[2048], err[1400];
-            if (file[0] == '/')
-                snprintf(full, sizeof full, "%s", file);
-            else
-                snprintf(full, sizeof full, "%s%s", r->dir, file);
+            if (inflow_csv(&m, "hydrograph", full, sizeof full) != 0)
+                return;
             in->ntable = lahar_hydrograph_read_csv(full, &in->kind, &in->table_t, &in->table_v, err, (int)sizeof err);
             if (in->ntable < 0) {
                 in->ntable = 0;
                 rmap_fail(&m, "hydrograph", "%s (paths are relative to the case file's directory)", err);
+                return;
+            }
+            if (in->kind == LAHAR_HYDRO_TABLE_H) {
+                rmap_fail(&m, "hydrograph", "%s holds a level (header t,h); give it as level_hydrograph:, and the "
+                          "inflow as t,u or t,Q", full);
                 return;
             }
             for (int k = 0; k < in->ntable; k++)
@@ -3135,7 +3181,7 @@ void lahar_case_free(lahar_case *c)
     free(c->blocks);
     free(c->probes);
     for (int i = 0; i < c->ninlet; i++)
-        free(c->inlets[i].table_t), free(c->inlets[i].table_v);
+        free(c->inlets[i].table_t), free(c->inlets[i].table_v), free(c->inlets[i].level_t), free(c->inlets[i].level_h);
     free(c->inlets);
     free(c->outlets);
     memset(c, 0, sizeof *c);

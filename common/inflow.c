@@ -7,6 +7,27 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* linear in a table (t increasing), the end values outside */
+static double table_at(const double *tt, const double *vv, int n, double t)
+{
+    if (n <= 0)
+        return 0.0;
+    if (t <= tt[0])
+        return vv[0];
+    if (t >= tt[n - 1])
+        return vv[n - 1];
+    int lo = 0, hi = n - 1; /* tt[lo] < t < tt[hi] */
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (tt[mid] <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    const double w = (t - tt[lo]) / (tt[hi] - tt[lo]);
+    return vv[lo] + w * (vv[hi] - vv[lo]);
+}
+
 double lahar_inlet_hydrograph(const lahar_inlet *in, double t)
 {
     if (!(t >= in->t_start && t < in->t_end))
@@ -19,28 +40,16 @@ double lahar_inlet_hydrograph(const lahar_inlet *in, double t)
         return a / beta * e * exp(-e);
     }
     case LAHAR_HYDRO_TABLE_U:
-    case LAHAR_HYDRO_TABLE_Q: {
-        const int n = in->ntable;
-        if (n <= 0)
-            return 0.0;
-        if (t <= in->table_t[0])
-            return in->table_v[0];
-        if (t >= in->table_t[n - 1])
-            return in->table_v[n - 1];
-        int lo = 0, hi = n - 1; /* table_t[lo] < t < table_t[hi] */
-        while (hi - lo > 1) {
-            const int mid = (lo + hi) / 2;
-            if (in->table_t[mid] <= t)
-                lo = mid;
-            else
-                hi = mid;
-        }
-        const double w = (t - in->table_t[lo]) / (in->table_t[hi] - in->table_t[lo]);
-        return in->table_v[lo] + w * (in->table_v[hi] - in->table_v[lo]);
-    }
+    case LAHAR_HYDRO_TABLE_Q:
+        return table_at(in->table_t, in->table_v, in->ntable, t);
     default:
         return in->velocity;
     }
+}
+
+double lahar_inlet_level(const lahar_inlet *in, double t)
+{
+    return in->nlevel > 0 ? table_at(in->level_t, in->level_h, in->nlevel, t) : in->level;
 }
 
 /* the first two comma-separated fields of a line as numbers; 0 or -1 */
@@ -87,12 +96,12 @@ int lahar_hydrograph_read_csv(const char *path, int *kind, double **t, double **
         if (!header) {
             char a[32], b[32];
             if (sscanf(s, " %31[^, \t] , %31[^, \t\r\n]", a, b) != 2 || strcmp(a, "t") != 0 ||
-                (strcmp(b, "u") != 0 && strcmp(b, "Q") != 0)) {
-                snprintf(err, (size_t)errlen, "%s:%d: the first line must be the header `t,u` (velocity, m/s) or "
-                         "`t,Q` (discharge)", path, lineno);
+                (strcmp(b, "u") != 0 && strcmp(b, "Q") != 0 && strcmp(b, "h") != 0)) {
+                snprintf(err, (size_t)errlen, "%s:%d: the first line must be the header `t,u` (velocity, m/s), "
+                         "`t,Q` (discharge) or `t,h` (level, m)", path, lineno);
                 goto fail;
             }
-            *kind = b[0] == 'u' ? LAHAR_HYDRO_TABLE_U : LAHAR_HYDRO_TABLE_Q;
+            *kind = b[0] == 'u' ? LAHAR_HYDRO_TABLE_U : b[0] == 'Q' ? LAHAR_HYDRO_TABLE_Q : LAHAR_HYDRO_TABLE_H;
             header = 1;
             continue;
         }

@@ -13,7 +13,9 @@
  *              m^3/s in 3D), linear between rows, the end values outside;
  * all multiplied by 0 outside the active window [start, end). A discharge Q is turned into the
  * velocity u = Q / A with A the wetted area of the section's lattice (slots below the level times
- * dx^(D-1)), so the particles delivered carry Q exactly up to one row (sph_inflow.c). */
+ * dx^(D-1)), so the particles delivered carry Q exactly up to one row (sph_inflow.c). The level h
+ * is a constant or a CSV table t,h (level_hydrograph): a new buffer row fills the slots below
+ * h(t) at its creation, and the buffer's hydrostatic density follows h(t). */
 #ifndef LAHAR_INFLOW_H
 #define LAHAR_INFLOW_H
 #include <stdint.h>
@@ -24,7 +26,8 @@ typedef enum {
     LAHAR_HYDRO_CONSTANT = 0,
     LAHAR_HYDRO_GUMBEL = 1,
     LAHAR_HYDRO_TABLE_U = 2, /* CSV t,u */
-    LAHAR_HYDRO_TABLE_Q = 3  /* CSV t,Q */
+    LAHAR_HYDRO_TABLE_Q = 3, /* CSV t,Q */
+    LAHAR_HYDRO_TABLE_H = 4  /* CSV t,h: a level table (level_hydrograph), not a velocity */
 } lahar_hydro_kind;
 
 typedef struct {
@@ -32,7 +35,11 @@ typedef struct {
     double x0[3];       /* one end of the line (2D) or a corner of the rectangle (3D) */
     double e1[3], e2[3]; /* edges: the section is x0 + a e1 (+ b e2), a, b in [0, 1]; 2D: e2 = 0 */
     double n[3];        /* inward unit normal (perpendicular to the edges) */
-    double level;       /* water depth above the section's lowest point, m */
+    double level;       /* water depth above the section's lowest point, m (with a level table: its
+                           largest value, which sets the slots of the section's lattice) */
+    int nlevel;         /* level table rows (0: the level is constant) */
+    double *level_t, *level_h; /* t (s, increasing) and h (m): h(t) linear between rows, the end
+                                  values outside (not limited to [t_start, t_end)) */
     int layers;         /* rows of buffer particles behind the section (>= kernel support / dx) */
     int kind;           /* lahar_hydro_kind */
     double velocity;    /* constant: m/s */
@@ -55,7 +62,10 @@ typedef struct {
  * t,Q tables; 0 outside [t_start, t_end). */
 double lahar_inlet_hydrograph(const lahar_inlet *in, double t);
 
-/* Read a CSV hydrograph: a header line `t,u` or `t,Q` (kind LAHAR_HYDRO_TABLE_U / _Q), then rows
+/* The inlet's level at t: the constant level, or the level table at t. */
+double lahar_inlet_level(const lahar_inlet *in, double t);
+
+/* Read a CSV hydrograph: a header line `t,u`, `t,Q` or `t,h` (kind LAHAR_HYDRO_TABLE_U / _Q / _H), then rows
  * of two numbers, t strictly increasing; blank lines and lines starting with # are skipped.
  * Allocates *t and *v (free both). Returns the number of rows, or -1 with "line N: what to do" in
  * err. */

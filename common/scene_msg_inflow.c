@@ -34,6 +34,9 @@ int lahar_scene_msg_inflow_from_case(const lahar_case *c, lahar_scene_t *m)
         b->ntable = a->ntable;
         b->table_t = a->table_t;
         b->table_v = a->table_v;
+        b->nlevel = a->nlevel;
+        b->level_t = a->level_t;
+        b->level_h = a->level_h;
     }
     for (int i = 0; i < c->noutlet; i++) {
         const lahar_outlet *a = &c->outlets[i];
@@ -72,7 +75,7 @@ int lahar_scene_msg_inflow_to_case(const lahar_scene_t *m, lahar_case *c, char *
         lahar_inlet *b = &c->inlets[i];
         c->ninlet = i + 1;
         if (a->kind < LAHAR_HYDRO_CONSTANT || a->kind > LAHAR_HYDRO_TABLE_Q || a->ntable < 0 || !(a->level > 0.0) ||
-            a->layers < 0 || a->max_particles < 0 ||
+            a->layers < 0 || a->max_particles < 0 || a->nlevel < 0 ||
             ((a->kind == LAHAR_HYDRO_TABLE_U || a->kind == LAHAR_HYDRO_TABLE_Q) && a->ntable < 1)) {
             snprintf(err, errlen, "malformed scene message (inlet %d)", i);
             return -1;
@@ -98,6 +101,15 @@ int lahar_scene_msg_inflow_to_case(const lahar_scene_t *m, lahar_case *c, char *
             memcpy(b->table_t, a->table_t, (size_t)a->ntable * sizeof *b->table_t);
             memcpy(b->table_v, a->table_v, (size_t)a->ntable * sizeof *b->table_v);
             b->ntable = a->ntable;
+        }
+        if (a->nlevel > 0) {
+            b->level_t = malloc((size_t)a->nlevel * sizeof *b->level_t);
+            b->level_h = malloc((size_t)a->nlevel * sizeof *b->level_h);
+            if (!b->level_t || !b->level_h)
+                goto oom;
+            memcpy(b->level_t, a->level_t, (size_t)a->nlevel * sizeof *b->level_t);
+            memcpy(b->level_h, a->level_h, (size_t)a->nlevel * sizeof *b->level_h);
+            b->nlevel = a->nlevel;
         }
     }
     if (m->noutlet > 0 && !(c->outlets = calloc((size_t)m->noutlet, sizeof *c->outlets)))

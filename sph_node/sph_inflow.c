@@ -10,11 +10,23 @@
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
+double sph_inflow_area(const sph_inflow *fl, int k, double h)
+{
+    const sph_inlet *in = &fl->in[k];
+    int wet = 0;
+    for (int s = 0; s < in->nslot; s++)
+        wet += in->slot_s[s] < h;
+    return wet * (fl->dim == 3 ? fl->dx * fl->dx : fl->dx);
+}
+
 double sph_inflow_velocity(const sph_inflow *fl, int k, double t)
 {
     const sph_inlet *in = &fl->in[k];
     const double v = lahar_inlet_hydrograph(in->def, t);
-    return in->def->kind == LAHAR_HYDRO_TABLE_Q ? v / in->area : v;
+    if (in->def->kind != LAHAR_HYDRO_TABLE_Q)
+        return v;
+    const double a = in->def->nlevel > 0 ? sph_inflow_area(fl, k, lahar_inlet_level(in->def, t)) : in->area;
+    return a > 0.0 ? v / a : 0.0;
 }
 
 int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const double gravity[3], int ninlet, const lahar_inlet *inlets,
@@ -68,7 +80,8 @@ int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const do
                 q[a] = d->x0[a] + (c & 1 ? d->e1[a] : 0.0) + (c & 2 ? d->e2[a] : 0.0);
             in->s_low = fmin(in->s_low, dot3(q, in->up));
         }
-        if (!(in->slot = malloc((size_t)n1 * (size_t)n2 * 3 * sizeof *in->slot))) {
+        in->slot_s = malloc((size_t)n1 * (size_t)n2 * sizeof *in->slot_s);
+        if (!(in->slot = malloc((size_t)n1 * (size_t)n2 * 3 * sizeof *in->slot)) || !in->slot_s) {
             snprintf(err, (size_t)errlen, "out of memory for the inlets");
             return -1;
         }
@@ -79,6 +92,7 @@ int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const do
                     q[a] = d->x0[a] + (i + 0.5) * dx * in->t1[a] + (dim == 3 ? (j + 0.5) * dx * in->t2[a] : 0.0);
                 if (dot3(q, in->up) - in->s_low < d->level) {
                     memcpy(&in->slot[3 * in->nslot], q, sizeof q);
+                    in->slot_s[in->nslot] = dot3(q, in->up) - in->s_low;
                     in->nslot++;
                 }
             }
@@ -89,6 +103,7 @@ int sph_inflow_init(sph_inflow *fl, int dim, double dx, double support, const do
         }
         in->layers = d->layers > 0 ? d->layers : (int)ceil(support / dx - 1e-9);
         in->area = in->nslot * (dim == 3 ? dx * dx : dx);
+        in->h = d->level;
         in->max_particles = d->max_particles;
         if (in->max_particles <= 0) {
             /* the estimate: the rows the hydrograph pushes through the section in the active window
@@ -124,7 +139,7 @@ int64_t sph_inflow_capacity(const sph_inflow *fl)
 static double inlet_density(const sph_inflow *fl, const sph_inlet *in, const sph_params *prm, const double x[3])
 {
     const double gmag = sqrt(dot3(fl->gravity, fl->gravity));
-    const double depth = in->def->level - (dot3(x, in->up) - in->s_low);
+    const double depth = in->h - (dot3(x, in->up) - in->s_low);
     return sph_fluid_density_of_pressure(prm, prm->rho0 * gmag * fmax(depth, 0.0));
 }
 
@@ -135,15 +150,20 @@ static int inlet_row(sph_inflow *fl, sph_fluid *f, int k, double c, double t, ch
     sph_particles *p = &f->p;
     const lahar_inlet *d = in->def;
     const double vol = fl->dim == 3 ? fl->dx * fl->dx * fl->dx : fl->dx * fl->dx;
-    if (in->created + in->nslot > in->max_particles || p->n + in->nslot > p->cap) {
+    int nrow = 0; /* the slots below the current level */
+    for (int s = 0; s < in->nslot; s++)
+        nrow += in->slot_s[s] < in->h;
+    if (in->created + nrow > in->max_particles || p->n + nrow > p->cap) {
         snprintf(err, (size_t)errlen, "inlets[%d] '%s' has created %lld particles at t = %g s and needs %d more: "
                  "its limit is inlets[%d].max_particles = %lld (by default the estimate from its hydrograph "
-                 "+ 10 %%); raise inlets[%d].max_particles", k, d->name, (long long)in->created, t, in->nslot, k,
+                 "+ 10 %%); raise inlets[%d].max_particles", k, d->name, (long long)in->created, t, nrow, k,
                  (long long)in->max_particles, k);
         return -1;
     }
     const double v[3] = {in->u * d->n[0], in->u * d->n[1], in->u * d->n[2]};
     for (int s = 0; s < in->nslot; s++) {
+        if (!(in->slot_s[s] < in->h))
+            continue;
         double x[3];
         for (int a = 0; a < 3; a++)
             x[a] = in->slot[3 * s + a] + c * d->n[a];
@@ -152,8 +172,8 @@ static int inlet_row(sph_inflow *fl, sph_fluid *f, int k, double c, double t, ch
         p->id[i] = fl->next_id++;
         p->inlet[i] = k;
     }
-    in->created += in->nslot;
-    fl->counts.created += in->nslot;
+    in->created += nrow;
+    fl->counts.created += nrow;
     return 0;
 }
 
@@ -184,6 +204,7 @@ int sph_inflow_start(sph_inflow *fl, sph_fluid *f, double t, char *err, int errl
         top = p->id[i] > top ? p->id[i] : top;
     fl->next_id = top + 1;
     for (int k = 0; k < fl->ninlet; k++) {
+        fl->in[k].h = lahar_inlet_level(fl->in[k].def, t);
         fl->in[k].u = sph_inflow_velocity(fl, k, t);
         if (inlet_rows(fl, f, k, t, err, errlen) != 0)
             return -1;
@@ -254,6 +275,7 @@ int64_t sph_inflow_apply(sph_inflow *fl, sph_fluid *f, double t, double dt, char
         }
         /* 3. the hydrograph at t; new rows behind the buffer */
         for (int k = 0; k < fl->ninlet; k++) {
+            fl->in[k].h = lahar_inlet_level(fl->in[k].def, t);
             fl->in[k].u = sph_inflow_velocity(fl, k, t);
             if (inlet_rows(fl, f, k, t, err, errlen) != 0)
                 return INT64_MIN;
@@ -293,7 +315,7 @@ double sph_inflow_domain_mass(const sph_inflow *fl, const sph_particles *p)
 void sph_inflow_free(sph_inflow *fl)
 {
     for (int k = 0; k < fl->ninlet; k++)
-        free(fl->in[k].slot);
+        free(fl->in[k].slot), free(fl->in[k].slot_s);
     free(fl->in);
     free(fl->drop);
     memset(fl, 0, sizeof *fl);

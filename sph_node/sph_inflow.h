@@ -14,7 +14,8 @@
  * along n. The inlet keeps the displacement D = sum u(t_k) dt_k; row r (r = 0, 1, ...) sits at
  * the normal coordinate D - (r + 1/2) dx: it is created when that reaches -layers dx (behind the
  * buffer) and its particles become fluid particles when it reaches 0 (they cross the section),
- * keeping their position, velocity, density, mass and rates. A created particle gets the next
+ * keeping their position, velocity, density, mass and rates. With a level table h(t) a row takes
+ * the slots below h at its creation and the buffer's density follows h(t). A created particle gets the next
  * unique id (never reused) and the mass rho dx^D of its hydrostatic density rho (as the blocks'
  * particles: its volume is its lattice cell). Discharge: the particles entering up to time t
  * carry the volume A dx floor(D/dx + 1/2), A = (slots) dx^(D-1), i.e. A D = the integral of
@@ -39,9 +40,12 @@ typedef struct {
     double t1[3], t2[3];   /* unit edge directions (2D: t2 = 0) */
     double up[3];          /* unit vector against gravity */
     double s_low;          /* height (along up) of the section's lowest point */
-    int nslot;             /* lattice slots of the section below the level */
+    int nslot;             /* lattice slots of the section below the (largest) level */
     double *slot;          /* nslot x 3: slot centres on the section */
-    double area;           /* nslot dx^(D-1): m in 2D (per unit thickness), m^2 in 3D */
+    double *slot_s;        /* nslot: their heights above s_low */
+    double area;           /* slots below the current level x dx^(D-1): m in 2D (per unit
+                              thickness), m^2 in 3D */
+    double h;              /* the current level (lahar_inlet_level) */
     double disp;           /* D = sum of u dt so far */
     int64_t next_row;      /* rows created so far */
     int64_t created;       /* particles created (buffer particles included) */
@@ -92,8 +96,10 @@ int sph_inflow_start(sph_inflow *fl, sph_fluid *f, double t, char *err, int errl
  * Returns the number of particles added minus removed (>= INT64_MIN / 2), or INT64_MIN with a
  * message in err (capacity exhausted). */
 int64_t sph_inflow_apply(sph_inflow *fl, sph_fluid *f, double t, double dt, char *err, int errlen);
-/* The inlet's velocity at t (the hydrograph, a discharge divided by the area). */
+/* The inlet's velocity at t (the hydrograph; a discharge divided by the area below h(t)). */
 double sph_inflow_velocity(const sph_inflow *fl, int k, double t);
+/* The wetted area of inlet k's lattice below the level h: slots x dx^(D-1). */
+double sph_inflow_area(const sph_inflow *fl, int k, double h);
 /* Mass of the domain particles (buffer particles excluded), summed in particle order. */
 double sph_inflow_domain_mass(const sph_inflow *fl, const sph_particles *p);
 void sph_inflow_free(sph_inflow *fl);
