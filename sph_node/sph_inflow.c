@@ -150,9 +150,12 @@ static int inlet_row(sph_inflow *fl, sph_fluid *f, int k, double c, double t, ch
     sph_particles *p = &f->p;
     const lahar_inlet *d = in->def;
     const double vol = fl->dim == 3 ? fl->dx * fl->dx * fl->dx : fl->dx * fl->dx;
-    int nrow = 0; /* the slots below the current level */
+    /* the slots below the level at the time the row will cross the section (c < 0 behind it, at
+     * the current velocity): the buffer's transit does not delay a change of level */
+    const double hr = d->nlevel > 0 && in->u > 0.0 ? lahar_inlet_level(d, t - c / in->u) : in->h;
+    int nrow = 0;
     for (int s = 0; s < in->nslot; s++)
-        nrow += in->slot_s[s] < in->h;
+        nrow += in->slot_s[s] < hr;
     if (in->created + nrow > in->max_particles || p->n + nrow > p->cap) {
         snprintf(err, (size_t)errlen, "inlets[%d] '%s' has created %lld particles at t = %g s and needs %d more: "
                  "its limit is inlets[%d].max_particles = %lld (by default the estimate from its hydrograph "
@@ -162,7 +165,7 @@ static int inlet_row(sph_inflow *fl, sph_fluid *f, int k, double c, double t, ch
     }
     const double v[3] = {in->u * d->n[0], in->u * d->n[1], in->u * d->n[2]};
     for (int s = 0; s < in->nslot; s++) {
-        if (!(in->slot_s[s] < in->h))
+        if (!(in->slot_s[s] < hr))
             continue;
         double x[3];
         for (int a = 0; a < 3; a++)

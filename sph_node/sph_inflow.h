@@ -15,7 +15,8 @@
  * the normal coordinate D - (r + 1/2) dx: it is created when that reaches -layers dx (behind the
  * buffer) and its particles become fluid particles when it reaches 0 (they cross the section),
  * keeping their position, velocity, density, mass and rates. With a level table h(t) a row takes
- * the slots below h at its creation and the buffer's density follows h(t). A created particle gets the next
+ * the slots below h at the time it will cross the section (t - c/u at creation, c its normal
+ * coordinate: the buffer's transit does not delay the level) and the buffer's density follows h(t). A created particle gets the next
  * unique id (never reused) and the mass rho dx^D of its hydrostatic density rho (as the blocks'
  * particles: its volume is its lattice cell). Discharge: the particles entering up to time t
  * carry the volume A dx floor(D/dx + 1/2), A = (slots) dx^(D-1), i.e. A D = the integral of

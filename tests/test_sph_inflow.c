@@ -18,6 +18,11 @@
  *     within 12 % of the prescribed h (shallow water: a supercritical stream on a horizontal
  *     frictionless bed keeps its depth; the bound covers the dx/2 lattice quantisation of the
  *     free surface, dx = h/5).
+ *  F. A level table h(t) (CSV t,h: 0.03 m rising to 0.07 m in 0.4 s), constant 0.5 m/s: the volume
+ *     in against u int h dt, within half a row at the top level + the staircase of the slots
+ *     (|A(h) - h| <= dx/2: u dx/2 t) + 1 %, and within half a row + 1 % (the rows take the level
+ *     of the time they cross the section, so the buffer's transit does not delay it); the newest
+ *     buffer row holds the slots below h(t).
  *  E. 3D: a rectangular inlet (0.1 m wide, level 0.06 m: 5 x 3 slots of dx = 0.02 m) on a
  *     floor, constant 0.5 m/s: 15 slots, area 0.1 x 0.06 m^2, the volume in against A u t within
  *     half a row + 1 %. (No side walls: the water spreads and speeds up past the section, so the
@@ -366,6 +371,65 @@ static void test_steady(void)
     channel_close(&ch);
 }
 
+/* F: level table */
+static void test_level(void)
+{
+    const char *path = "test_sph_inflow_h.csv";
+    FILE *fc = fopen(path, "w");
+    if (!fc) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(fc, "t,h\n0, 0.03\n0.4, 0.07\n1.0, 0.07\n");
+    fclose(fc);
+    lahar_inlet in;
+    memset(&in, 0, sizeof in);
+    snprintf(in.name, sizeof in.name, "level");
+    char err[512];
+    int kind = -1;
+    in.nlevel = lahar_hydrograph_read_csv(path, &kind, &in.level_t, &in.level_h, err, sizeof err);
+    remove(path);
+    CHECK(in.nlevel == 3 && kind == LAHAR_HYDRO_TABLE_H, "level csv: %d rows, kind %d", in.nlevel, kind);
+    if (in.nlevel != 3) {
+        free(in.level_t), free(in.level_h);
+        return;
+    }
+    in.kind = LAHAR_HYDRO_CONSTANT;
+    in.velocity = 0.5;
+    in.t_start = 0.0, in.t_end = 1e9;
+    channel ch;
+    const double dx = 0.01, t_stop = 0.5;
+    /* channel_open sets level = h; the table's largest value sets the slots */
+    if (channel_open(&ch, dx, 0.07, 1.0, 20.0, &in, 0, NULL, 0, NULL, NULL, t_stop, 0, err, sizeof err) != 0) {
+        CHECK(0, "level: set-up: %s", err);
+    } else {
+        int ok = 1;
+        while (ch.f.t < t_stop - 1e-12 && ok)
+            ok = channel_step(&ch, 1e-3, err, sizeof err) > 0.0;
+        CHECK(ok, "level: %s", err);
+        /* u int h dt: h = 0.03 + 0.1 t up to 0.4 s, then 0.07 */
+        const double t = ch.f.t, ih = t <= 0.4 ? 0.03 * t + 0.05 * t * t : 0.03 * 0.4 + 0.05 * 0.16 + 0.07 * (t - 0.4);
+        const double ref = 0.5 * ih, got = entered_volume(&ch);
+        const double bound = 0.5 * 0.07 * dx + 0.5 * 0.5 * dx * t + 0.01 * ref;
+        int newest = 0; /* buffer particles of the newest row: those furthest behind the section */
+        double back = 0.0;
+        for (int64_t i = 0; i < ch.f.p.n; i++)
+            if (ch.f.p.inlet[i] == 0)
+                back = fmin(back, ch.f.p.x[i]);
+        for (int64_t i = 0; i < ch.f.p.n; i++)
+            newest += ch.f.p.inlet[i] == 0 && ch.f.p.x[i] < back + 0.5 * dx;
+        printf("level: t = %.3g s, volume in %.6g m^2 against u int h dt = %.6g m^2 (bound %.3g); newest buffer row "
+               "%d particles (level %.4g m: %d slots below it)\n",
+               t, got, ref, bound, newest, ch.fl.in[0].h, (int)floor(ch.fl.in[0].h / dx + 0.5));
+        CHECK(fabs(got - ref) <= bound, "level: volume in %.6g vs %.6g", got, ref);
+        CHECK(newest == (int)floor(ch.fl.in[0].h / dx + 0.5), "level: newest row %d particles", newest);
+        CHECK(fabs(got - ref) <= 0.5 * 0.07 * dx + 0.01 * ref, "level: the volume lags the level by more than half a "
+              "row: %.6g vs %.6g", got, ref);
+    }
+    channel_close(&ch);
+    free(in.level_t), free(in.level_h);
+}
+
 /* E: 3D rectangle inlet */
 static void test_3d(void)
 {
@@ -454,5 +518,6 @@ int main(void)
     test_balance();
     test_steady();
     test_3d();
+    test_level();
     return failures ? 1 : 0;
 }
