@@ -735,7 +735,7 @@ static int coord_dt_collapse(coord *co, int64_t k, double dt_allowed, double dt_
 
 /* ---- checkpoints --------------------------------------------------------------------------- */
 
-/* The coordinator's part of a checkpoint (common/checkpoint.h; one function both ways): the step
+/* The coordinator's part of a checkpoint (common/io/checkpoint.h; one function both ways): the step
  * and time, the clock, the next step's limit and the first step (dt collapse), whether the state
  * is a scheduled snapshot, and the totals summary.json continues. */
 static int coord_state_io(coord *co, lahar_ckpt_file *f, int64_t *k, lahar_clock *clk, double *dt_allowed,
@@ -1230,7 +1230,7 @@ static int coord_lock_outdir(const char *outdir, const char *case_path)
     return fd;
 }
 
-/* OUT holding an earlier run's files (common/output.h, lahar_output_run_files) is refused, so
+/* OUT holding an earlier run's files (common/io/output.h, lahar_output_run_files) is refused, so
  * that runs never mix (a water run's particles.h5 left beside a later DEM-only run, lahar.xmf
  * pointing at both); with --overwrite those files are removed first. 0 to go on, -1 refused. */
 static int coord_clear_outdir(const char *outdir, int overwrite)

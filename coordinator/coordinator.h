@@ -13,7 +13,7 @@ typedef struct {
     int no_spawn;          /* nodes are started by the user */
     int quiet;
     double join_wait_s;    /* how long to wait for the nodes' hello (default 30 s) */
-    const char *auth_key_path; /* authenticated run across machines (common/auth.h); NULL: $LAHAR_AUTH_KEY */
+    const char *auth_key_path; /* authenticated run across machines (common/protocol/auth.h); NULL: $LAHAR_AUTH_KEY */
     int overwrite;         /* 1: remove an earlier run's files in outdir first (else such an outdir is refused) */
     double node_timeout_s; /* a node silent this long is lost, unless it is ours and still computing
                               (default COORD_NODE_SILENCE, 2 s) */

@@ -16,6 +16,7 @@
 #include "auth.h"
 #include "netns.h"
 #include "output.h"
+#include "case_keys.h"
 
 static void usage(FILE *f)
 {
@@ -30,6 +31,9 @@ static void usage(FILE *f)
             "       lahar resume OUT [--time-end T] [options] continue the run in OUT from its newest\n"
             "                                                checkpoint (case section checkpoint:), to its\n"
             "                                                time.end or to T; same options as run\n"
+            "       lahar keys [SECTION | --yaml]            every case key: type, unit, default, allowed values\n"
+            "                                                (SECTION e.g. sph, time, sph.blocks[]; --yaml: the\n"
+            "                                                commented reference, cases/reference.yaml)\n"
             "       lahar keygen FILE                        a new key for --auth-key (mode 0600)\n"
             "       lahar --help | --version\n\n"
             "Options of run and check:\n"
@@ -174,7 +178,7 @@ static int check_memory(const char *cmd, const lahar_case *cs, const lahar_estim
     return -1;
 }
 
-/* The DEM engine the case names must exist in this build (dem_node/dem_engine_registry.c): said at
+/* The DEM engine the case names must exist in this build (dem_node/engines/dem_engine_registry.c): said at
  * validation, with the case's file and line, not when the DEM node starts. */
 static int check_dem_engine(const lahar_case *cs)
 {
@@ -202,6 +206,17 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "bench"))
         return bench_exec(argc, argv);
+    if (!strcmp(cmd, "keys")) {
+        if (argc > 3) {
+            fprintf(stderr, "usage: lahar keys [SECTION | --yaml]\n");
+            return 2;
+        }
+        if (argc == 3 && !strcmp(argv[2], "--yaml")) {
+            lahar_keys_print_yaml(stdout);
+            return 0;
+        }
+        return lahar_keys_print(stdout, argc == 3 ? argv[2] : NULL) == 0 ? 0 : 2;
+    }
     if (!strcmp(cmd, "keygen")) {
         char err[512];
         if (argc != 3 || argv[2][0] == '-') {
@@ -219,7 +234,7 @@ int main(int argc, char **argv)
     int is_run = !strcmp(cmd, "run"), is_check = !strcmp(cmd, "check"), is_validate = !strcmp(cmd, "validate");
     int is_resume = !strcmp(cmd, "resume");
     if (!is_run && !is_check && !is_validate && !is_resume) {
-        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, resume, bench, keygen)\n", cmd);
+        fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, resume, bench, keys, keygen)\n", cmd);
         usage(stderr);
         return 2;
     }

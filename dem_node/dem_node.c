@@ -181,7 +181,7 @@ static int dem_node_wait_stop(dem_node *d)
 }
 
 /* After advance() failed in step k (ending at time t): when the engine reports an instability of
- * the bodies (ops->fault), the report of common/instability.h with the body's name, the place
+ * the bodies (ops->fault), the report of common/protocol/instability.h with the body's name, the place
  * (its centre or the contact point) and the step, else 0 (the engine's message stays). */
 static int dem_node_fault_report(const dem_node *d, int64_t k, double t, lahar_instability *u)
 {
@@ -229,7 +229,7 @@ static void dem_node_final_snapshot(dem_node *d, const lahar_link_msg *stop, int
     lahar_output_mark_last_snapshot(d->ns.output_dir, "bodies.h5", "stopped", why);
 }
 
-/* The node's whole state for a checkpoint (common/checkpoint.h; one function both ways): the
+/* The node's whole state for a checkpoint (common/io/checkpoint.h; one function both ways): the
  * engine's restart blob (bodies and contact history, dem_engine.h) and the loop's own state.
  * Returns 0, or -1 with the message in f->err. */
 static int dem_node_state_io(dem_node *d, lahar_ckpt_file *f, int64_t *k, double *t_now, int *at_output_time,

@@ -7,7 +7,7 @@
 
 #include "node_cli.h"
 
-/* The node's options: the command line every node takes (common/node_cli.h). */
+/* The node's options: the command line every node takes (common/protocol/node_cli.h). */
 typedef lahar_node_options lahar_dem_node_options;
 
 /* Runs until the coordinator stops the run. Returns the process exit status: 0 normal stop,

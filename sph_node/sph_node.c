@@ -173,7 +173,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->h_over_dx = o->h_over_dx;
     prm->rho0 = c->sph_density;
     prm->c0 = o->c0;
-    prm->eos = o->eos == LAHAR_SPH_EOS_TAIT ? SPH_EOS_TAIT : SPH_EOS_LINEAR;
+    prm->eos = o->eos;
     prm->gamma = o->gamma;
     prm->mu = o->mu;
     prm->alpha = o->alpha;
@@ -187,12 +187,10 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     prm->cfl = o->cfl;
     prm->cfl_force = o->cfl_force;
     prm->cfl_visc = o->cfl_visc;
-    prm->wall_viscous = o->wall_viscous == LAHAR_SPH_WALL_PAPER ? SPH_WALL_VISCOUS_PAPER : SPH_WALL_VISCOUS_HALFSPACE;
-    prm->wall_pressure = o->wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
-                                                                            : SPH_WALL_PRESSURE_PENALTY;
+    prm->wall_viscous = o->wall_viscous;
+    prm->wall_pressure = o->wall_pressure;
     prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
-    prm->soil_wall_stress = o->soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST ? SPH_WALL_PRESSURE_GHOST
-                                                                                  : SPH_WALL_PRESSURE_PENALTY;
+    prm->soil_wall_stress = o->soil_wall_stress;
     prm->shepard_every = o->shepard_interval;
     prm->shifting = o->shifting;
     prm->shifting_density = o->shifting_density;
@@ -317,7 +315,7 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
     return rc;
 }
 
-/* Mark the last snapshot of the files this node writes (common/output.h). */
+/* Mark the last snapshot of the files this node writes (common/io/output.h). */
 static void sph_node_mark_last(const sph_node *s, const char *name, const char *text)
 {
     lahar_output_mark_last_snapshot(s->ns.output_dir, "particles.h5", name, text);
@@ -698,7 +696,7 @@ static void sph_node_crossing_report(const sph_node *s, int64_t k, double t, lah
     sph_node_crossing_message(s, k, t, u->text, sizeof u->text);
 }
 
-/* The particle checks of common/instability.h on the state after step k (time t): every
+/* The particle checks of common/protocol/instability.h on the state after step k (time t): every
  * position, velocity and density finite, and rho / rho0 within stability.density_band. One
  * streaming pass counts the failures (a sum: the same for any thread count); only when there are
  * some, a serial pass names the worst: the non-finite particle of lowest id, else the one
@@ -844,7 +842,7 @@ static int sph_node_probes_sample(sph_node *s, int64_t k, double t)
     return lahar_gauge_output_write(s->gauges, k + 1, t, s->probes.value, s->probes.due);
 }
 
-/* ---- checkpoints (common/checkpoint.h) -------------------------------------------------------
+/* ---- checkpoints (common/io/checkpoint.h) -------------------------------------------------------
  * Everything step k + 1 reads of the state after step k, in the particles' current (sorted)
  * order: the particle arrays (incl. the rates of the last evaluation, which the first kick of
  * the next step uses, and the soil's stress and stress rate), the solver's counters (step: the

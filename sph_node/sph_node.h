@@ -9,7 +9,7 @@
 
 #include "node_cli.h"
 
-/* The node's options: the command line every node takes (common/node_cli.h). */
+/* The node's options: the command line every node takes (common/protocol/node_cli.h). */
 typedef lahar_node_options lahar_sph_node_options;
 
 #include <stddef.h>

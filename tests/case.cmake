@@ -1,4 +1,4 @@
-# Case files, shapes and mass properties (common/case.c, common/shape_build.c).
+# Case files, shapes and mass properties (common/io/case.c, common/geometry/shape_build.c).
 add_executable(lahar-case-check ${LAHAR_TEST_DIR}/case_check_main.c)
 target_link_libraries(lahar-case-check PRIVATE lahar_common)
 
@@ -34,3 +34,13 @@ set_tests_properties(cli_bad_args PROPERTIES LABELS fast)
 add_test(NAME cli_interrupt_setup COMMAND sh ${LAHAR_TEST_DIR}/cli_interrupt.sh $<TARGET_FILE:lahar>
          ${CMAKE_SOURCE_DIR}/tools/case_override.py ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/cli_interrupt)
 set_tests_properties(cli_interrupt_setup PROPERTIES LABELS "slow;netns" TIMEOUT 120)
+
+# The key table (common/io/case_keys.c) drives the loader: keys accepted, defaults, range messages
+add_executable(test_case_keys ${LAHAR_TEST_DIR}/test_case_keys.c)
+target_link_libraries(test_case_keys PRIVATE lahar_common)
+add_test(NAME case_keys COMMAND test_case_keys)
+set_tests_properties(case_keys PROPERTIES LABELS fast)
+# cases/reference.yaml is what `lahar keys --yaml` prints (regenerate: build/bin/lahar keys --yaml > cases/reference.yaml)
+add_test(NAME case_reference_yaml COMMAND sh -c "\"$1\" keys --yaml | diff -u \"$2\" - && ! \"$1\" keys nosuchsection 2>/dev/null"
+         sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/reference.yaml)
+set_tests_properties(case_reference_yaml PROPERTIES LABELS fast)

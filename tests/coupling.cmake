@@ -1,4 +1,4 @@
-# Protocol, coordinator and nodes (brief C): common/link.c, common/transport.c, common/netns.c,
+# Protocol, coordinator and nodes (brief C): common/protocol/link.c, common/protocol/transport.c, common/protocol/netns.c,
 # coordinator/, dem_node/dem_node.c, sph_node/. The run tests need `unshare` of user + network
 # namespaces and nft (label netns); each multicast run happens in a private namespace.
 add_executable(test_coupling_clock ${LAHAR_TEST_DIR}/test_coupling_clock.c)

@@ -356,9 +356,9 @@ engine_error)
     # stability.max_overlap, 5 % of the smaller sweep radius; a DEM step beyond the contact's
     # stability limit is refused by the case loader) stops the run with the engine's message
     # (which bodies, which step), exit 1, and a last snapshot at the failed step.
-    write_case bad.yaml 0.3
-    sed -i 's/^time:.*/time: {end: 0.3, dt_max: 1e-2, output_interval: 0.05}\ndem: {engine: spheropoly, dt_safety: 0.2}\nstability: {max_overlap: 0.05}/;
-            s/velocity: \[0, 0, -1\]/velocity: [0, 0, -6]/' bad.yaml
+    write_case base.yaml 0.3
+    "$python" "$tools/case_override.py" base.yaml bad.yaml time.dt_max=1e-2 'dem={engine: spheropoly, dt_safety: 0.2}' \
+        'stability={max_overlap: 0.05}' 'bodies.ball2.velocity=[0, 0, -6]' || fail "cannot make bad.yaml"
     "$bin/lahar" run bad.yaml -o bad -q --in-process 2> stderr.txt
     rc=$?
     cat stderr.txt

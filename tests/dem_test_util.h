@@ -1,5 +1,5 @@
 /* Building lahar_case structs directly in C for the DEM tests: materials, spheres/discs, boxes,
- * planes and segment walls with their mass properties. Shapes come from common/shape_build. */
+ * planes and segment walls with their mass properties. Shapes come from common/geometry/shape_build. */
 #ifndef LAHAR_DEM_TEST_UTIL_H
 #define LAHAR_DEM_TEST_UTIL_H
 #include "dem_engine.h"

@@ -15,9 +15,9 @@ set -u
 lahar=$1 case=$2 out=$3 py=$4
 here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$out" && mkdir -p "$out" || exit 2
-# the loader has no end-time override: a copy of the case with time.end = 0.95
-sed -E "s/^(time: *\{.*end: *)[^,} ]+/\10.95/" "$case" > "$out/case.yaml" || exit 2
-grep -qE "^time: *\{.*end: *0\.95[,} ]" "$out/case.yaml" || { echo "example_debris: cannot set time.end in $case" >&2; exit 2; }
+# a copy of the case with time.end = 0.95 (tools/case_override.py)
+"$py" "$here/../tools/case_override.py" "$case" "$out/case.yaml" time.end=0.95 ||
+    { echo "example_debris: cannot set time.end in $case" >&2; exit 2; }
 start=$(date +%s)
 "$lahar" check "$out/case.yaml" -o "$out/run" --in-process -q --overwrite
 rc=$?

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Wall-force chatter of the penalty wall (sph.penalty_stiffness, sph_node/sph_coupling.h).
+"""Wall-force chatter of the penalty wall (sph.penalty_stiffness, sph_node/coupling/sph_coupling.h).
 
   force_chatter_check.py LAHAR OUT
 

@@ -1,4 +1,4 @@
-# Pressure probes (case section probes:, sph_node/sph_probes.h, OUT/gauges.h5): a tank at rest
+# Pressure probes (case section probes:, sph_node/probes/sph_probes.h, OUT/gauges.h5): a tank at rest
 # (cases/hydrostatic_2d.yaml at dx = 10 mm, 0.5 s) with probes on the walls (a point and a 9 mm
 # sensor, Adami et al. 2012 eq. 27), on the floor, in the water (Shepard), above it (dry: 0) and
 # one at 100 Hz: every wetted probe's mean over 0.3-0.5 s within 1 % of rho g h of rho g (h - y),

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Pressure probes (case section probes:, sph_node/sph_probes.h) in a tank at rest.
+"""Pressure probes (case section probes:, sph_node/probes/sph_probes.h) in a tank at rest.
 
   probes_check.py LAHAR OUT [--dx M] [--wall penalty|ghost] [--tol F]
   probes_check.py LAHAR OUT --3d

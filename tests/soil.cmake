@@ -1,4 +1,4 @@
-# Soil phase (issue 5, brief SOIL): the Drucker-Prager SPH soil of sph_node/sph_soil.[ch] against
+# Soil phase (issue 5, brief SOIL): the Drucker-Prager SPH soil of sph_node/soil/sph_soil.[ch] against
 # closed forms (return mapping, elastic and Jaumann stress rates, equilibrium of a uniform
 # stress), and its cases end to end through `lahar check` at CI resolution (the cases' own bounds;
 # measured values in cases/README.md, "Soil").

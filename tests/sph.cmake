@@ -1,4 +1,4 @@
-# SPH solver core (brief E): kernels (common/kernel.c), particles, cell lists, WCSPH and the
+# SPH solver core (brief E): kernels (common/kernels/kernel.c), particles, cell lists, WCSPH and the
 # SPH-DEM coupling (sph_node/sph_*.c), tested at library level without processes.
 add_executable(test_kernel ${LAHAR_TEST_DIR}/test_kernel.c)
 target_link_libraries(test_kernel PRIVATE lahar_common)
@@ -42,15 +42,16 @@ target_link_libraries(test_sph_sps PRIVATE lahar_sph)
 add_test(NAME sph_sps COMMAND test_sph_sps)
 set_tests_properties(sph_sps PROPERTIES LABELS "fast;sph" TIMEOUT 120)
 
-# Split step (brief L): step_begin + step_end bitwise equal to the one-call step, on 2 threads.
+# Split step: step_begin + step_end integrate at second order in time (observed order at dt, dt/2, dt/4).
 add_executable(test_sph_split ${LAHAR_TEST_DIR}/test_sph_split.c)
 target_link_libraries(test_sph_split PRIVATE lahar_sph)
 add_test(NAME sph_split COMMAND test_sph_split)
-set_tests_properties(sph_split PROPERTIES LABELS "fast;sph" TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=2")
+set_tests_properties(sph_split PROPERTIES LABELS "fast;sph" TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=2")
 
-# Open boundaries (sph_node/sph_inflow.h): discharge through an inlet against the Gumbel
-# hydrograph (Trujillo-Vela et al. 2020, eq. 36) and a CSV t,Q table, mass balance, outflow
-# counts, unique ids, the capacity error, a supercritical channel at its steady depth.
+# Open boundaries (sph_node/inflow/sph_inflow.h): discharge through an inlet against the Gumbel
+# hydrograph (Trujillo-Vela et al. 2020, eq. 36), a CSV t,Q table and a level table t,h, a 3D
+# inlet, mass balance, outflow counts, unique ids, the capacity error, a supercritical channel at
+# its steady depth.
 add_executable(test_sph_inflow ${LAHAR_TEST_DIR}/test_sph_inflow.c)
 target_link_libraries(test_sph_inflow PRIVATE lahar_sph)
 add_test(NAME sph_inflow COMMAND test_sph_inflow)

@@ -25,17 +25,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static int failures, checks;
-#define CHECK(cond, ...)                                                                                           \
-    do {                                                                                                           \
-        checks++;                                                                                                  \
-        if (!(cond)) {                                                                                             \
-            failures++;                                                                                            \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                            \
-            printf(__VA_ARGS__);                                                                                   \
-            printf("\n");                                                                                          \
-        }                                                                                                          \
-    } while (0)
+#include "test_util.h"
 
 static double rel(double a, double b) { return fabs(a - b) / fabs(b); }
 
@@ -551,8 +541,7 @@ static void test_cases_dir(const char *dir)
     int n = 0;
     struct dirent *de;
     while ((de = readdir(d)) && n < 256) {
-        size_t l = strlen(de->d_name);
-        if (l > 5 && strcmp(de->d_name + l - 5, ".yaml") == 0)
+        if (lahar_test_is_case_file(de->d_name))
             names[n++] = strdup(de->d_name);
     }
     closedir(d);

@@ -1,5 +1,5 @@
 /* Particle blocks: the lattice fill of boxes, polygons and closed STL meshes, and the cut-out of
- * bodies (common/shape_build.c lahar_particle_block_*, common/case.c lahar_case_block_lattice),
+ * bodies (common/geometry/shape_build.c lahar_particle_block_*, common/io/case.c lahar_case_block_lattice),
  * against exact counts and analytic areas/volumes:
  *  - an L-shaped (non-convex) polygon whose corners lie on lattice-cell boundaries holds exactly
  *    area / dx^2 points, in either orientation, and the notch stays empty;
@@ -33,17 +33,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static int failures, checks;
-#define CHECK(cond, ...)                                                                                           \
-    do {                                                                                                           \
-        checks++;                                                                                                  \
-        if (!(cond)) {                                                                                             \
-            failures++;                                                                                            \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                            \
-            printf(__VA_ARGS__);                                                                                   \
-            printf("\n");                                                                                          \
-        }                                                                                                          \
-    } while (0)
+#include "test_util.h"
 
 static lahar_particle_block polygon_block(const double (*p)[2], int n)
 {
@@ -406,7 +396,7 @@ static void test_defaults(const char *tmp)
     lahar_case_free(&c);
 }
 
-/* sph.body_layers (common/case.c case_block_layers): layers on the surface of a round body. */
+/* sph.body_layers (common/io/case.c case_block_layers): layers on the surface of a round body. */
 static void layers_check(const char *tmp, const char *name, int dim, const char *yaml, double R, const double ctr[3],
                          double L, int nl, double dx, double fluid_cells, int periodic)
 {

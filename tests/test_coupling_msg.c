@@ -1,4 +1,4 @@
-/* The allocation-free decoders of the per-step messages (common/scene_msg.c) against LCM's
+/* The allocation-free decoders of the per-step messages (common/protocol/scene_msg.c) against LCM's
  * generated decoders: same values bit for bit for random messages of growing and shrinking size,
  * and truncated or foreign buffers are rejected. */
 #include <stdio.h>

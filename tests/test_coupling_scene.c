@@ -10,18 +10,7 @@
 #include "case.h"
 #include "scene_msg.h"
 
-static int failures, quiet;
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            if (!quiet) {                                                                          \
-                fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                               \
-                fprintf(stderr, __VA_ARGS__);                                                      \
-                fputc('\n', stderr);                                                               \
-            }                                                                                      \
-            failures++;                                                                            \
-        }                                                                                          \
-    } while (0)
+#include "test_util.h"
 #define SAME(a, b) (memcmp(&(a), &(b), sizeof(a)) == 0)
 
 static void compare(const char *path, const lahar_case *a, const lahar_case *b)
@@ -119,9 +108,9 @@ static void round_trip(const char *path, int off_default)
         back.sph.c0 *= 1.5;
         back.blocks[0].v[0] += 1.0;
         int before = failures;
-        quiet = 1;
+        test_quiet = 1;
         compare(path, &c, &back);
-        quiet = 0;
+        test_quiet = 0;
         if (failures == before + 2)
             failures = before;
         else
@@ -143,8 +132,7 @@ int main(int argc, char **argv)
     int ncase = 0;
     struct dirent *e;
     while (dir && (e = readdir(dir))) {
-        size_t n = strlen(e->d_name);
-        if (n > 5 && !strcmp(e->d_name + n - 5, ".yaml")) {
+        if (lahar_test_is_case_file(e->d_name)) {
             char path[4096];
             snprintf(path, sizeof path, "%s/%s", argv[1], e->d_name);
             round_trip(path, 0);

@@ -1,4 +1,4 @@
-/* Instability reports through a STATUS message (common/instability.h): what a node encodes, the
+/* Instability reports through a STATUS message (common/protocol/instability.h): what a node encodes, the
  * coordinator decodes field for field, within the 512 bytes of status_t.message; a '|' in a body
  * name cannot shift the fields; an ordinary error message is not taken for an instability. */
 #include <math.h>

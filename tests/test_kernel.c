@@ -1,4 +1,4 @@
-/* Kernels (common/kernel.h) checked numerically on a fine lattice (spacing h/40 in 2D, h/16 in
+/* Kernels (common/kernels/kernel.h) checked numerically on a fine lattice (spacing h/40 in 2D, h/16 in
  * 3D, origin shifted off the kernel centre so that no symmetry hides an error), tolerance 1e-3:
  *   sum W dV = 1                         (normalisation: catches the constants of Trujillo-Vela et al. 2020 eq. 4;
  *                                         the quintic 3D constant is 1/(120 pi), not 3/(359 pi))

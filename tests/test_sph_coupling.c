@@ -128,7 +128,7 @@ int main(void)
         walls[1].q[0] = 1.0;
         sph_params prm = {0};
         prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.c0 = 10, prm.mu = MU;
-        prm.wall_pressure = SPH_WALL_PRESSURE_GHOST;
+        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
         char err[256];
         if (sph_fluid_init(&f, &prm, 4, err, sizeof err) != 0)
             abort();

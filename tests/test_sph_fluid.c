@@ -114,7 +114,7 @@ static int64_t brute_rates(const sph_fluid *f, int64_t i, double out[4])
  * every axis periodic and 2 threads with n above SPH_OMP_MIN_HEAVY, so that the symmetric pass runs
  * its blocks in parallel and, with an odd number of runs along a periodic axis, merges the last
  * two (sph_cells_blocks). */
-static void check_rates_brute(int dim, const char *kern, sph_eos eos, int big)
+static void check_rates_brute(int dim, const char *kern, lahar_sph_eos eos, int big)
 {
     /* small: 2D 12 x 12 periodic x and y, 3D 12 x 6 x 6 periodic x; big: 2D 55 x 55 (42 cell rows
      * of the cubic kernel, 21 runs of 2), 3D 14 x 14 x 14 (10 rows: 5 runs of 2 along z, 2 of 4
@@ -179,7 +179,7 @@ static void check_rates_brute(int dim, const char *kern, sph_eos eos, int big)
         worst = fmax(worst, fabs(b[3] - p->az[i]) / scale_a);
     }
     printf("rates vs brute force, %dD %-9s %s: %lld particles%s, max relative difference %.2e, %lld pairs\n", dim,
-           kern, eos == SPH_EOS_TAIT ? "Tait  " : "linear", (long long)p->n, big ? " (2 threads)" : "", worst,
+           kern, eos == LAHAR_SPH_EOS_TAIT ? "Tait  " : "linear", (long long)p->n, big ? " (2 threads)" : "", worst,
            (long long)pairs);
     CHECK(worst < 1e-12, "%dD %s: cell-list rates differ from brute force by %.2e", dim, kern, worst);
     CHECK(f.work_neighbours_fluid == pairs, "%dD %s: the water pass counted %lld neighbours, brute force %lld", dim,
@@ -305,9 +305,9 @@ static void check_eos(void)
     prm.rho0 = 1000;
     prm.c0 = 30;
     prm.gamma = 7;
-    prm.eos = SPH_EOS_LINEAR;
+    prm.eos = LAHAR_SPH_EOS_LINEAR;
     CHECK(fabs(sph_fluid_pressure(&prm, 1010) - 900 * 10) < 1e-9, "linear EOS");
-    prm.eos = SPH_EOS_TAIT;
+    prm.eos = LAHAR_SPH_EOS_TAIT;
     double pt = sph_fluid_pressure(&prm, 1010), expect = 1000 * 900 / 7.0 * (pow(1.01, 7) - 1);
     CHECK(fabs(pt - expect) < 1e-9 * expect, "Tait EOS %.12g vs %.12g", pt, expect);
     double e = 1e-3, slope = (sph_fluid_pressure(&prm, 1000 + e) - sph_fluid_pressure(&prm, 1000 - e)) / (2 * e);
@@ -592,11 +592,11 @@ int main(void)
 {
     const char *kernels[] = {"cubic", "quintic", "wendland2"};
     for (int k = 0; k < 3; k++) {
-        check_rates_brute(2, kernels[k], SPH_EOS_LINEAR, 0);
-        check_rates_brute(3, kernels[k], k == 0 ? SPH_EOS_TAIT : SPH_EOS_LINEAR, 0);
+        check_rates_brute(2, kernels[k], LAHAR_SPH_EOS_LINEAR, 0);
+        check_rates_brute(3, kernels[k], k == 0 ? LAHAR_SPH_EOS_TAIT : LAHAR_SPH_EOS_LINEAR, 0);
     }
-    check_rates_brute(2, "cubic", SPH_EOS_LINEAR, 1);
-    check_rates_brute(3, "cubic", SPH_EOS_LINEAR, 1);
+    check_rates_brute(2, "cubic", LAHAR_SPH_EOS_LINEAR, 1);
+    check_rates_brute(3, "cubic", LAHAR_SPH_EOS_LINEAR, 1);
     check_blocks();
     check_delta_sph();
     check_eos();

@@ -11,7 +11,7 @@
  *   - no particle crossed a wall, the free surface stays level (height spread < dx/2) and the
  *     kinetic energy has decayed (|v|max < 1 % of sqrt(g H)).
  * usage: test_sph_hydrostatic [NY [T [ghost]]]. With "ghost" the walls carry the pressure of ghost
- * layers (SPH_WALL_PRESSURE_GHOST, sph_coupling.h) and the gauges start at dx/2 above the floor,
+ * layers (LAHAR_SPH_WALL_PRESSURE_GHOST, sph_coupling.h) and the gauges start at dx/2 above the floor,
  * where the penalty wall alone reads +13 % of rho0 g H at 1.5 dx: the same bounds hold there; the
  * side walls then carry part of the weight (the ghosts beside a particle complete its vertical
  * pressure gradient), so the floor plus the side walls' vertical forces must carry it (0.5 %). */
@@ -54,7 +54,7 @@ int main(int argc, char **argv)
     prm.body_force[1] = -g;
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
     if (ghost)
-        prm.wall_pressure = SPH_WALL_PRESSURE_GHOST;
+        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, NX * NY, err, sizeof err) != 0) {

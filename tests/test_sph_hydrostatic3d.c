@@ -51,7 +51,7 @@ int main(int argc, char **argv)
      * 2012 eq. 27) on the quintic kernel at h = dx, the settings of cases/hydrostatic_3d.yaml */
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
     if (ghost) {
-        prm.wall_pressure = SPH_WALL_PRESSURE_GHOST;
+        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
         prm.kernel = "quintic";
         prm.h_over_dx = 1.0;
     }

@@ -1,4 +1,4 @@
-/* Open boundaries (sph_node/sph_inflow.h) on a 2D channel: a floor (fixed wall) from behind the
+/* Open boundaries (sph_node/inflow/sph_inflow.h) on a 2D channel: a floor (fixed wall) from behind the
  * inlet to x = L, the inlet a vertical line at x = 0 with inward normal +x, water level h.
  *
  *  A. Gumbel hydrograph (Trujillo-Vela et al. 2020, eq. 36, scaled: a_G = 0.2 m, beta_G = 0.1 s,

@@ -10,7 +10,7 @@
  *  - the pressure of those densities by the solver's own EOS (sph_fluid_pressure) is
  *    rho0 g (h - y) to 1e-9 of rho0 g H (round trip);
  *  - initial_pressure: none (the default) keeps rho0 exactly; the option survives the scene
- *    message (common/scene_msg.c); a misspelt value is refused with the closest name.
+ *    message (common/protocol/scene_msg.c); a misspelt value is refused with the closest name.
  * usage: test_sph_initial_pressure TMP_DIR */
 #include <math.h>
 #include <stdio.h>
@@ -97,11 +97,11 @@ static void test_linear_2d(const char *dir)
     CHECK(back.sph.initial_pressure == LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC, "initial_pressure lost in the message");
     CHECK(c.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && back.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST,
           "wall_pressure not read or lost in the message");
-    CHECK(prm.wall_pressure == SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
+    CHECK(prm.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
     CHECK(c.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST &&
               back.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST,
           "soil_wall_stress not read or lost in the message");
-    CHECK(prm.soil_wall_stress == SPH_WALL_PRESSURE_GHOST, "soil_wall_stress not passed to the solver");
+    CHECK(prm.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST, "soil_wall_stress not passed to the solver");
     lahar_scene_msg_release(&msg);
     lahar_case_free(&back);
     sph_particles_free(&p);

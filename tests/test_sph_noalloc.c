@@ -102,7 +102,7 @@ static long steps(sph_fluid *f, int nsteps, lahar_body_state *states, int moving
 /* Scene: water block [0, wlo..whi) of spacing dx in a tank [0, tank) of fixed walls (+ a disc in
  * 2D when `disc`). */
 static void scene(const char *name, int dim, double dx, const double water[3], const double tank[3], int disc, int sps,
-                  sph_eos eos, int nwarm, int ncount)
+                  lahar_sph_eos eos, int nwarm, int ncount)
 {
     sph_params prm;
     memset(&prm, 0, sizeof prm);
@@ -203,10 +203,10 @@ int main(void)
     counting = 0;
     CHECK(nalloc == 1 && nfree == 1, "malloc/free are counted (--wrap works): %ld, %ld", nalloc, nfree);
     const double wa[3] = {0.3, 0.2, 0}, ta[3] = {0.3, 0.4, 0};
-    scene("A 2D disc SPS", 2, 0.005, wa, ta, 1, 1, SPH_EOS_LINEAR, 10, 30);
+    scene("A 2D disc SPS", 2, 0.005, wa, ta, 1, 1, LAHAR_SPH_EOS_LINEAR, 10, 30);
     const double wb[3] = {0.46, 0.46, 0}, tb[3] = {0.46, 0.6, 0};
-    scene("B 2D 33856", 2, 0.0025, wb, tb, 0, 0, SPH_EOS_LINEAR, 2, 4);
+    scene("B 2D 33856", 2, 0.0025, wb, tb, 0, 0, LAHAR_SPH_EOS_LINEAR, 2, 4);
     const double wc[3] = {0.2, 0.2, 0.1}, tc[3] = {0.2, 0.2, 0.3};
-    scene("C 3D Tait", 3, 0.01, wc, tc, 0, 0, SPH_EOS_TAIT, 5, 10);
+    scene("C 3D Tait", 3, 0.01, wc, tc, 0, 0, LAHAR_SPH_EOS_TAIT, 5, 10);
     return failures ? 1 : 0;
 }

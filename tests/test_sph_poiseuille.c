@@ -72,7 +72,7 @@ typedef struct {
     int steps;
 } poiseuille_result;
 
-static void run(int nrow, const char *kern, sph_wall_viscous wv, int threads, poiseuille_result *res)
+static void run(int nrow, const char *kern, lahar_sph_wall_viscous wv, int threads, poiseuille_result *res)
 {
     omp_set_num_threads(threads);
     memset(res, 0, sizeof *res);
@@ -144,11 +144,11 @@ int main(void)
 {
     const double f_steady = RHO * A * H / 2.0 * PERIOD;
     poiseuille_result r20, r40, r20b, paper;
-    run(20, "cubic", SPH_WALL_VISCOUS_HALFSPACE, 2, &r20);
+    run(20, "cubic", LAHAR_SPH_WALL_HALFSPACE, 2, &r20);
     report("cubic, half-space wall", 20, &r20);
-    run(40, "cubic", SPH_WALL_VISCOUS_HALFSPACE, 2, &r40);
+    run(40, "cubic", LAHAR_SPH_WALL_HALFSPACE, 2, &r40);
     report("cubic, half-space wall", 40, &r40);
-    run(20, "cubic", SPH_WALL_VISCOUS_PAPER, 2, &paper);
+    run(20, "cubic", LAHAR_SPH_WALL_PAPER, 2, &paper);
     report("cubic, eq. 17 as printed", 20, &paper);
 
     CHECK(r20.l2[NTIMES - 1] <= 0.01, "20 across: steady L2 error %.3f%% > 1%%", 100 * r20.l2[NTIMES - 1]);
@@ -171,7 +171,7 @@ int main(void)
     CHECK(r20.crossings == 0 && r40.crossings == 0, "particles crossed a plate");
 
     /* determinism: the same run on one thread gives the same bits */
-    run(20, "cubic", SPH_WALL_VISCOUS_HALFSPACE, 1, &r20b);
+    run(20, "cubic", LAHAR_SPH_WALL_HALFSPACE, 1, &r20b);
     CHECK(memcmp(&r20b, &r20, sizeof r20) == 0, "1 vs 2 threads differ: plate force %.17g vs %.17g",
           r20b.force_lower, r20.force_lower);
     if (failures)

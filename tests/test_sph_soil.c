@@ -1,4 +1,4 @@
-/* SPH soil (sph_node/sph_soil.h) against closed forms:
+/* SPH soil (sph_node/soil/sph_soil.h) against closed forms:
  *  1. return mapping (Bui 2008 section 3.3): a stress beyond the Drucker-Prager surface is scaled
  *     back onto it (|f| < 1e-12 of the stress scale) with I1 and the direction of s kept; a
  *     tensile stress of a cohesionless soil goes to zero; with cohesion to the apex
@@ -395,7 +395,7 @@ static int64_t soil_on_plate(sph_fluid *f, lahar_body *plate, int nx, int ny, do
     prm.c0 = 10.0;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 0.0);
-    prm.soil_wall_stress = SPH_WALL_PRESSURE_GHOST;
+    prm.soil_wall_stress = LAHAR_SPH_WALL_PRESSURE_GHOST;
     char err[256];
     if (sph_fluid_init(f, &prm, (int64_t)nx * ny, err, sizeof err) != 0) {
         CHECK(0, "init: %s", err);

@@ -67,7 +67,7 @@ SETTINGS = [
     ("c0", "x2", {"sph.c0": 2.0}),
 ]
 QUICK_SETTINGS = ["kernel=wendland2", "cfl=0.4", "soil_av=paper"]
-# The soil's own trade (Drucker-Prager SPH, sph_node/sph_soil.h): lahar's default artificial
+# The soil's own trade (Drucker-Prager SPH, sph_node/soil/sph_soil.h): lahar's default artificial
 # viscosity alpha = 0.1, beta = 0 against the paper's alpha = beta = 1 (Trujillo-Vela et al. 2020, section 5.3);
 # `{soil}` is replaced by the name of the case's soil material.
 SOIL_SETTINGS = [
@@ -674,7 +674,7 @@ def final_body_positions(out):
     import numpy as np
     with h5py.File(os.path.join(out, "bodies.h5"), "r") as f:
         names = [n.decode() if isinstance(n, bytes) else str(n) for n in f["header/body_name"][()]]
-        free = np.asarray(f["header/motion"][()]) == 0  # LAHAR_MOTION_FREE (common/scene.h)
+        free = np.asarray(f["header/motion"][()]) == 0  # LAHAR_MOTION_FREE (common/scene/scene.h)
         snaps = sorted(f["snapshots"])
         first, last = f["snapshots"][snaps[0]], f["snapshots"][snaps[-1]]
         x0, x1 = np.asarray(first["position"]), np.asarray(last["position"])

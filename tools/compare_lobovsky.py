@@ -23,7 +23,7 @@ Metrics (printed, and written to --json):
               of its runs; beside it the difference between the two experimental runs (their
               repeat spread) where both exist. h_run: the case's level gauges (kind: level, 1 kHz;
               the highest point of the vertical line where the water's kernel fraction is 1/2,
-              sph_node/sph_probes.h). For H2-H4 also the arrival of the front, the first t* with
+              sph_node/probes/sph_probes.h). For H2-H4 also the arrival of the front, the first t* with
               h >= 0.05 H, reported only.
 With --check: exit 1 unless |rise - 2.446| / 2.446 <= --rise-tol (default 0.05), every sensor 1-3
 sensor in --sensors (default sensor1 sensor2) peak_mean / experiment within --peak-band (default

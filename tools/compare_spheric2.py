@@ -13,7 +13,7 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
   levels     H1-H4 at (x, y) = (1.488, 0.5), (0.992, 0.5), (0.496, 0.5), (2.638, 0.5) m: the time
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
-             the floor, where the water's kernel fraction falls to 1/2, sph_node/sph_probes.h)
+             the floor, where the water's kernel fraction falls to 1/2, sph_node/probes/sph_probes.h)
 The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment."""
 import argparse
 import json

@@ -1,4 +1,4 @@
-/* Harness: the case loader (common/case.c) on the bytes of a case file. The file is named as if
+/* Harness: the case loader (common/io/case.c) on the bytes of a case file. The file is named as if
  * it lay in cases/, so the relative STL paths of the seeds resolve. A case that loads must travel
  * as a scene message and come back as the same case (what the nodes rebuild); a case that does
  * not must come with one message naming the file. */

@@ -1,8 +1,8 @@
-/* Harness: the receive path of the link layer (common/link.c): frame parsing, the MAC check of
+/* Harness: the receive path of the link layer (common/protocol/link.c): frame parsing, the MAC check of
  * authenticated runs, run-id adoption, reassembly slots, the duplicate window, heartbeats and
  * NACKs (answered from kept copies), and the typed decoder of every message it completes.
  *
- * The link runs over a transport of this file (the function table of common/transport.h) that
+ * The link runs over a transport of this file (the function table of common/protocol/transport.h) that
  * hands it the input's datagrams one at a time; nothing touches a socket. Input:
  *   byte 0      configuration: role = bits 0-1 (mod 3), bit 2 authenticated (fuzz_auth_key),
  *               bit 3 run id known (else adopted from the first coordinator HELLO)

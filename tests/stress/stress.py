@@ -9,7 +9,7 @@ snapshot) while a stable one finishes.
 Every run is `lahar run CASE -o OUT --in-process` on a copy of a case from cases/ (or a scene
 written here) with keys overridden (override(): dotted keys, e.g. sph.c0=2). A sweep walks one
 setting from safe to unsafe and reports, per setting, how the run ended, what caught a failure
-(density band, crossing, overlap, non-finite state, dt collapse: common/instability.h), where and
+(density band, crossing, overlap, non-finite state, dt collapse: common/protocol/instability.h), where and
 when, and an accuracy figure; then the largest stable setting. Tables go to stdout and OUT/*.csv.
 """
 import argparse

@@ -1,0 +1,824 @@
+/* `lahar check` references of the SPH soil (sph_node/soil/sph_soil.h; cases/README.md).
+ *
+ * soil_geostatic: a soil layer at rest under gravity, laterally confined (periodic sides or
+ * frictionless walls), loaded by its own weight from a stress-free start. One-dimensional
+ * (confined) elastic compression gives, at depth z below the surface (tension positive stress,
+ * gravity along the last axis):
+ *   sigma_v = -rho g z,  sigma_h = K0 sigma_v,  K0 = nu / (1 - nu)
+ * (plane strain and 3D alike: the lateral strains vanish). Measured: the soil particles binned in
+ * rows of dx by depth below the current surface (the highest particle + dx/2), each row's mean
+ * stress averaged over the snapshots of the last quarter of the run (the start-up oscillation
+ * averages out). Metrics over pairs of rows (bins of 2 dx) deeper than H/4 (relative errors near
+ * the free surface divide by ~0), without the row resting on the floor (its kernel is cut by the
+ * wall):
+ *   sigma_v_rel_error  max |mean sigma_v - (-rho g z)| / (rho g z)
+ *   K0_rel_error       max |sigma_h / sigma_v - K0| / K0
+ * Pairs of rows, because the symmetric SPH divergence sum_j m_j (sigma_i/rho_i^2 + sigma_j/rho_j^2)
+ * . grad W cannot see a stress alternating row by row (sigma_k + sigma_(k+-d) cancels in the
+ * difference of the two sides of particle k): the start-up leaves such a mode of a few per cent
+ * in the layer, and its row-by-row size is reported as sigma_v_row_max_rel_error (info).
+ *   sigma_v_floor_rel_error  |mean sigma_v - (-rho g z)| / (rho g z) of the deepest row alone (the
+ *                      one resting on the floor): ~0.2 with the penalty wall, whose one-sided kernel
+ *                      makes the stress divergence carry the weight with too large a stress; a few
+ *                      per cent with the soil's ghost layers (sph.soil_wall_stress: ghost)
+ *   creep_rel          |mean height at t_end - mean height at the start of the last quarter|
+ *                      / (rho g H^2 / (3 M)), the elastic settlement of the column's mean height
+ *                      (M = E (1 - nu) / ((1 + nu)(1 - 2 nu)) the constrained modulus): ~0 when the
+ *                      column has stopped settling.
+ * Info: the mean settlement against rho g H^2 / (3 M). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "check.h"
+#include <hdf5.h>
+#include "geometry.h"
+#include "output.h"
+#include "vec.h"
+
+/* The soil material of the case (the first soil block's), or NULL. */
+static const lahar_material *soil_material(const lahar_case *c)
+{
+    for (int b = 0; b < c->nblock; b++)
+        if (c->blocks[b].phase == 1 && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial)
+            return &c->materials[c->blocks[b].material];
+    return NULL;
+}
+
+static double soil_up(const lahar_check_particles *p, int dim, int64_t i)
+{
+    return dim == 3 ? p->z[i] : p->y[i];
+}
+
+/* Height of the surface (highest soil particle + dx/2), bottom (lowest - dx/2) and mean height of
+ * the soil particles of the snapshot in p's buffers. Returns the number of soil particles. */
+static int64_t soil_extent(const lahar_check_particles *p, int dim, double dx, double *top, double *bottom,
+                           double *mean)
+{
+    int64_t n = 0;
+    double hi = -INFINITY, lo = INFINITY, sum = 0.0;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        if (p->phase[i] != 1)
+            continue;
+        double u = soil_up(p, dim, i);
+        hi = u > hi ? u : hi;
+        lo = u < lo ? u : lo;
+        sum += u;
+        n++;
+    }
+    *top = hi + 0.5 * dx;
+    *bottom = lo - 0.5 * dx;
+    *mean = n ? sum / (double)n : 0.0;
+    return n;
+}
+
+int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    if (!p || !p->phase || !p->stress || !mat) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: needs a soil block and the particle fields phase and stress "
+                 "(output: fields)");
+        return -1;
+    }
+    const int dim = c->dim, up = dim - 1; /* gravity along the last axis */
+    double g = -c->gravity[up];
+    const double dx = c->sph_dx, rho = mat->density, nu = mat->poisson;
+    for (int a = 0; a < dim; a++)
+        if (a != up && c->gravity[a] != 0.0)
+            g = NAN;
+    if (!(g > 0.0) || !(dx > 0.0) || p->nsnap < 2) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: needs gravity along -%c only, sph.dx > 0 and >= 2 snapshots",
+                 "xyz"[up]);
+        return -1;
+    }
+    const double k0 = nu / (1.0 - nu);
+    const double M = mat->young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    double top0, bot0, mean0;
+    if (lahar_check_particles_read(p, 0, r->err, sizeof r->err) ||
+        soil_extent(p, dim, dx, &top0, &bot0, &mean0) == 0) {
+        if (!r->err[0])
+            snprintf(r->err, sizeof r->err, "soil_geostatic: no soil particles at t = 0");
+        return -1;
+    }
+    const double H = top0 - bot0;
+    const int nrow = (int)ceil(H / dx) + 2;
+    double *sv = calloc((size_t)nrow, sizeof *sv), *sh = calloc((size_t)nrow, sizeof *sh);
+    int64_t *cnt = calloc((size_t)nrow, sizeof *cnt);
+    if (!sv || !sh || !cnt) {
+        free(sv), free(sh), free(cnt);
+        snprintf(r->err, sizeof r->err, "out of memory");
+        return -1;
+    }
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+    int64_t kfirst = kl;
+    double mean_first = 0.0, mean_last = 0.0;
+    int rc = 0;
+    /* the stress of component a along axis e: xx, yy or zz */
+    const int comp_v = up == 1 ? 3 : 5, comp_h = 0;
+    for (int64_t k = kl; k >= 0 && (k == kl || p->t[k] >= t_from); k--) {
+        double top, bot, mean;
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err)) {
+            rc = -1;
+            break;
+        }
+        soil_extent(p, dim, dx, &top, &bot, &mean);
+        if (k == kl)
+            mean_last = mean;
+        kfirst = k;
+        mean_first = mean;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            if (p->phase[i] != 1)
+                continue;
+            int row = (int)floor((top - soil_up(p, dim, i)) / dx);
+            if (row < 0 || row >= nrow)
+                continue;
+            sv[row] += p->stress[i * 6 + comp_v];
+            sh[row] += p->stress[i * 6 + comp_h];
+            cnt[row]++;
+        }
+    }
+    if (rc) {
+        free(sv), free(sh), free(cnt);
+        return -1;
+    }
+    double ev = 0.0, ek = 0.0;
+    int nused = 0;
+    int pv = lahar_check_panel(r, "soil column at rest: stress vs depth (late-window mean per row)", "depth z (m)",
+                               "stress (kPa, compression positive)");
+    lahar_check_curve(r, pv, 1, "sigma_v (lahar)");
+    for (int row = 0; row < nrow; row++)
+        if (cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sv[row] / (double)cnt[row]);
+    lahar_check_curve(r, pv, 1, "sigma_h (lahar)");
+    for (int row = 0; row < nrow; row++)
+        if (cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sh[row] / (double)cnt[row]);
+    lahar_check_curve(r, pv, 0, "rho g z");
+    lahar_check_point(r, 0.0, 0.0);
+    lahar_check_point(r, H, 1e-3 * rho * g * H);
+    lahar_check_curve(r, pv, 0, "K0 rho g z");
+    lahar_check_point(r, 0.0, 0.0);
+    lahar_check_point(r, H, 1e-3 * k0 * rho * g * H);
+    double erow = 0.0, efloor = NAN;
+    for (int row = nrow - 1; row >= 0; row--)
+        if (cnt[row] > 0) { /* the deepest row: the one on the floor */
+            double z = (row + 0.5) * dx;
+            efloor = fabs(sv[row] / (double)cnt[row] + rho * g * z) / (rho * g * z);
+            break;
+        }
+    for (int row = 0; row < nrow; row++) {
+        double z = (row + 0.5) * dx;
+        if (cnt[row] > 0 && z >= 0.25 * H && z <= H) /* every row, the one on the floor too */
+            erow = fmax(erow, fabs(sv[row] / (double)cnt[row] + rho * g * z) / (rho * g * z));
+    }
+    for (int row = 0; row + 1 < nrow; row += 2) { /* bins of two rows, centred at depth (row + 1) dx */
+        double z = (row + 1) * dx;
+        int64_t nb = cnt[row] + cnt[row + 1];
+        if (cnt[row] == 0 || cnt[row + 1] == 0 || z < 0.25 * H || z + dx > H - dx * (1.0 - 1e-6))
+            continue; /* (the row on the floor lacks half its neighbours: left out, its error is in the info) */
+        double v = (sv[row] + sv[row + 1]) / (double)nb, h = (sh[row] + sh[row + 1]) / (double)nb;
+        double ref = -rho * g * z;
+        ev = fmax(ev, fabs(v - ref) / fabs(ref));
+        ek = fmax(ek, fabs(h / v - k0) / k0);
+        nused++;
+    }
+    free(sv), free(sh), free(cnt);
+    if (nused == 0) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: no soil rows below H/4 (H = %g m, dx = %g m)", H, dx);
+        return -1;
+    }
+    const double settle_ref = rho * g * H * H / (3.0 * M);
+    lahar_check_value(r, "sigma_v_rel_error", ev);
+    lahar_check_value(r, "K0_rel_error", ek);
+    lahar_check_value(r, "creep_rel", fabs(mean_last - mean_first) / settle_ref);
+    lahar_check_value(r, "sigma_v_row_max_rel_error", erow);
+    lahar_check_value(r, "sigma_v_floor_rel_error", efloor);
+    lahar_check_value(r, "K0_reference", k0);
+    lahar_check_value(r, "settlement_m", mean0 - mean_last);
+    lahar_check_value(r, "settlement_elastic_m", settle_ref);
+    lahar_check_value(r, "height_m", H);
+    lahar_check_value(r, "window_start_s", p->t[kfirst]);
+    snprintf(r->convention, sizeof r->convention,
+             "stress tension positive; rows of dx by depth below the surface, mean over t >= %.3g s; bins of "
+             "two rows deeper than H/4 enter the metrics", p->t[kfirst]);
+    snprintf(r->note, sizeof r->note, "K0 = nu/(1-nu) = %.4f, H = %.4g m, 2-row bins used %d", k0, H, nused);
+    return 0;
+}
+
+/* soil_slide: a soil block resting on a fixed floor whose normal is +y (2D) / +z (3D), gravity
+ * tilted by theta from the normal (the same as a block on a plane inclined by theta). With the
+ * soil-DEM friction mu_phi (Trujillo-Vela et al. 2020 eq. 22-25) the block slides when tan(theta) > mu_phi with
+ *   a = g (sin theta - mu_phi cos theta)
+ * and stays put otherwise (a = 0). Measured: the mean velocity of the soil particles along the
+ * tangential part of gravity, fitted by a straight line over the snapshots after the first
+ * quarter of the run (the block first settles onto the floor). Metric:
+ *   accel_rel_error = |a - a_ref| / a_ref when it slides, |a| / (g sin theta) when it should stick. */
+int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    if (!p || !p->phase || !p->vx || !mat || p->nsnap < 4) {
+        snprintf(r->err, sizeof r->err, "soil_slide: needs a soil block, >= 4 snapshots and the particle fields "
+                 "velocity and phase");
+        return -1;
+    }
+    const int dim = c->dim, up = dim - 1;
+    double gt[3] = {c->gravity[0], c->gravity[1], c->gravity[2]};
+    const double gn = -gt[up];
+    gt[up] = 0.0;
+    const double gtm = sqrt(gt[0] * gt[0] + gt[1] * gt[1] + gt[2] * gt[2]);
+    if (!(gn > 0.0) || !(gtm > 0.0)) {
+        snprintf(r->err, sizeof r->err, "soil_slide: gravity must point into the floor (-%c) with a tangential part",
+                 "xyz"[up]);
+        return -1;
+    }
+    const double mu = mat->friction, theta = atan2(gtm, gn), g = hypot(gtm, gn);
+    const double a_ref = gtm - mu * gn > 0.0 ? gtm - mu * gn : 0.0;
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[0] + 0.25 * (p->t[kl] - p->t[0]);
+    double st = 0, sv = 0, stt = 0, stv = 0, x0 = 0, x1 = 0;
+    int nfit = 0;
+    for (int64_t k = 0; k <= kl; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
+        double v = 0.0, x = 0.0;
+        int64_t n = 0;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            if (p->phase[i] == 1) {
+                const double vv[3] = {p->vx[i], p->vy[i], p->vz[i]}, xx[3] = {p->x[i], p->y[i], p->z[i]};
+                for (int a = 0; a < 3; a++)
+                    v += vv[a] * gt[a] / gtm, x += xx[a] * gt[a] / gtm;
+                n++;
+            }
+        if (n == 0)
+            continue;
+        v /= (double)n, x /= (double)n;
+        if (k == 0)
+            x0 = x;
+        x1 = x;
+        if (r->nseries < LAHAR_CHECK_MAX_SERIES) {
+            r->series_t[r->nseries] = p->t[k];
+            r->series_measured[r->nseries] = v;
+            r->series_reference[r->nseries] = 0.0; /* set after the fit */
+            r->nseries++;
+        }
+        if (p->t[k] >= t_from) {
+            st += p->t[k], sv += v, stt += p->t[k] * p->t[k], stv += p->t[k] * v;
+            nfit++;
+        }
+    }
+    if (nfit < 3) {
+        snprintf(r->err, sizeof r->err, "soil_slide: fewer than 3 snapshots after t = %g s", t_from);
+        return -1;
+    }
+    const double a = (nfit * stv - st * sv) / (nfit * stt - st * st), v0 = (sv - a * st) / nfit;
+    for (int k = 0; k < r->nseries; k++) /* the reference slope through the fitted velocity at t_from */
+        r->series_reference[k] = v0 + a * t_from + a_ref * (r->series_t[k] - t_from);
+    lahar_check_value(r, "accel_rel_error", a_ref > 0.0 ? fabs(a - a_ref) / a_ref : fabs(a) / gtm);
+    lahar_check_value(r, "accel_measured", a);
+    lahar_check_value(r, "accel_reference", a_ref);
+    lahar_check_value(r, "theta_deg", theta * 180.0 / acos(-1.0));
+    lahar_check_value(r, "mu_phi", mu);
+    lahar_check_value(r, "g_sin_theta", g * sin(theta));
+    lahar_check_value(r, "displacement_m", x1 - x0);
+    snprintf(r->title, sizeof r->title, "soil block on a %.1f deg slope, mu_phi = %.3g: %s", theta * 180.0 / acos(-1.0),
+             mu, a_ref > 0.0 ? "slides" : "sticks");
+    snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
+    snprintf(r->ylabel, sizeof r->ylabel, "mean soil velocity down the slope (m/s)");
+    snprintf(r->convention, sizeof r->convention,
+             "a fitted to the mean velocity along the slope for t >= %.3g s; reference g (sin theta - mu_phi cos theta)",
+             t_from);
+    return 0;
+}
+
+/* granular_collapse: a soil column against a fixed wall released to one side onto a fixed floor
+ * (Bui et al. 2008 aluminium bars; shared/reference/04a gives the material, not the deposit).
+ * The wall (x_wall) and the floor (y_floor) are the left and bottom edges of the column's lattice
+ * cells at t = 0 (the column stands in the corner). Reported (last
+ * snapshot): run-out L_f (the front: the rightmost soil particle + dx/2, from the wall; and where
+ * the deposit stops being at least two particles thick, runout_2dx_thick_m), the
+ * height at the wall H_f, the surface profile (highest particle + dx/2 per column of dx), and the
+ * slope of the deposit's surface fitted over its sloping part (columns from the wall's
+ * neighbourhood to the front with height between 10 % and 90 % of H_f). Metrics:
+ *   escaped_particles   soil particles below the floor or behind the wall at any snapshot (0)
+ *   kinetic_energy_rel  kinetic energy of the soil at the end / its largest value (settled: small)
+ *   slope_excess_deg    max(0, fitted deposit slope - friction angle): a dry deposit rests at or
+ *                       below its angle of repose
+ *   runout_band_excess_rel  the mass run-out against the published 2D scalings (below): 0 inside
+ *                       the band they span, else the relative distance to its nearer edge
+ * The mass run-out L_99 (runout_mass99_m, from the wall) is where 99 % of the soil particles (equal
+ * masses) lie behind: the front particle of an SPH deposit is a spray of single particles whose
+ * reach changes with dx (it grew 13 % from dx = 5 to 2.5 mm, a = 1), L_99 converges (3.5 %).
+ * Scalings (L_inf - L0)/L0 of quasi-2D column collapses, a = H0/L0, as consolidated by Lagree,
+ * Staron & Popinet (2011, J. Fluid Mech. 686:378, eq. 3.1; docs/soil/column_collapse_scalings.md):
+ *   Lube et al. (2005, Phys. Rev. E 72:041301):      1.2 a (a < 1.8),  1.9 a^(2/3) (a > 2.8)
+ *   Lajeunesse et al. (2005, Phys. Fluids 17:103302): 1.8 a (a < 3),    2.3 a^(2/3) (a > 3)
+ * The band is [min, max] of the branches that apply at a (both of Lube's between 1.8 and 2.8): the
+ * experiments' own spread between materials and set-ups. */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    if (!p || !p->phase || !p->vx || !mat || p->nsnap < 2 || c->dim != 2) {
+        snprintf(r->err, sizeof r->err, "granular_collapse: needs a 2D case with a soil block, >= 2 snapshots and the "
+                 "particle fields velocity and phase");
+        return -1;
+    }
+    const double dx = c->sph_dx;
+    if (lahar_check_particles_read(p, 0, r->err, sizeof r->err))
+        return -1;
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        if (p->phase[i] == 1) {
+            xmin = fmin(xmin, p->x[i]), xmax = fmax(xmax, p->x[i]);
+            ymin = fmin(ymin, p->y[i]), ymax = fmax(ymax, p->y[i]);
+        }
+    if (!(xmax >= xmin)) {
+        snprintf(r->err, sizeof r->err, "granular_collapse: no soil particles at t = 0");
+        return -1;
+    }
+    /* the column's lattice cell edges stand for the wall and the floor surfaces */
+    const double x_wall = xmin - 0.5 * dx, y_floor = ymin - 0.5 * dx;
+    const double L0 = xmax + 0.5 * dx - x_wall, H0 = ymax + 0.5 * dx - y_floor;
+    int64_t escaped = 0;
+    double ke_max = 0.0, ke_last = 0.0;
+    for (int64_t k = 0; k < p->nsnap; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
+        double ke = 0.0;
+        int64_t esc = 0;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            if (p->phase[i] == 1) {
+                ke += 0.5 * (p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i]);
+                esc += p->y[i] < y_floor || p->x[i] < x_wall;
+            }
+        escaped = esc > escaped ? esc : escaped;
+        ke_max = fmax(ke_max, ke);
+        ke_last = ke;
+    }
+    /* the deposit (the last snapshot is in the buffers) */
+    const int ncol = 4096;
+    double *top = malloc(ncol * sizeof *top);
+    if (!top) {
+        snprintf(r->err, sizeof r->err, "out of memory");
+        return -1;
+    }
+    for (int k = 0; k < ncol; k++)
+        top[k] = -INFINITY;
+    double front = x_wall, front2 = x_wall;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        if (p->phase[i] == 1) {
+            int col = (int)floor((p->x[i] - x_wall) / dx);
+            if (col >= 0 && col < ncol)
+                top[col] = fmax(top[col], p->y[i] + 0.5 * dx - y_floor);
+            front = fmax(front, p->x[i] + 0.5 * dx);
+        }
+    for (int k = 0; k < ncol && top[k] >= 2.0 * dx; k++) /* the deposit at least two particles thick */
+        front2 = x_wall + (k + 1) * dx;
+    const double Lf = front - x_wall, Hf = top[0] > 0.0 ? top[0] : 0.0;
+    /* the mass run-out: 99 % of the soil particles behind it (a partial selection by counting) */
+    double L99 = NAN;
+    {
+        int64_t ns = 0;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            ns += p->phase[i] == 1;
+        double *xs = malloc((size_t)(ns > 0 ? ns : 1) * sizeof *xs);
+        if (!xs) {
+            free(top);
+            snprintf(r->err, sizeof r->err, "out of memory");
+            return -1;
+        }
+        int64_t m = 0;
+        for (int64_t i = 0; i < p->cur_n; i++)
+            if (p->phase[i] == 1)
+                xs[m++] = p->x[i];
+        qsort(xs, (size_t)ns, sizeof *xs, cmp_double);
+        if (ns > 0) { /* linear interpolation between order statistics (numpy's default quantile) */
+            double q = 0.99 * (double)(ns - 1);
+            int64_t k0 = (int64_t)floor(q), k1 = k0 + 1 < ns ? k0 + 1 : k0;
+            L99 = xs[k0] + (q - (double)k0) * (xs[k1] - xs[k0]) - x_wall;
+        }
+        free(xs);
+    }
+    /* the published scalings at a = H0/L0 (see above) */
+    const double asp = H0 / L0, a23 = pow(asp, 2.0 / 3.0);
+    double band_lo = INFINITY, band_hi = -INFINITY;
+    const double branch[4] = {asp < 2.8 ? 1.2 * asp : NAN, asp > 1.8 ? 1.9 * a23 : NAN, asp <= 3.0 ? 1.8 * asp : NAN,
+                              asp >= 3.0 ? 2.3 * a23 : NAN};
+    for (int b = 0; b < 4; b++)
+        if (branch[b] == branch[b]) {
+            band_lo = fmin(band_lo, branch[b]);
+            band_hi = fmax(band_hi, branch[b]);
+        }
+    const double r99 = (L99 - L0) / L0;
+    const double excess = r99 < band_lo ? (band_lo - r99) / band_lo : r99 > band_hi ? (r99 - band_hi) / band_hi : 0.0;
+    int pl = lahar_check_panel(r, "deposit surface (last snapshot) and the initial column", "x from the wall (m)",
+                               "height (m)");
+    lahar_check_curve(r, pl, 1, "lahar deposit");
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int nfit = 0;
+    for (int k = 0; k < ncol; k++) {
+        if (!(top[k] > -INFINITY))
+            continue;
+        double xc = (k + 0.5) * dx;
+        lahar_check_point(r, xc, top[k]);
+        if (top[k] >= 0.1 * Hf && top[k] <= 0.9 * Hf) {
+            sx += xc, sy += top[k], sxx += xc * xc, sxy += xc * top[k];
+            nfit++;
+        }
+    }
+    free(top);
+    lahar_check_curve(r, pl, 0, "initial column");
+    lahar_check_point(r, 0.0, H0);
+    lahar_check_point(r, L0, H0);
+    lahar_check_point(r, L0, 0.0);
+    const double slope = nfit >= 2 ? -(nfit * sxy - sx * sy) / (nfit * sxx - sx * sx) : 0.0;
+    const double slope_deg = atan(slope) * 180.0 / acos(-1.0), phi_deg = mat->friction_angle * 180.0 / acos(-1.0);
+    lahar_check_value(r, "escaped_particles", (double)escaped);
+    lahar_check_value(r, "kinetic_energy_rel", ke_max > 0.0 ? ke_last / ke_max : 0.0);
+    lahar_check_value(r, "slope_excess_deg", slope_deg > phi_deg ? slope_deg - phi_deg : 0.0);
+    lahar_check_value(r, "runout_band_excess_rel", excess);
+    lahar_check_value(r, "runout_mass99_m", L99);
+    lahar_check_value(r, "runout_mass99_normalised", r99);
+    lahar_check_value(r, "aspect_ratio", asp);
+    lahar_check_value(r, "scaling_band_lo", band_lo);
+    lahar_check_value(r, "scaling_band_hi", band_hi);
+    lahar_check_value(r, "runout_m", Lf);
+    lahar_check_value(r, "runout_normalised", (Lf - L0) / L0);
+    lahar_check_value(r, "runout_2dx_thick_m", front2 - x_wall);
+    lahar_check_value(r, "height_at_wall_m", Hf);
+    lahar_check_value(r, "height_at_wall_normalised", Hf / H0);
+    lahar_check_value(r, "deposit_slope_deg", slope_deg);
+    lahar_check_value(r, "friction_angle_deg", phi_deg);
+    lahar_check_value(r, "L0_m", L0);
+    lahar_check_value(r, "H0_m", H0);
+    snprintf(r->note, sizeof r->note, "no published run-out in shared/reference/04a: run-out and profile reported only");
+    snprintf(r->convention, sizeof r->convention, "run-out from the wall to the front (rightmost particle + dx/2); "
+             "slope fitted to the column tops between 10 %% and 90 %% of the height at the wall");
+    return 0;
+}
+
+/* darcy: water driven through a soil by sph.body_force b (fluid only; hydraulic gradient
+ * i = |b| / g with g = |gravity|, 9.81 m/s^2 without gravity, the g of k = k_h mu / (rho_w g)).
+ * Darcy's law gives the seepage (superficial) velocity u = k_h i along b relative to the soil
+ * (Trujillo-Vela et al. 2020 eq. 10). Measured: mean water velocity minus mean soil velocity along b, averaged
+ * over the snapshots of the last quarter of the run. Metric:
+ *   darcy_velocity_rel_error = |u - k_h i| / (k_h i). */
+int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    const double *b = c->sph.body_force;
+    const double bm = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    const double gg = sqrt(c->gravity[0] * c->gravity[0] + c->gravity[1] * c->gravity[1] + c->gravity[2] * c->gravity[2]);
+    if (!p || !p->phase || !p->vx || !mat || !(mat->permeability > 0.0) || !(bm > 0.0) || p->nsnap < 2) {
+        snprintf(r->err, sizeof r->err, "darcy: needs a soil with permeability > 0, water, sph.body_force != 0, >= 2 "
+                 "snapshots and the particle fields velocity and phase");
+        return -1;
+    }
+    const double g = gg > 0.0 ? gg : 9.81, i_h = bm / g, u_ref = mat->permeability * i_h;
+    const int64_t kl = p->nsnap - 1;
+    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+    double usum = 0.0;
+    int nwin = 0;
+    for (int64_t k = 0; k <= kl; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
+        double uw = 0.0, us = 0.0;
+        int64_t nw = 0, ns = 0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            double u = (p->vx[i] * b[0] + p->vy[i] * b[1] + p->vz[i] * b[2]) / bm;
+            if (p->phase[i] == 1)
+                us += u, ns++;
+            else
+                uw += u, nw++;
+        }
+        if (nw == 0 || ns == 0) {
+            snprintf(r->err, sizeof r->err, "darcy: snapshot %lld lacks water or soil particles", (long long)k);
+            return -1;
+        }
+        double u = uw / (double)nw - us / (double)ns;
+        if (r->nseries < LAHAR_CHECK_MAX_SERIES) {
+            r->series_t[r->nseries] = p->t[k];
+            r->series_measured[r->nseries] = u;
+            r->series_reference[r->nseries] = u_ref;
+            r->nseries++;
+        }
+        if (p->t[k] >= t_from)
+            usum += u, nwin++;
+    }
+    const double u = usum / nwin;
+    lahar_check_value(r, "darcy_velocity_rel_error", fabs(u - u_ref) / u_ref);
+    lahar_check_value(r, "darcy_velocity", u);
+    lahar_check_value(r, "darcy_velocity_reference", u_ref);
+    lahar_check_value(r, "hydraulic_gradient", i_h);
+    lahar_check_value(r, "k_h", mat->permeability);
+    snprintf(r->title, sizeof r->title, "Darcy flow through a soil: k_h = %g m/s, i = %.3g", mat->permeability, i_h);
+    snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
+    snprintf(r->ylabel, sizeof r->ylabel, "mean water - mean soil velocity along b (m/s)");
+    snprintf(r->convention, sizeof r->convention, "i = |sph.body_force| / g; velocities averaged over t >= %.3g s",
+             t_from);
+    return 0;
+}
+
+/* granular_impact: a soil mass flowing down a chute onto a fixed wall (Trujillo-Vela et al. 2020 section 5.3,
+ * Moriguchi et al. 2009). The chute's bed is normal to the last axis (z in 3D, y in 2D) and
+ * gravity is tilted from it; "down the chute" is the unit vector t along gravity's tangential part,
+ * and the wall is the fixed body named `wall` across it. The soil block fills the chute's width at
+ * t = 0 (its lattice's side faces are the side walls). Measured:
+ *   F(t)  the force of the soil on the wall along t, every row of the force stream (forces.h5 needs
+ *         time.forces_interval: 0, every step); its peak F_peak after a moving average over
+ *         10 ms (a load cell's bandwidth; the raw peak of single steps is in the info) and the time
+ *         of first impact (the first row where F exceeds 1 % of M g_t: a stray particle does not
+ *         count);
+ *   F_mf  the momentum flux of the soil arriving at the wall, rho u^2 A estimated at each snapshot
+ *         as sum m u^2 / L over the particles moving towards the wall (u = v.t > 0) in the slab of
+ *         length L = max(0.1 m, 3 dx) in front of the wall's face: a jet of density rho, speed u and
+ *         section A stopped by a wall pushes it with rho u^2 A (the fluid-mechanics estimate of a
+ *         granular impact, dynamic part only);
+ *   momentum balance along t: the soil's momentum changes by M g_t T minus the impulse of every
+ *         body's force on it (action and reaction of Trujillo-Vela et al. 2020 eq. 15, 20 and 26), so
+ *         sum_b J_b(T) = M g_t T - (P(T) - P(0)), with J_b the impulse of the force stream of body b.
+ * Metrics:
+ *   escaped_particles           soil particles that went through the wall, the bed or a side wall:
+ *                               followed by id (output field id) from snapshot to snapshot, a particle
+ *                               that crossed the wall's face, or a side face, with both positions more
+ *                               than 2 dx below the wall's top, or the bed's plane upstream of the
+ *                               wall (0). Particles passing over the wall's top (the experiment's
+ *                               overtopping: the run-up reaches ~1.1 m at 45 deg) are counted apart,
+ *                               overtopped_particles (info, those beyond the wall at the end)
+ *   particle_count_change       |n(end) - n(0)| (0)
+ *   momentum_balance_rel_error  |sum_b J_b - (M g_t T - dP)| / (M g_t T) at the last snapshot; needs
+ *                               the soil's damping 0 (damping is an external force)
+ *   peak_to_load_estimate_log   |ln(F_peak / (max_t F_mf + M g_t))|: the peak against the dynamic
+ *                               load of the arriving front plus the whole mass's weight along the
+ *                               chute (the static load of the deposit if the bed held none of it);
+ *                               a missing or spiky wall force (no coupling, a blow-up) is far off
+ *   first_impact_outside_s      how far the first impact lies outside [t_ritter, t_block] (s): the
+ *                               frictionless dam-break front on the slope, s = 2 sqrt(g_n H) t + g_t
+ *                               t^2/2, arrives first; a rigid block sliding from rest with mu_phi,
+ *                               s = (g_t - mu_phi g_n) t^2/2, last (0)
+ * Trujillo-Vela et al. 2020, Fig. 14-15 are images without numbers in the text (shared/papers/000): no published
+ * peak force is compared; the peak, its time and the first impact are reported. */
+
+/* The particle ids of snapshot k (output field id), read beside the check's buffers. */
+static int impact_read_ids(const lahar_check_particles *p, int64_t k, int64_t *ids, char *err, size_t n)
+{
+    char name[64];
+    snprintf(name, sizeof name, "snapshots/%06lld/id", (long long)k);
+    hid_t ds = (p->fields & LAHAR_PFIELD_ID) ? H5Dopen2((hid_t)p->file, name, H5P_DEFAULT) : -1;
+    int rc = ds < 0 || (p->n[k] > 0 && H5Dread(ds, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, ids) < 0);
+    if (ds >= 0)
+        H5Dclose(ds);
+    if (rc)
+        snprintf(err, n, "granular_impact: particles.h5: %s missing (output: fields needs id)", name);
+    return rc ? -1 : 0;
+}
+
+static int impact_wall_body(const lahar_case *c)
+{
+    for (int b = 0; b < c->nbody; b++)
+        if (strcmp(c->bodies[b].name, "wall") == 0 && c->bodies[b].motion == LAHAR_MOTION_FIXED)
+            return b;
+    return -1;
+}
+
+int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    const lahar_material *mat = soil_material(c);
+    const int wall = impact_wall_body(c);
+    if (!p || !p->phase || !p->vx || !mat || p->nsnap < 2 || wall < 0 || d->nrow < 2 || d->nbody != c->nbody) {
+        snprintf(r->err, sizeof r->err, "granular_impact: needs a soil block, a fixed body named `wall`, the force "
+                 "stream (forces.h5), >= 2 snapshots and the particle fields velocity and phase");
+        return -1;
+    }
+    if (c->forces_interval != 0.0 || mat->damping != 0.0) {
+        snprintf(r->err, sizeof r->err, "granular_impact: needs time.forces_interval: 0 (the impulse of every step) "
+                 "and the soil's damping 0 (got %g s, %g 1/s)", c->forces_interval, mat->damping);
+        return -1;
+    }
+    const int dim = c->dim, up = dim - 1, nb = d->nbody;
+    vec3 gt = v3(c->gravity[0], c->gravity[1], c->gravity[2]);
+    if (up == 1)
+        gt.y = 0.0;
+    else
+        gt.z = 0.0;
+    const double gtm = v3_norm(gt), dx = c->sph_dx;
+    if (!(gtm > 0.0) || !(c->gravity[up] < 0.0)) {
+        snprintf(r->err, sizeof r->err, "granular_impact: gravity must point into the bed (-%c) with a component "
+                 "down the chute", "xyz"[up]);
+        return -1;
+    }
+    const vec3 t = v3_scale(gt, 1.0 / gtm);
+    const double m = mat->density * pow(dx, dim); /* soil particle mass (sph_node: rho dx^D) */
+    /* the initial block: bed, chute width, centroid, the wall's face along t */
+    if (lahar_check_particles_read(p, 0, r->err, sizeof r->err))
+        return -1;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    vec3 centre = v3(0, 0, 0);
+    int64_t n0 = 0;
+    double P0 = 0.0, front0 = -INFINITY;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        if (p->phase[i] == 1) {
+            const double xx[3] = {p->x[i], p->y[i], p->z[i]};
+            for (int a = 0; a < 3; a++)
+                lo[a] = fmin(lo[a], xx[a]), hi[a] = fmax(hi[a], xx[a]);
+            centre = v3_add(centre, v3_load(xx));
+            P0 += m * (p->vx[i] * t.x + p->vy[i] * t.y + p->vz[i] * t.z);
+            front0 = fmax(front0, v3_dot(v3_load(xx), t) + 0.5 * dx);
+            n0++;
+        }
+    if (n0 == 0) {
+        snprintf(r->err, sizeof r->err, "granular_impact: no soil particles at t = 0");
+        return -1;
+    }
+    centre = v3_scale(centre, 1.0 / (double)n0);
+    const lahar_body *wb = &c->bodies[wall];
+    vec3 cp;
+    int feature;
+    const double wall_gap = geom_point_body_core(&wb->shape, wb->x, wb->q, centre, &cp, &feature) - wb->shape.radius;
+    const double s_wall = v3_dot(centre, t) + wall_gap; /* the wall's face along t */
+    const double bed = lo[up] - 0.5 * dx;
+    const int side = up == 2 ? 1 : -1; /* the axis across the chute (3D) */
+    const double L = fmax(0.1, 3.0 * dx), M = m * (double)n0;
+    /* the top of the wall along the up axis (its highest core vertex + its sweep radius): a particle
+     * above it passes over the wall and the side walls (the experiment's overtopping), not through */
+    double h_top = -INFINITY;
+    for (int v = 0; v < wb->shape.nv; v++) {
+        const vec3 xv = v3_add(v3_load(wb->x), q_rotate(q_load(wb->q), v3_load(wb->shape.v[v])));
+        h_top = fmax(h_top, (up == 2 ? xv.z : xv.y) + wb->shape.radius);
+    }
+    /* particles: escapes (by id between consecutive snapshots), momentum, momentum flux at the wall */
+    int64_t escaped = 0, nlast = n0, over = 0;
+    double Plast = P0, tlast = p->t[0], fmf_max = 0.0, fmf_t = 0.0;
+    const int64_t nid = 4 * p->nmax + 1; /* ids are below this (particles are never created later) */
+    double *fmf = malloc((size_t)p->nsnap * sizeof *fmf), *pt = malloc((size_t)p->nsnap * sizeof *pt);
+    double *force = malloc((size_t)d->nrow * sizeof *force), *jcum = malloc(((size_t)d->nrow + 1) * sizeof *jcum);
+    double *prev = malloc((size_t)nid * 3 * sizeof *prev); /* s, up, across of each id at the last snapshot */
+    int64_t *ids = malloc((size_t)(p->nmax ? p->nmax : 1) * sizeof *ids);
+    unsigned char *seen = calloc((size_t)nid, 1);
+    if (!fmf || !pt || !force || !jcum || !prev || !ids || !seen) {
+        free(fmf), free(pt), free(force), free(jcum), free(prev), free(ids), free(seen);
+        snprintf(r->err, sizeof r->err, "out of memory");
+        return -1;
+    }
+    for (int64_t k = 0; k < p->nsnap; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err) || impact_read_ids(p, k, ids, r->err, sizeof r->err)) {
+            free(fmf), free(pt), free(force), free(jcum), free(prev), free(ids), free(seen);
+            return -1;
+        }
+        int64_t n = 0;
+        double P = 0.0, flux = 0.0;
+        over = 0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            if (p->phase[i] != 1)
+                continue;
+            const vec3 x = v3(p->x[i], p->y[i], p->z[i]);
+            const double u = p->vx[i] * t.x + p->vy[i] * t.y + p->vz[i] * t.z, s = v3_dot(x, t);
+            const double xs[3] = {x.x, x.y, x.z}, hgt = xs[up], acr = side > 0 ? xs[side] : 0.0;
+            const int64_t id = ids[i];
+            if (id < 0 || id >= nid || !isfinite(s) || !isfinite(hgt)) {
+                escaped++;
+                continue;
+            }
+            /* crossed a boundary since the last snapshot, more than 2 dx below the walls' top (a particle
+             * arcing over the rounded top edge between two snapshots is not through it)? */
+            if (seen[id]) {
+                const double s0 = prev[id * 3], h0 = prev[id * 3 + 1], a0 = prev[id * 3 + 2];
+                const int low = h0 < h_top - 2.0 * dx && hgt < h_top - 2.0 * dx, upstream = s0 <= s_wall && s <= s_wall;
+                const double alo = lo[side > 0 ? side : 0] - 0.5 * dx, ahi = hi[side > 0 ? side : 0] + 0.5 * dx;
+                escaped += (s0 <= s_wall && s > s_wall && low) ||                /* through the wall */
+                           (upstream && h0 >= bed && hgt < bed) ||                /* through the bed */
+                           (side > 0 && upstream && low &&
+                            ((a0 >= alo && acr < alo) || (a0 <= ahi && acr > ahi))); /* through a side wall */
+            }
+            seen[id] = 1;
+            prev[id * 3] = s, prev[id * 3 + 1] = hgt, prev[id * 3 + 2] = acr;
+            over += s > s_wall;
+            P += m * u;
+            if (s > s_wall - L && s <= s_wall && u > 0.0)
+                flux += m * u * u / L;
+            n++;
+        }
+        fmf[k] = flux, pt[k] = P;
+        if (flux > fmf_max)
+            fmf_max = flux, fmf_t = p->t[k];
+        nlast = n, Plast = P, tlast = p->t[k];
+    }
+    free(prev), free(ids), free(seen);
+    /* the force stream: F(t) on the wall, impulses of every body up to the last snapshot */
+    double J = 0.0, tprev = 0.0, t_first = NAN, raw_peak = 0.0;
+    jcum[0] = 0.0;
+    for (int64_t k = 0; k < d->nrow; k++) {
+        const double *f = d->force + (size_t)k * (size_t)nb * 3;
+        force[k] = f[wall * 3] * t.x + f[wall * 3 + 1] * t.y + f[wall * 3 + 2] * t.z;
+        const double dt = d->ft[k] - tprev;
+        jcum[k + 1] = jcum[k] + force[k] * dt;
+        if (d->ft[k] <= tlast * (1.0 + 1e-12))
+            for (int b = 0; b < nb; b++)
+                J += (f[b * 3] * t.x + f[b * 3 + 1] * t.y + f[b * 3 + 2] * t.z) * dt;
+        if (isnan(t_first) && force[k] > 0.01 * M * gtm)
+            t_first = d->ft[k];
+        raw_peak = fmax(raw_peak, force[k]);
+        tprev = d->ft[k];
+    }
+    /* 10 ms moving average of F: (impulse over [t - w/2, t + w/2]) / w, from the cumulative impulse */
+    const double w = 0.01;
+    double peak = 0.0, t_peak = 0.0;
+    int64_t lo_k = 0, hi_k = 0;
+    const int64_t stride = d->nrow / 2000 + 1;
+    int pf = lahar_check_panel(r, "impact force on the wall (along the chute)", "t (s)", "F (N)");
+    lahar_check_curve(r, pf, 1, "lahar, 10 ms moving average");
+    for (int64_t k = 0; k < d->nrow; k++) {
+        const double tc = d->ft[k];
+        if (tc - 0.5 * w < 0.0 || tc + 0.5 * w > d->ft[d->nrow - 1])
+            continue;
+        while (lo_k < d->nrow && d->ft[lo_k] < tc - 0.5 * w)
+            lo_k++;
+        while (hi_k < d->nrow && d->ft[hi_k] <= tc + 0.5 * w)
+            hi_k++;
+        const double ta = lo_k > 0 ? d->ft[lo_k - 1] : 0.0, tb = d->ft[hi_k - 1];
+        const double fs = tb > ta ? (jcum[hi_k] - jcum[lo_k]) / (tb - ta) : force[k];
+        if (fs > peak)
+            peak = fs, t_peak = tc;
+        if (k % stride == 0)
+            lahar_check_point(r, tc, fs);
+    }
+    lahar_check_curve(r, pf, 0, "momentum flux rho u^2 A arriving (snapshots)");
+    for (int64_t k = 0; k < p->nsnap; k++)
+        lahar_check_point(r, p->t[k], fmf[k]);
+    lahar_check_curve(r, pf, 0, "estimate max rho u^2 A + M g sin(theta)");
+    lahar_check_point(r, 0.0, fmf_max + M * gtm);
+    lahar_check_point(r, d->ft[d->nrow - 1], fmf_max + M * gtm);
+    /* panel 2: the momentum balance over time */
+    int pm = lahar_check_panel(r, "momentum balance along the chute", "t (s)", "impulse (N s)");
+    lahar_check_curve(r, pm, 1, "M g_t t - (P(t) - P(0)) (particles)");
+    for (int64_t k = 0; k < p->nsnap; k++)
+        lahar_check_point(r, p->t[k], M * gtm * p->t[k] - (pt[k] - P0));
+    lahar_check_curve(r, pm, 0, "impulse of every body's force (force stream)");
+    double jall = 0.0;
+    tprev = 0.0;
+    for (int64_t k = 0; k < d->nrow; k++) {
+        const double *f = d->force + (size_t)k * (size_t)nb * 3;
+        for (int b = 0; b < nb; b++)
+            jall += (f[b * 3] * t.x + f[b * 3 + 1] * t.y + f[b * 3 + 2] * t.z) * (d->ft[k] - tprev);
+        tprev = d->ft[k];
+        if (k % stride == 0)
+            lahar_check_point(r, d->ft[k], jall);
+    }
+    lahar_check_curve(r, pm, 0, "impulse of the wall alone");
+    for (int64_t k = 0; k < d->nrow; k += stride)
+        lahar_check_point(r, d->ft[k], jcum[k + 1]);
+    free(fmf), free(pt), free(force), free(jcum);
+    const double grav_impulse = M * gtm * (tlast - p->t[0]);
+    const double balance = fabs(J - (grav_impulse - (Plast - P0))) / grav_impulse;
+    const double theta = atan2(gtm, -c->gravity[up]) * 180.0 / acos(-1.0);
+    const double a_block = gtm - mat->friction * (-c->gravity[up]);
+    const double travel = s_wall - front0;
+    lahar_check_value(r, "escaped_particles", (double)escaped);
+    lahar_check_value(r, "particle_count_change", fabs((double)(nlast - n0)));
+    lahar_check_value(r, "momentum_balance_rel_error", balance);
+    const double load_est = fmf_max + M * gtm;
+    lahar_check_value(r, "peak_to_load_estimate_log", peak > 0.0 ? fabs(log(peak / load_est)) : INFINITY);
+    lahar_check_value(r, "overtopped_particles", (double)over);
+    lahar_check_value(r, "peak_force_N", peak);
+    lahar_check_value(r, "peak_time_s", t_peak);
+    lahar_check_value(r, "peak_force_raw_N", raw_peak);
+    lahar_check_value(r, "first_impact_s", t_first);
+    lahar_check_value(r, "momentum_flux_max_N", fmf_max);
+    lahar_check_value(r, "momentum_flux_max_time_s", fmf_t);
+    lahar_check_value(r, "load_estimate_N", load_est);
+    lahar_check_value(r, "weight_along_chute_N", M * gtm);
+    lahar_check_value(r, "soil_mass_kg", M);
+    lahar_check_value(r, "slope_deg", theta);
+    lahar_check_value(r, "travel_m", travel);
+    lahar_check_value(r, "dx_m", dx);
+    lahar_check_value(r, "wall_face_m", s_wall);
+    lahar_check_value(r, "wall_top_m", h_top);
+    /* bounds on the arrival of the front: no later than a rigid block sliding from rest with mu_phi
+     * (t_block; the flowing front runs ahead of the block it was), no earlier than the frictionless
+     * dam-break front on a slope, s = 2 sqrt(g_n H) t + g_t t^2 / 2 (Ritter's front speed 2 sqrt(g H)
+     * of a column of height H plus the free acceleration along the chute; the fastest a mass without
+     * any friction spreads) */
+    const double t_block = a_block > 0.0 ? sqrt(2.0 * travel / a_block) : INFINITY;
+    const double c_front = 2.0 * sqrt(-c->gravity[up] * (hi[up] + 0.5 * dx - bed));
+    const double t_ritter = (-c_front + sqrt(c_front * c_front + 2.0 * gtm * travel)) / gtm;
+    lahar_check_value(r, "first_impact_outside_s",
+                      isnan(t_first) ? INFINITY : fmax(0.0, fmax(t_ritter - t_first, t_first - t_block)));
+    lahar_check_value(r, "sliding_block_arrival_s", t_block);
+    lahar_check_value(r, "frictionless_front_arrival_s", t_ritter);
+    snprintf(r->note, sizeof r->note, "slope %.1f deg, travel %.3g m from the block's front to the wall; Trujillo-Vela et al. 2020 "
+             "Fig. 14-15 give no numbers in the text: no published peak compared", theta, travel);
+    snprintf(r->convention, sizeof r->convention, "F = force of the soil on the body `wall` along the chute, "
+             "10 ms moving average; F_mf = sum m u^2 / L over particles moving to the wall within L = %.3g m", L);
+    return 0;
+}
