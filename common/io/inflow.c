@@ -1,4 +1,4 @@
-/* Inflow hydrographs (common/scene/inflow.h). */
+/* Inflow hydrographs and their CSV reader (declared in common/scene/inflow.h). */
 #include "inflow.h"
 
 #include <errno.h>
