@@ -2804,13 +2804,13 @@ static void read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                       in->t_end);
             return;
         }
-        if (layers != floor(layers) || layers < 0.0 || layers > 64.0) {
+        if (layers != floor(layers) || layers > 64.0 || (rmap_get(&m, "layers") && layers < 1.0)) {
             rmap_fail(&m, "layers", "must be a whole number of buffer rows in 1 .. 64 (got %g); leave it out for the "
                       "kernel support / dx", layers);
             return;
         }
         in->layers = (int)layers;
-        if (maxp != floor(maxp) || maxp < 0.0 || maxp > 1e12) {
+        if (maxp != floor(maxp) || maxp > 1e12 || (rmap_get(&m, "max_particles") && maxp < 1.0)) {
             rmap_fail(&m, "max_particles", "must be a whole number >= 1 (got %g); leave it out for the estimate from "
                       "the hydrograph", maxp);
             return;
