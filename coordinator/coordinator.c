@@ -491,6 +491,19 @@ static void coord_take_work(coord_node *n, const lahar_status_t *s)
     n->work.work_output_derived = s->work_output_derived;
     n->work.auth_rejected = s->auth_rejected;
     n->work.auth_replayed = s->auth_replayed;
+    memcpy(n->work.flow, s->flow, sizeof n->work.flow);
+}
+
+/* summary.json "flow": the open boundaries' counters of the last SPH STATUS (only for a case with
+ * inlets, outlets or a domain box; names in common/output.h) */
+static void coord_summary_flow(const coord *co, cJSON *root)
+{
+    const lahar_case *c = co->c;
+    if (!(c->ninlet > 0 || c->noutlet > 0 || c->has_domain))
+        return;
+    cJSON *fj = cJSON_AddObjectToObject(root, "flow");
+    for (int k = 0; k < LAHAR_FLOW_NVAL; k++)
+        cJSON_AddNumberToObject(fj, lahar_flow_names[k] + 5, co->node[LAHAR_ROLE_SPH].work.flow[k]);
 }
 
 /* summary.json "work": what the run computed and sent, per kind (coordinator/README.md). Nodes
@@ -1128,6 +1141,7 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(auth, "frames_rejected", rejected);
     cJSON_AddNumberToObject(auth, "frames_replayed", replayed);
     coord_summary_work(co, root);
+    coord_summary_flow(co, root);
     coord_summary_instability(co, root);
     if (co->ckpt_on || co->resumed) {
         cJSON *ck = cJSON_AddObjectToObject(root, "checkpoints");

@@ -7,6 +7,8 @@
 #include <math.h>
 #include <unistd.h>
 #include "case.h"
+#include "sph_inflow.h"
+#include "sph_node.h"
 
 #define BASE_BYTES 20.0e6
 #define WATER_BYTES_2D 300.0
@@ -53,7 +55,17 @@ void lahar_estimate_case(const lahar_case *c, lahar_estimate *e)
         if (c->blocks[b].phase == 1)
             e->soil_particles += n;
     }
-    double water = (double)(e->particles - e->soil_particles);
+    /* open boundaries: the room the SPH node reserves for what the inlets create (the memory is
+     * allocated at set-up, so it counts in full) */
+    sph_params prm;
+    sph_inflow fl = {0};
+    char err[256];
+    if (sph_inflow_case_wanted(c) && lahar_sph_node_params(c, &prm, err, sizeof err) == 0 &&
+        sph_inflow_setup_case(&fl, c, &prm, err, (int)sizeof err) == 0)
+        e->inflow_particles = sph_inflow_capacity(&fl);
+    if (sph_inflow_case_wanted(c))
+        sph_inflow_free(&fl);
+    double water = (double)(e->particles - e->soil_particles + e->inflow_particles);
     e->bytes = BASE_BYTES + BODY_BYTES * c->nbody + water * (c->dim == 3 ? WATER_BYTES_3D : WATER_BYTES_2D) +
                (double)e->soil_particles * SOIL_BYTES;
     if (e->particles > 0 && c->sph_dx > 0.0) {

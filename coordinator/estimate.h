@@ -9,6 +9,7 @@ typedef struct {
     int64_t particles;     /* SPH particles at t = 0 (exact when `exact`, else the blocks' lattice) */
     int exact;             /* 1: counted point by point with the bodies cut out (lahar_case_block_lattice) */
     int64_t soil_particles;
+    int64_t inflow_particles; /* room the SPH node reserves for the inlets (sph_inflow_capacity; 0 without) */
     int bodies;
     double bytes;          /* peak memory of the run, estimated (all nodes) */
     double dt;             /* the largest SPH step the CFL limit allows (0: no particles) */

@@ -155,6 +155,8 @@ static void print_estimate(const lahar_case *cs, const lahar_estimate *e)
     printf("  %lld particles%s (%lld soil%s), %d bodies\n", (long long)e->particles, e->exact ? "" : " at most",
            (long long)e->soil_particles,
            e->exact ? "" : "; the blocks' lattices: too many points to count with the bodies cut out", e->bodies);
+    if (e->inflow_particles > 0)
+        printf("  inlets: room for up to %lld more particles (inlets[k].max_particles)\n", (long long)e->inflow_particles);
     printf("  memory: about %s for the run (machine: %s)\n", human_bytes(e->bytes, mem, sizeof mem),
            human_bytes(lahar_estimate_machine_bytes(), machine, sizeof machine));
     if (e->particles > 0)

@@ -36,6 +36,7 @@
 #include "scene_msg.h"
 #include "shape_build.h"
 #include "transport.h"
+#include "sph_inflow.h"
 #include "sph_probes.h"
 #include "vec.h"
 
@@ -263,6 +264,9 @@ typedef struct {
     /* pressure probes (probes: in the case; nothing allocated or sampled without them) */
     sph_probes probes;
     lahar_gauge_output *gauges;
+    /* open boundaries (inlets:, outlets:, domain:; nothing set up or run without them) */
+    int has_flow;
+    sph_inflow flow;
 } sph_node;
 
 static int sph_node_fixed_snapshot(sph_node *s, int64_t step, double t);
@@ -287,6 +291,12 @@ static int sph_node_snapshot(sph_node *s, int64_t step, double t)
         .id = fields & LAHAR_PFIELD_ID ? p->id : NULL,
         .stress = {NULL, NULL, NULL, NULL, NULL, NULL}, /* soil only, below */
     };
+    double flow[LAHAR_FLOW_NVAL];
+    if (s->has_flow) {
+        sph_inflow_values(&s->flow, p, flow);
+        v.inlet = p->inlet;
+        v.flow = flow;
+    }
     if ((fields & LAHAR_PFIELD_PRESSURE) && s->out_pressure) {
         const sph_params *prm = &s->f.prm;
         for (int64_t i = 0; i < p->n; i++) /* soil (sph_soil.h): the mean stress -tr(sigma)/3 */
@@ -379,6 +389,7 @@ static void sph_node_free(sph_node *s)
     lahar_contact_output_close(s->cout);
     lahar_gauge_output_close(s->gauges);
     sph_probes_free(&s->probes);
+    sph_inflow_free(&s->flow);
     free(s->reports);
     free(s->c_x);
     free(s->c_f);
@@ -628,6 +639,8 @@ static void sph_node_work(const sph_node *s, lahar_status_t *st)
     st->work_particle_body = s->work_particle_body;
     st->work_body_body = 0;
     st->work_output_derived = s->work_output_derived;
+    if (s->has_flow) /* cumulative, like the work counters; the coordinator's summary.json "flow" */
+        sph_inflow_values(&s->flow, &s->f.p, st->flow);
 }
 
 /* After every evaluation of the coupling: its contacts join the particle-body work. */
@@ -856,7 +869,16 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
     lahar_ckpt_f64(f, "t", t_now, 1);
     int64_t n = p->n;
     lahar_ckpt_i64(f, "n", &n, 1);
-    if (!f->writing && !f->failed && n != p->n) {
+    if (s->has_flow && !f->writing && !f->failed) {
+        /* open boundaries: the count varies, up to the capacity of this case */
+        if (n < 0 || n > p->cap) {
+            snprintf(f->err, sizeof f->err, "the checkpoint holds %lld particles, this case has room for %lld "
+                     "(another case?)", (long long)n, (long long)p->cap);
+            f->failed = 1;
+        } else {
+            p->n = n;
+        }
+    } else if (!f->writing && !f->failed && n != p->n) {
         snprintf(f->err, sizeof f->err, "the checkpoint holds %lld particles, this case fills %lld (another case?)",
                  (long long)n, (long long)p->n);
         f->failed = 1;
@@ -939,6 +961,8 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
     }
     if (s->probes.n > 0)
         lahar_ckpt_i64(f, "probe_next_slot", s->probes.next_slot, s->probes.n);
+    if (s->has_flow)
+        sph_inflow_state_io(&s->flow, p, f);
     return f->failed ? -1 : 0;
 }
 
@@ -1006,6 +1030,9 @@ static int sph_node_loop(sph_node *s, int64_t k0, double t0)
         /* the particle work of step k needs no body states: do it before waiting for them, so
          * the DEM node's advance and the BODY_STATE latency hide behind it */
         int begun = 0;
+        if (!st.error && s->has_flow &&
+            sph_inflow_apply(&s->flow, &s->f, step.t, step.dt, err, (int)sizeof err) == INT64_MIN)
+            st.error = 1;
         if (!st.error) {
             if (sph_fluid_step_begin(&s->f, step.dt) != 0) {
                 st.error = 1;
@@ -1111,14 +1138,22 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
     }
     if (lahar_sph_node_params(c, &prm, err, errlen) != 0)
         return -1;
-    int64_t total = sph_node_count(c);
-    if (sph_fluid_init(&s->f, &prm, total > 0 ? total : 1, err, (int)errlen) != 0)
+    int64_t total = sph_node_count(c), room = 0;
+    if (sph_inflow_case_wanted(c)) {
+        s->has_flow = 1;
+        if (sph_inflow_setup_case(&s->flow, c, &prm, err, (int)errlen) != 0)
+            return -1;
+        room = sph_inflow_capacity(&s->flow); /* what the inlets may add */
+    }
+    if (sph_fluid_init(&s->f, &prm, total + room > 0 ? total + room : 1, err, (int)errlen) != 0)
         return -1;
     s->fluid_ready = 1;
     if (total < 0 || sph_node_add_blocks(&s->f.p, c) != 0) {
         snprintf(err, errlen, "out of memory for %lld particles", (long long)total);
         return -1;
     }
+    if (s->has_flow && sph_inflow_start(&s->flow, &s->f, 0.0, err, (int)errlen) != 0)
+        return -1;
     if (sph_node_alloc(s) != 0) {
         snprintf(err, errlen, "out of memory");
         return -1;

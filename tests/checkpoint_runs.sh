@@ -7,7 +7,7 @@
 # lahar's own private network namespace or in-process.
 #
 #   checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
-#   TEST: water | dem | coupled_killed | soil | sigterm | sigusr1 | errors
+#   TEST: water | dem | coupled_killed | soil | sigterm | sigusr1 | errors | inflow
 set -u
 test_name=$1 bin=$2 tools=$3 cases=$4 work=$5
 python=/usr/bin/python3
@@ -82,6 +82,22 @@ water)
     # the sidecars list every snapshot once
     n_full=$(grep -c '<Time ' full/particles.xmf) n_part=$(grep -c '<Time ' part/particles.xmf)
     [ "$n_full" = "$n_part" ] || fail "particles.xmf: $n_part time steps, the uninterrupted run has $n_full"
+    ;;
+inflow)
+    # open boundaries (cases/inflow_channel_2d: inlet with a CSV hydrograph, outlet, domain box):
+    # the particle count varies; run to 0.25 s, resume with --time-end 0.4 against a run to 0.4 s
+    override "$cases/inflow_channel_2d.yaml" flow.yaml time.end=0.4 time.output_interval=0.05 'outlets.downstream.position=[0.3, -0.5]' \
+        'checkpoint={interval: 0.1}'
+    override flow.yaml flow_part.yaml time.end=0.25
+    nice -n 10 "$lahar" run flow.yaml -o full --threads 1 -q || fail "full run"
+    nice -n 10 "$lahar" run flow_part.yaml -o part --threads 1 -q || fail "run to 0.25 s"
+    nice -n 10 "$lahar" resume part --time-end 0.4 --threads 1 -q || fail "resume --time-end 0.4"
+    same_output full part particles.h5
+    f_full=$(summary full "d['flow']")
+    f_part=$(summary part "d['flow']")
+    [ "$f_full" = "$f_part" ] || fail "summary.json flow: resumed $f_part, uninterrupted $f_full"
+    [ "$(summary full "d['flow']['removed_water'] > 0 and d['flow']['entered'] > 0")" = True ] ||
+        fail "the shortened run moved no water through the boundaries: $f_full"
     ;;
 dem)
     # DEM only (dem_drop_3d shortened): a crash right after a checkpoint, before the next one is

@@ -1,18 +1,15 @@
 # The LAMMPS DEM engine (dem_node/engines/lammps): analytic checks of the engine, and a coupled run
 # with `lahar run` against the spheropoly engine. Without liblammps the tests exist and report
 # SKIP (exit 77), so a build without the engine says what it did not test.
-add_executable(test_dem_lammps ${LAHAR_TEST_DIR}/test_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
-target_include_directories(test_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
-target_link_libraries(test_dem_lammps PRIVATE lahar_dem)
-add_test(NAME test_dem_lammps COMMAND test_dem_lammps)
-set_tests_properties(test_dem_lammps PROPERTIES LABELS "fast;dem;lammps" TIMEOUT 300 SKIP_RETURN_CODE 77)
+lahar_test(test_dem_lammps SOURCES test_dem_lammps.c dem_test_util.c LIBS lahar_dem LABELS fast dem lammps TIMEOUT 300
+  PROPERTIES SKIP_RETURN_CODE 77)
 # `lahar-dem --engine lammps` on a case that names spheropoly (lahar run --no-spawn and the node
 # started by hand in a private network namespace) against the same case run as usual; an unknown
 # --engine refused.
-add_test(NAME dem_lammps_engine_option
-         COMMAND bash ${LAHAR_TEST_DIR}/dem_lammps_engine_option.sh $<TARGET_FILE_DIR:lahar>
-                 ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_engine_option ${LAHAR_TEST_PYTHON})
-set_tests_properties(dem_lammps_engine_option PROPERTIES LABELS "fast;netns;lammps;coupling" TIMEOUT 300)
+lahar_test(dem_lammps_engine_option
+  COMMAND bash ${LAHAR_TEST_DIR}/dem_lammps_engine_option.sh $<TARGET_FILE_DIR:lahar>
+          ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_engine_option ${LAHAR_TEST_PYTHON}
+  LABELS fast netns lammps coupling TIMEOUT 300)
 if(NOT LAHAR_HAVE_LAMMPS)
   set_tests_properties(dem_lammps_engine_option PROPERTIES DISABLED TRUE)
 endif()
@@ -27,10 +24,10 @@ endif()
 
 # A coupled run through `lahar run` (processes, private network namespace): a disc sinking in water
 # onto the floor, lammps vs spheropoly (dem_lammps_coupled.sh says why the tolerance). ~20 s.
-add_test(NAME dem_lammps_coupled
-         COMMAND sh ${LAHAR_TEST_DIR}/dem_lammps_coupled.sh $<TARGET_FILE:lahar> ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_coupled
-                 ${LAHAR_TEST_PYTHON})
-set_tests_properties(dem_lammps_coupled PROPERTIES LABELS "slow;netns;lammps;coupling" TIMEOUT 600)
+lahar_test(dem_lammps_coupled
+  COMMAND sh ${LAHAR_TEST_DIR}/dem_lammps_coupled.sh $<TARGET_FILE:lahar> ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_coupled
+          ${LAHAR_TEST_PYTHON}
+  LABELS slow netns lammps coupling TIMEOUT 600)
 if(NOT LAHAR_HAVE_LAMMPS)
   set_tests_properties(dem_lammps_coupled PROPERTIES DISABLED TRUE)
 endif()

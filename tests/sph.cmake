@@ -31,3 +31,9 @@ lahar_test(sph_sps PROGRAM test_sph_sps SOURCES test_sph_sps.c LIBS lahar_sph LA
 # Split step: step_begin + step_end integrate at second order in time (observed order at dt, dt/2, dt/4).
 lahar_test(sph_split PROGRAM test_sph_split SOURCES test_sph_split.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=2")
+
+# Open boundaries (sph_node/inflow/sph_inflow.h): discharge through an inlet against the Gumbel
+# hydrograph (Trujillo-Vela et al. 2020, eq. 36), a CSV t,Q table and a level table t,h, a 3D
+# inlet, mass balance, outflow counts, unique ids, the capacity error, a supercritical channel at
+# its steady depth.
+lahar_test(sph_inflow PROGRAM test_sph_inflow SOURCES test_sph_inflow.c LIBS lahar_sph LABELS fast sph TIMEOUT 300)

@@ -122,7 +122,7 @@ static void run_snapshot(run_out *o, int64_t k, double t)
             memcpy(states[j].q, bodies[j].q, sizeof states[j].q);
         }
     CHECK(lahar_body_output_snapshot(o->bo, k, t, states) == 0, "body snapshot");
-    lahar_particles_view v = {np, px, py, pz, pvx, pvy, NULL, pden, ppr, NULL, NULL, {NULL}};
+    lahar_particles_view v = {np, px, py, pz, pvx, pvy, NULL, pden, ppr, NULL, NULL, {NULL}, NULL, NULL};
     static double zeros[MAXP];
     static int32_t phase[MAXP];
     static int64_t ids[MAXP];
@@ -786,7 +786,7 @@ static void test_errors(const char *base)
     cs.output_fields = LAHAR_PFIELD_PRESSURE;
     lahar_particle_output *po = lahar_particle_output_open(dir, &cs, cs.output_fields, err, sizeof err);
     if (po) {
-        lahar_particles_view v = {np, px, py, NULL, NULL, NULL, NULL, NULL, ppr, NULL, NULL, {NULL}};
+        lahar_particles_view v = {np, px, py, NULL, NULL, NULL, NULL, NULL, ppr, NULL, NULL, {NULL}, NULL, NULL};
         lahar_particle_output_snapshot(po, 0, 1.0, &v);
         lahar_particle_output_close(po);
     }

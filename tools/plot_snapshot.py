@@ -12,6 +12,9 @@ end). --all writes every snapshot to DIR (default OUT/frames/snapshot_NNNNNN.png
 colour scale for the whole series. Default output: OUT/snapshot_NNNNNN.png.
 2D runs are drawn in the x-y plane; 3D runs are projected onto --view (default xz: a side view
 with z up). Moving bodies are drawn at their snapshot pose, fixed bodies (walls, terrain) in grey.
+Runs with open boundaries (inlets:, outlets:, domain:): each snapshot has its own particle count;
+the inlets' buffer particles (dataset `inlet` >= 0) are drawn in light grey and the title adds
+the particles that entered and left so far (attributes flow_*).
 Works on runs with only bodies or only particles, and on a run still going (last complete
 snapshot)."""
 import argparse
@@ -137,6 +140,16 @@ def draw(out_png, pf, psnap, bf, bsnap, dim, view, color, clim, limits, dx):
             order = np.argsort(x[:, depth] if view != "xz" else -x[:, depth])
             x = x[order]
             val = val[order] if val is not None else None
+        snap = pf["snapshots"][psnap[0]]
+        if "inlet" in snap:  # open boundaries: the buffer particles apart, in grey
+            buf = snap["inlet"][()] >= 0
+            if dim == 3:
+                buf = buf[order]
+            ax.scatter(x[buf, ax2[0]], x[buf, ax2[1]], s=size, color="0.75", linewidths=0, zorder=2)
+            x = x[~buf]
+            val = val[~buf] if val is not None else None
+            title.append(f"entered {int(snap.attrs.get('flow_entered', 0))}, "
+                         f"removed {int(snap.attrs.get('flow_removed_water', 0) + snap.attrs.get('flow_removed_soil', 0))}")
         if val is not None:
             if color == "pressure" and clim == (None, None) and len(val):
                 # one impact spike would wash out the rest: scale to the 1st..99th percentile

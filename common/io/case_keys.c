@@ -27,6 +27,9 @@ static const lahar_key top_keys[] = {
     {"checkpoint", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "coordinated checkpoints for lahar resume (none without it)"},
     {"output", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "what the snapshots and streams hold"},
     {"check", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the reference lahar check compares the run with"},
+    {"inlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections where water enters with a hydrograph (cases/README.md)"},
+    {"outlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections beyond which particles are removed and counted"},
+    {"domain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: particles outside this box are removed and counted"},
     END};
 
 static const lahar_key time_keys[] = {
@@ -91,6 +94,37 @@ static const lahar_key probe_keys[] = {
     {"body", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "pressure probes: a body's name: the probe is a sensor on its surface"},
     {"size", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m", "pressure probes on a body: sensor diameter (0 = a point)"},
     {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step)"},
+    END};
+
+static const lahar_key inlet_keys[] = {
+    {"name", LAHAR_KEY_TEXT, 0, "inlet<i>", 0, 0, 0, NULL, "", "name (messages)"},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)"},
+    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]"},
+    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge, perpendicular to edge"},
+    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "inward normal, perpendicular to the edges (normalised)"},
+    {"level", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "m", "water depth above the section's lowest point along gravity (or level_hydrograph)"},
+    {"level_hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,h: the level h(t) instead of level (path relative to the case file)"},
+    {"velocity", LAHAR_KEY_NUMBER, 0, NULL, LO, 0, 0, NULL, "m/s", "a constant inflow velocity (one of velocity, gumbel, hydrograph)"},
+    {"gumbel", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "[a_G (m), beta_G (s), mu_G (s)]: u of Trujillo-Vela et al. 2020, eq. 36"},
+    {"hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,u (m/s) or t,Q (m^2/s in 2D, m^3/s in 3D), relative to the case file"},
+    {"start", LAHAR_KEY_NUMBER, 0, "0", 0, 0, 0, NULL, "s", "the inflow acts from start"},
+    {"end", LAHAR_KEY_NUMBER, 0, "forever", 0, 0, 0, NULL, "s", "... until end (u = 0 outside [start, end))"},
+    {"layers", LAHAR_KEY_WHOLE, 0, "support/dx", LO | HI, 1, 64, NULL, "", "buffer rows behind the section"},
+    {"max_particles", LAHAR_KEY_WHOLE, 0, "estimate", LO, 1, 0, NULL, "", "most particles the inlet may create (default: from the hydrograph + 10 %)"},
+    END};
+
+static const lahar_key outlet_keys[] = {
+    {"name", LAHAR_KEY_TEXT, 0, "outlet<i>", 0, 0, 0, NULL, "", "name (messages)"},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)"},
+    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]"},
+    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge"},
+    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "outward normal, perpendicular to the edges (normalised)"},
+    {"depth", LAHAR_KEY_NUMBER, 0, "unlimited", LOX, 0, 0, NULL, "m", "how far beyond the section particles are removed"},
+    END};
+
+static const lahar_key domain_keys[] = {
+    {"lo", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "lower corner of the box"},
+    {"hi", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "upper corner (> lo on every axis)"},
     END};
 
 static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
@@ -192,6 +226,9 @@ static const lahar_key_section sections[] = {
     {"checkpoint", "coordinated checkpoints (optional; lahar resume)", checkpoint_keys},
     {"output", "what is written (optional)", output_keys},
     {"check", "the reference of lahar check (optional)", check_keys},
+    {"inlets[]", "an inlet: water enters through the section with a hydrograph (optional; cases/README.md \"Open boundaries\")", inlet_keys},
+    {"outlets[]", "an outlet: particles beyond the section are removed and counted (optional)", outlet_keys},
+    {"domain", "particles outside the box are removed and counted (optional)", domain_keys},
 };
 
 const lahar_key_section *lahar_key_sections(int *count)

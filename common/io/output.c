@@ -185,6 +185,10 @@ static int out_attr(hid_t loc, const char *name, hid_t type, int n, const void *
     H5Sclose(sp);
     return rc < 0 ? -1 : 0;
 }
+const char *const lahar_flow_names[LAHAR_FLOW_NVAL] = {
+    "flow_entered", "flow_entered_mass", "flow_removed_water", "flow_removed_water_mass",
+    "flow_removed_soil", "flow_removed_soil_mass", "flow_created", "flow_domain_mass"};
+
 static int out_attr_double(hid_t loc, const char *name, double v) { return out_attr(loc, name, H5T_NATIVE_DOUBLE, 0, &v); }
 static int out_attr_int64(hid_t loc, const char *name, int64_t v) { return out_attr(loc, name, H5T_NATIVE_INT64, 0, &v); }
 static int out_attr_string(hid_t loc, const char *name, const char *s)
@@ -1024,6 +1028,10 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
         }
         if (!rc && (o->fields & LAHAR_PFIELD_STRESS))
             rc |= out_particle_stress(g, p);
+        if (!rc && p->inlet)
+            rc |= out_dataset(g, "inlet", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, n, 0, p->inlet);
+        for (int k = 0; p->flow && k < LAHAR_FLOW_NVAL && !rc; k++)
+            rc |= out_attr_double(g, lahar_flow_names[k], p->flow[k]);
         H5Gclose(g);
     }
     if (out_close(f) < 0)

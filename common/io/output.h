@@ -55,7 +55,19 @@ typedef struct {
     const int32_t *phase;
     const int64_t *id;
     const double *stress[6]; /* SoA xx, xy, xz, yy, yz, zz; NULL without soil (then not written) */
+    /* open boundaries only (NULL without inlets, outlets or domain; sph_node/sph_inflow.h):
+     * inlet: per particle, the inlet whose buffer holds it, -1 in the domain (dataset `inlet`);
+     * flow: LAHAR_FLOW_NVAL cumulative counters since the start of the run, written as the
+     * snapshot's attributes named in lahar_flow_names */
+    const int32_t *inlet;
+    const double *flow;
 } lahar_particles_view;
+
+#define LAHAR_FLOW_NVAL 8
+/* entered (particles that crossed an inlet into the domain) and their mass, removed water and
+ * soil particles (outlets, domain box) and their masses, particles created in buffers, the mass
+ * of the domain's particles at the snapshot (buffers excluded); kg/m in 2D */
+extern const char *const lahar_flow_names[LAHAR_FLOW_NVAL];
 
 typedef struct lahar_particle_output lahar_particle_output;
 

@@ -94,7 +94,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->blocks = calloc((size_t)(c->nblock > 0 ? c->nblock : 1), sizeof *m->blocks);
     m->nprobe = c->nprobe;
     m->probes = calloc((size_t)(c->nprobe > 0 ? c->nprobe : 1), sizeof *m->probes);
-    if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks || !m->probes)
+    if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks || !m->probes ||
+        lahar_scene_msg_inflow_from_case(c, m) != 0)
         goto fail;
     for (int i = 0; i < c->nprobe; i++) {
         const lahar_probe *a = &c->probes[i];
@@ -203,6 +204,7 @@ void lahar_scene_msg_release(lahar_scene_t *m)
     free(m->body_record_contacts);
     free(m->blocks);
     free(m->probes);
+    lahar_scene_msg_inflow_release(m);
     memset(m, 0, sizeof *m);
 }
 
@@ -406,6 +408,10 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         b->body = a->body;
         b->size = a->size;
         b->rate = a->rate;
+    }
+    if (lahar_scene_msg_inflow_to_case(m, c, err, errlen) != 0) {
+        lahar_case_free(c);
+        return -1;
     }
     return 0;
 oom:

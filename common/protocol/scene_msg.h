@@ -19,6 +19,13 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
 
 #endif
 
+/* The open boundaries (common/scene_msg_inflow.c; used by the two functions above): fill / release
+ * m's inlets, outlets and domain, and read them into c (-1 with a message; c is freed by the
+ * caller). */
+int lahar_scene_msg_inflow_from_case(const lahar_case *c, lahar_scene_t *m);
+void lahar_scene_msg_inflow_release(lahar_scene_t *m);
+int lahar_scene_msg_inflow_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen);
+
 /* ---- how a node joins a run (shared by lahar-dem and lahar-sph) ---------------------------- */
 #include "link.h"
 

@@ -5,6 +5,7 @@
 #ifndef LAHAR_SCENE_H
 #define LAHAR_SCENE_H
 #include <stdint.h>
+#include "inflow.h"
 
 #define LAHAR_NAME_MAX 64
 #define LAHAR_EXPR_MAX 256 /* an initial-field expression of a particle block (case key velocity:, pressure:) */
@@ -228,6 +229,15 @@ typedef struct {
 
     int nprobe;            /* pressure probes (probes: section; 0 = none, no gauges.h5) */
     lahar_probe *probes;
+
+    /* open boundaries of the SPH fluid (sections inlets:, outlets:, domain:; common/scene/inflow.h,
+     * sph_node/inflow/sph_inflow.h); none by default: a case without them runs exactly as before */
+    int ninlet;
+    lahar_inlet *inlets;
+    int noutlet;
+    lahar_outlet *outlets;
+    int has_domain;        /* 1: particles outside [domain_lo, domain_hi] are removed */
+    double domain_lo[3], domain_hi[3];
 
     lahar_check check;
     lahar_stability stability; /* instability checks (stability: section) */

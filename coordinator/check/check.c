@@ -758,6 +758,8 @@ static const lahar_check_reference check_references[] = {
      "momentum balance, nothing through the wall", "escaped_particles", 0.0, lahar_check_granular_impact},
     {"darcy", "water driven through a soil: seepage velocity vs Darcy's k_h i", "darcy_velocity_rel_error", 0.05,
      lahar_check_darcy},
+    {"inflow", "open boundaries: discharge through the inlets vs the hydrographs, mass balance, outflow vs inflow, "
+     "steady depth vs the inlet level", "discharge_rel_error", 0.02, lahar_check_inflow},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

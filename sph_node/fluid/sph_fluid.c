@@ -176,6 +176,13 @@ double sph_fluid_pressure(const sph_params *prm, double rho)
     return prm->c0 * prm->c0 * (rho - prm->rho0); /* Trujillo-Vela et al. 2020, eq. 3 */
 }
 
+double sph_fluid_density_of_pressure(const sph_params *prm, double p)
+{
+    if (prm->eos == LAHAR_SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 inverted */
+        return prm->rho0 * pow(1.0 + prm->gamma * p / (prm->rho0 * prm->c0 * prm->c0), 1.0 / prm->gamma);
+    return prm->rho0 + p / (prm->c0 * prm->c0); /* Trujillo-Vela et al. 2020, eq. 3 inverted */
+}
+
 static inline int prm_tvf(const sph_fluid *f) { return f->prm.transport_velocity != 0; }
 
 /* The pairs (i, j) of water particle i with the water particles j after it in the forward half

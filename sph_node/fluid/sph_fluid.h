@@ -167,6 +167,8 @@ void sph_fluid_free(sph_fluid *f);
 
 /* Pressure from density by the EOS of the parameters. */
 double sph_fluid_pressure(const sph_params *prm, double rho);
+/* The density whose EOS pressure is p (the inverse of sph_fluid_pressure). */
+double sph_fluid_density_of_pressure(const sph_params *prm, double p);
 
 /* SPS turbulence (Canelas et al. 2015, eq. 10-11, Dalrymple & Rogers 2006), when prm.sps is on. Before the
  * particle-particle sums, one gather pass takes the velocity gradient

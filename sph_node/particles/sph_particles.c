@@ -71,8 +71,49 @@ int sph_particles_alloc_transport(sph_particles *p)
     return 0;
 }
 
+int sph_particles_alloc_inlet(sph_particles *p)
+{
+    if (p->inlet)
+        return 0;
+    if (!(p->inlet = malloc((size_t)p->cap * sizeof *p->inlet)))
+        return -1;
+    for (int64_t i = 0; i < p->cap; i++)
+        p->inlet[i] = -1;
+    return 0;
+}
+
+int64_t sph_particles_remove(sph_particles *p, const unsigned char *drop)
+{
+    const int64_t n = p->n;
+    double **a[SPH_NDOUBLE + 2 * SPH_NSTRESS + 3];
+    particle_doubles(p, a);
+    int na = SPH_NDOUBLE;
+    if (p->sig[0])
+        for (int k = 0; k < SPH_NSTRESS; k++)
+            a[na++] = &p->sig[k], a[na++] = &p->sigh[k];
+    if (p->tvx)
+        a[na++] = &p->tvx, a[na++] = &p->tvy, a[na++] = &p->tvz;
+    int64_t j = 0;
+    for (int64_t i = 0; i < n; i++) {
+        if (drop[i])
+            continue;
+        if (j != i) {
+            for (int k = 0; k < na; k++)
+                (*a[k])[j] = (*a[k])[i];
+            p->id[j] = p->id[i];
+            p->phase[j] = p->phase[i];
+            if (p->inlet)
+                p->inlet[j] = p->inlet[i];
+        }
+        j++;
+    }
+    p->n = j;
+    return n - j;
+}
+
 void sph_particles_free(sph_particles *p)
 {
+    free(p->inlet);
     free(p->tvx), free(p->tvy), free(p->tvz);
     for (int k = 0; k < SPH_NSTRESS; k++)
         free(p->sig[k]), free(p->sigh[k]);
@@ -322,6 +363,14 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     int32_t *tp = p->phase;
     p->phase = p->scratch_p;
     p->scratch_p = tp;
+    if (p->inlet) { /* open boundaries only: the scratch now holds the old phases, free to reuse */
+#pragma omp parallel for schedule(static) if (par)
+        for (int64_t i = 0; i < n; i++)
+            p->scratch_p[i] = p->inlet[perm[i]];
+        tp = p->inlet;
+        p->inlet = p->scratch_p;
+        p->scratch_p = tp;
+    }
     /* cell_of in the new order */
 #pragma omp parallel for schedule(static) if (par)
     for (int64_t k = 0; k < ncell; k++)

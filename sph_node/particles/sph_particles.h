@@ -45,6 +45,9 @@ typedef struct {
      * minus the momentum velocity, v~ - v, of the last drift (Adami et al. 2013; sph_fluid.h),
      * permuted by the sort */
     double *tvx, *tvy, *tvz;
+    /* open boundaries only (NULL until sph_particles_alloc_inlet; sph_inflow.h): the index of the
+     * inlet whose buffer holds the particle, -1 for a particle of the domain; permuted by the sort */
+    int32_t *inlet;
     /* sort scratch */
     double *scratch_d;
     int64_t *scratch_i;
@@ -60,6 +63,12 @@ int sph_particles_alloc_stress(sph_particles *p);
 /* Allocate the transport-velocity arrays (tvx, tvy, tvz) for cap particles, zeroed; no-op when
  * present. Returns 0 or -1 (out of memory; none allocated). */
 int sph_particles_alloc_transport(sph_particles *p);
+/* Allocate the inlet marks (inlet) for cap particles, set to -1; no-op when present. Returns 0
+ * or -1 (out of memory). */
+int sph_particles_alloc_inlet(sph_particles *p);
+/* Remove the particles i with drop[i] != 0 (drop has n entries), keeping the order of the others
+ * (every per-particle array moves, rates included). Returns the number removed. */
+int64_t sph_particles_remove(sph_particles *p, const unsigned char *drop);
 /* Append one particle at rest density rho with mass m; returns its index, or -1 when full. */
 int64_t sph_particles_add(sph_particles *p, const double x[3], const double v[3], double m, double rho,
                           int32_t phase);
