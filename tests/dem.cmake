@@ -30,7 +30,13 @@ set_tests_properties(test_dem_noalloc PROPERTIES LABELS "fast;dem" TIMEOUT 300)
 
 # Benchmarks (tests/bench/, not ctest tests: they print a table and never fail on time).
 # `cmake --build <dir> --target bench` builds and runs bench_dem with its default sizes.
-add_executable(bench_dem EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem.c)
+add_executable(bench_dem EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem.c ${LAHAR_TEST_DIR}/bench/bench_lammps.c)
 target_link_libraries(bench_dem PRIVATE lahar_dem_pile)
+# bench_dem --lammps-data also runs LAMMPS through its C library when liblammps-dev is installed
+pkg_check_modules(LAMMPS IMPORTED_TARGET liblammps)
+if(LAMMPS_FOUND)
+  target_link_libraries(bench_dem PRIVATE PkgConfig::LAMMPS)
+  target_compile_definitions(bench_dem PRIVATE LAHAR_HAVE_LAMMPS)
+endif()
 add_custom_target(bench COMMAND bench_dem DEPENDS bench_dem WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} USES_TERMINAL
   COMMENT "bench_dem: DEM step cost for 500/2000/8000 bodies on 1 and 2 threads")

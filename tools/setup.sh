@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 packages=(cmake make gcc pkg-config libglib2.0-dev liblcm-dev liblcm-bin libhdf5-dev hdf5-tools
           libyaml-dev libcjson-dev libsodium-dev libmatheval-dev nftables iproute2 python3 python3-h5py python3-matplotlib
-          python3-numpy)
+          python3-numpy liblammps-dev lammps)
 # libFuzzer: clang, its runtime libclang_rt.fuzzer (libclang-rt-14-dev) and clang's OpenMP (libomp-dev)
 if [ "${LAHAR_FUZZ:-0}" = 1 ]; then
   packages+=(clang libclang-rt-14-dev libomp-dev)

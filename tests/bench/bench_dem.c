@@ -6,6 +6,10 @@
  *
  *   bench_dem [--hertz] [--layers n] [--warm s] [--meas s] [--threads 1,2] [n ...]  (default 500 2000 8000)
  *   bench_dem --case cases/dem_drop_3d.yaml [--warm s] [--meas s]           (a case file as is)
+ *   bench_dem --lammps-data FILE [--warm-steps n] [--steps n] [--threads t] [--no-lammps]
+ *             [--check-ke factor] [--check-contacts rel]
+ *     a settled LAMMPS pile (atom_style sphere data file), timed against LAMMPS on the same file in
+ *     the same run when built with liblammps (bench_lammps.h); the checks make it a test
  *   --restart FILE (one scene only): read the warmed-up state from FILE when it exists, else
  *   write it there after the warm-up (profiling runs then skip the warm-up).
  *
@@ -15,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "bench_lammps.h"
 #include "dem_engine.h"
 #include "dem_pile.h"
 #include "dem_test_util.h"
@@ -123,8 +128,15 @@ int main(int argc, char **argv)
     int hertz = 0, nthr = 0, thr[8], nn = 0, ns[32], layers = 4;
     double warm = 0.3, meas = 0.05;
     const char *casefile = NULL, *restart = NULL;
+    bench_lammps_opts lo = {.warm = 1000, .steps = 1000, .threads = 1, .lammps = 1};
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--hertz")) hertz = 1;
+        else if (!strcmp(argv[i], "--lammps-data") && i + 1 < argc) lo.file = argv[++i];
+        else if (!strcmp(argv[i], "--warm-steps") && i + 1 < argc) lo.warm = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--steps") && i + 1 < argc) lo.steps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--no-lammps")) lo.lammps = 0;
+        else if (!strcmp(argv[i], "--check-ke") && i + 1 < argc) lo.ke_tol = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--check-contacts") && i + 1 < argc) lo.contact_tol = atof(argv[++i]);
         else if (!strcmp(argv[i], "--warm") && i + 1 < argc) warm = atof(argv[++i]);
         else if (!strcmp(argv[i], "--layers") && i + 1 < argc) layers = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--meas") && i + 1 < argc) meas = atof(argv[++i]);
@@ -134,9 +146,17 @@ int main(int argc, char **argv)
             for (char *s = strtok(argv[++i], ","); s && nthr < 8; s = strtok(NULL, ",")) thr[nthr++] = atoi(s);
         } else if (nn < 32 && atoi(argv[i]) > 0) ns[nn++] = atoi(argv[i]);
         else {
-            fprintf(stderr, "usage: bench_dem [--hertz] [--layers n] [--warm s] [--meas s] [--threads 1,2] [--restart file] [n ...] | --case file\n");
+            fprintf(stderr, "usage: bench_dem [--hertz] [--layers n] [--warm s] [--meas s] [--threads 1,2] [--restart file] [n ...] | --case file | --lammps-data file [--warm-steps n] [--steps n] [--no-lammps] [--check-ke f] [--check-contacts r]\n");
             return 2;
         }
+    }
+    if (lo.file) {
+        lo.threads = nthr > 0 ? thr[0] : 1;
+        if (lo.steps < 1 || lo.warm < 0) {
+            fprintf(stderr, "bench_dem: --steps must be >= 1 and --warm-steps >= 0\n");
+            return 2;
+        }
+        return bench_lammps_run(&lo);
     }
     if (nthr == 0) {
         thr[nthr++] = 1;
