@@ -4,6 +4,7 @@
  * leap-frog for translation and an exactly rotating splitting (NO_SQUISH / Dullweber-Leimkuhler-
  * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
 #include "spheropoly.h"
+#include "spheropoly_impl.h"
 #include <float.h>
 #include <limits.h>
 #include <math.h>
@@ -14,115 +15,6 @@
 #include "dem_contact.h"
 #include "geometry.h"
 
-/* Contact types: which features of body a (lower index) and b meet. */
-enum { SP_VF = 0, SP_FV, SP_EE, SP_VE, SP_EV, SP_VV };
-
-/* Bodies with more features than this get a feature grid. */
-enum { SP_GRID_MIN_FEATURES = 64 };
-
-/* Per-body loops (kick, drift) run on the thread team from this many bodies on: below it the
- * fork/join of a team costs more than the loop (README, "Performance"). */
-enum { SP_PAR_MIN_BODIES = 1024 };
-
-typedef struct {
-    int a, b, type, fa, fb;
-    vec3 xi;     /* tangential spring (world), kept across steps while the contact lasts */
-    vec3 f;      /* force on b (a gets -f), world */
-    vec3 cp;     /* contact point, world */
-    vec3 n;      /* unit normal from a to b */
-    double delta;
-    double rstar; /* effective curvature radius (Hertz) */
-} sp_contact;
-
-typedef struct {
-    int nv, ne, nf;
-    int v0;      /* first vertex in vb/vw/vadj_start pools (vadj_start has nv+1 per body at va0) */
-    int va0;
-    int e0;      /* first edge in the edge pools */
-    int f0;      /* first face in fstart (nf+1 entries at fs0) and face normal pools */
-    int fs0;
-    double radius, bound; /* sweep radius; bounding radius about the centre of mass */
-    int grid;    /* index into e->grids or -1 */
-    int material;
-    lahar_motion motion;
-    double mass, inertia[3];
-    int isotropic; /* equal principal moments (spheres, cubes): free rotation is a plain rotation */
-    vec3 aabb_lo, aabb_hi; /* world box of non-free bodies (vertices +- radius) */
-} sp_geo;
-
-typedef struct {
-    vec3 x, v, L, w; /* position, velocity, angular momentum and velocity (world) */
-    quat q;
-    vec3 fc, tc;     /* contact force / torque of the last evaluation */
-} sp_state;
-
-/* A free body in the broad-phase grid (64 bytes: one cache line). */
-typedef struct {
-    long long c[3]; /* cell */
-    vec3 x;
-    double bound;
-    int id, level;
-} sp_bin;
-
-typedef struct {
-    sp_contact *c;
-    int n, cap;
-    geom_feature_query fq;
-    int *keep[2][3]; /* per side of a pair: features near the other body (vertex, edge, face) */
-    vec3 *emid;      /* edge-edge prefilter: midpoints and half-lengths of the kept edges of b */
-    double *ehalf;
-    int oom;
-} sp_thread;
-
-struct lahar_dem_engine {
-    int dim, nbody, nmat;
-    vec3 g;
-    double dt_stable;
-    long step;                /* substeps taken since creation */
-    sp_geo *geo;
-    sp_state *st;
-    char (*names)[LAHAR_NAME_MAX];
-    dem_pair_law *laws;       /* nmat x nmat */
-    /* geometry pools */
-    vec3 *vb, *vw;            /* body-frame and world vertices */
-    int *vadj_start, *vadj;   /* vertex neighbours (local vertex ids) */
-    int (*edge)[2];           /* local vertex ids */
-    int (*edge_face)[2];      /* local face ids adjacent to each edge, -1 if none */
-    int *fstart;              /* per body nf+1 offsets into fv/fw (global) */
-    int *fv;                  /* local vertex ids */
-    vec3 *fw;                 /* world copy of the face polygons */
-    vec3 *nb, *nw;            /* face normals body / world */
-    geom_feature_grid *grids;
-    int ngrid;
-    /* broad phase */
-    int nfree, *free_ids, nlarge, *large_ids;
-    int nlevel;               /* grid levels: cell of level l = D 2^(l - nlevel + 1), D the largest diameter */
-    double cell_inv[21];
-    int level_count[21];
-    int *level;               /* per free body (index into free_ids) */
-    long long (*cellc)[3];
-    int *bucket_of, *bucket_start, nbucket, bucket_cap, nhash, dense;
-    long long dlo[3], dn[3];  /* dense grid: first cell and cells per axis */
-    sp_bin *bins;             /* free bodies sorted by bucket */
-    int (*pairs)[2];
-    int npair, pair_cap;
-    /* contacts: previous evaluation (history) and hash over it */
-    sp_contact *prev, *cur;
-    int nprev, contact_cap;
-    int *hash, *vhash, hash_cap; /* by full key; by (pair, touching vertex); allocated size */
-    int hash_n;               /* table size in use: a power of 2 >= 2 nprev (cost of a rebuild ~ contacts) */
-    sp_thread *thr;
-    int nthr;
-    /* report accumulators over the substeps of one advance */
-    vec3 *rep_f, *rep_t;
-    int rep_n;
-    int *ncontact_body;
-    long long contacts_evaluated; /* work counter: contacts summed over every force evaluation */
-    /* instability report of the last failed advance (lahar_dem_fault) */
-    double max_overlap;       /* overlap limit, fraction of the smaller sweep radius (stability.max_overlap) */
-    lahar_dem_fault fault;
-    int has_fault;
-};
 
 /* ---------------------------------------------------------------------------------------------- */
 
@@ -614,7 +506,10 @@ static inline int bucket_of_level_cell(const lahar_dem_engine *e, int lev, long 
 static int broad_phase(lahar_dem_engine *e)
 {
     e->npair = 0;
-    if (e->nfree > 0) {
+    const sp_spheres *sph = e->sph;
+    /* free spheres meet each other on the fast path (spheropoly_spheres.c): with no other free
+     * body there is nothing to bin */
+    if (e->nfree > 0 && !(sph && e->nfree == sps_nspheres(e))) {
         long long lo[3] = {LLONG_MAX, LLONG_MAX, LLONG_MAX}, hi[3] = {LLONG_MIN, LLONG_MIN, LLONG_MIN};
         for (int k = 0; k < e->nfree; k++) {
             const sp_state *s = &e->st[e->free_ids[k]];
@@ -691,6 +586,7 @@ static int broad_phase(lahar_dem_engine *e)
                                 if ((own && bj->id <= bi.id) || bj->level != lev || bj->c[0] != cx || bj->c[1] != cy ||
                                     bj->c[2] != cz)
                                     continue;
+                                if (sph && sps_is_sphere(e, bi.id) && sps_is_sphere(e, bj->id)) continue;
                                 double r = bi.bound + bj->bound;
                                 if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
                             }
@@ -702,14 +598,20 @@ static int broad_phase(lahar_dem_engine *e)
         int i = e->free_ids[k];
         vec3 c = e->st[i].x;
         double r = e->geo[i].bound;
-        for (int l = 0; l < e->nlarge; l++) {
-            const sp_geo *gl = &e->geo[e->large_ids[l]];
+        /* a sphere meets the fast path's walls there; only the other fixed bodies here */
+        const int *lids = e->large_ids;
+        int nl = e->nlarge;
+        if (sph && sps_is_sphere(e, i)) nl = sps_general_large(e, &lids);
+        for (int l = 0; l < nl; l++) {
+            const sp_geo *gl = &e->geo[lids[l]];
             if (c.x + r < gl->aabb_lo.x || c.x - r > gl->aabb_hi.x || c.y + r < gl->aabb_lo.y ||
                 c.y - r > gl->aabb_hi.y || c.z + r < gl->aabb_lo.z || c.z - r > gl->aabb_hi.z)
                 continue;
-            if (add_pair(e, i, e->large_ids[l])) return -1;
+            if (add_pair(e, i, lids[l])) return -1;
         }
     }
+    /* spheres beyond the rim of a fast-path wall: edges and corners of the face */
+    if (sph && sps_fallback_pairs(e, add_pair)) return -1;
     return 0;
 }
 
@@ -720,6 +622,7 @@ static int broad_phase(lahar_dem_engine *e)
  * (advances the tangential springs). Returns 0, or -1 with err set. */
 static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
+    if (e->sph && sps_forces(e, h, err, errlen)) return -1;
     if (broad_phase(e)) {
         snprintf(err, errlen, "spheropoly: out of memory in the broad phase");
         return -1;
@@ -796,6 +699,7 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
             return -1;
         }
     }
+    if (e->sph) sps_accumulate(e);
     if (e->dim == 2)
         for (int i = 0; i < e->nbody; i++) {
             e->st[i].fc.z = 0.0;
@@ -951,6 +855,7 @@ static int sp_fault(const lahar_dem_engine *e, lahar_dem_fault *out)
 static void sp_destroy(lahar_dem_engine *e)
 {
     if (!e) return;
+    sps_destroy(e);
     for (int i = 0; i < e->ngrid; i++) geom_feature_grid_free(&e->grids[i]);
     if (e->thr)
         for (int t = 0; t < e->nthr; t++) {
@@ -1338,6 +1243,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         e->thr[t].cap = ccap;
     }
     e->dt_stable = stable_dt_of(e, c);
+    if (sps_create(e, err, errlen)) goto fail;
     if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;
     return e;
 fail:
@@ -1350,7 +1256,7 @@ fail:
 
 static double sp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
 static int sp_nbody(const lahar_dem_engine *e) { return e->nbody; }
-static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev; }
+static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev + sps_ncontacts(e); }
 static long long sp_contacts_evaluated(const lahar_dem_engine *e) { return e->contacts_evaluated; }
 
 static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
@@ -1385,7 +1291,8 @@ static double sp_kinetic_energy(const lahar_dem_engine *e)
     return k;
 }
 
-static const char sp_magic[8] = {'L', 'H', 'R', 'S', 'P', 'R', 'S', '1'};
+/* version 2: followed by the springs of the sphere fast path */
+static const char sp_magic[8] = {'L', 'H', 'R', 'S', 'P', 'R', 'S', '2'};
 
 static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
 {
@@ -1396,6 +1303,7 @@ static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
     ok = ok && fwrite(&e->nprev, sizeof(int), 1, f) == 1;
     ok = ok && fwrite(e->prev, sizeof(sp_contact), (size_t)e->nprev, f) == (size_t)e->nprev;
     ok = ok && fwrite(e->ncontact_body, sizeof(int), (size_t)e->nbody, f) == (size_t)e->nbody;
+    ok = ok && sps_write_restart(e, f) == 0;
     return ok ? 0 : -1;
 }
 
@@ -1415,6 +1323,7 @@ static int sp_read_restart(lahar_dem_engine *e, FILE *f)
     e->contact_cap = cap < cap2 ? cap : cap2;
     if (fread(e->prev, sizeof(sp_contact), (size_t)n, f) != (size_t)n) return -1;
     if (fread(e->ncontact_body, sizeof(int), (size_t)nbody, f) != (size_t)nbody) return -1;
+    if (sps_read_restart(e, f)) return -1;
     e->nprev = n;
     e->step = step;
     e->rep_n = 0;
