@@ -3,6 +3,7 @@
  * calibrated from the coefficient of restitution. Formulas and conventions: dem_node/README.md. */
 #ifndef LAHAR_DEM_CONTACT_H
 #define LAHAR_DEM_CONTACT_H
+#include <math.h>
 #include <stddef.h>
 #include "scene.h"
 #include "vec.h"
@@ -14,6 +15,7 @@ typedef struct {
     double kt_ratio; /* tangential / normal (secant) stiffness */
     double e;        /* restitution, min of the two */
     double mu;       /* Coulomb friction, min of the two */
+    double sqrt_kt_ratio; /* sqrt(kt_ratio): tangential damping / normal damping */
     double damp;     /* linear: damping ratio zeta; Hertz: alpha (Tsuji form), both calibrated for
                         the clipped force so that a binary impact rebounds with exactly e */
 } dem_pair_law;
@@ -29,11 +31,34 @@ double dem_restitution_clipped(lahar_contact_model model, double damp);
 /* Damping parameter (zeta for linear, alpha for Hertz) whose clipped impact rebounds with e. */
 double dem_damping_for_restitution(lahar_contact_model model, double e);
 
+/* The two force laws are inline: they are the inner loop of both narrow phases (general and the
+ * sphere fast path). */
+
 /* Normal force magnitude (>= 0, clipped) for overlap delta > 0 and overlap rate delta_dot
  * (> 0 approaching), the dashpot multiplied by damp_scale (1 for a single contact point); also the
  * current normal stiffness (secant for Hertz) and damping coefficient used for the tangential ones. */
-double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
-                        double rstar, double damp_scale, double *k_secant, double *c_normal);
+static inline double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
+                                      double rstar, double damp_scale, double *k_secant, double *c_normal)
+{
+    double f, k, c;
+    if (law->model == LAHAR_CONTACT_HERTZ) {
+        /* Canelas et al. 2015 eq. 14-15 with exponent 3/2 (the printed 3/4 is a typo, shared/papers/README):
+         * F = k_H delta^(3/2) + alpha sqrt(m* k_H) delta^(1/4) delta_dot, k_H = 4/3 E* sqrt(R*) */
+        double kh = 4.0 / 3.0 * law->estar * sqrt(rstar);
+        double sd = sqrt(delta);
+        k = kh * sd;
+        c = damp_scale * law->damp * sqrt(mstar * kh) * sqrt(sd);
+        f = k * delta + c * delta_dot;
+    } else {
+        /* linear spring-dashpot, c = 2 zeta sqrt(kn m*) (reference 06 sec. 6.2) */
+        k = law->kn;
+        c = damp_scale * 2.0 * law->damp * sqrt(law->kn * mstar);
+        f = k * delta + c * delta_dot;
+    }
+    *k_secant = k;
+    *c_normal = c;
+    return f > 0.0 ? f : 0.0;
+}
 
 /* Elastic contact period of the pair: linear 2 pi sqrt(m* / kn), twice the contact duration; Hertz: the elastic
  * Hertz duration 2.868266 (m*^2/(R* E*^2 v))^(1/5) (reference 06 sec. 6.1) at impact speed v. */
@@ -43,7 +68,21 @@ double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, d
  * advanced by the tangential displacement of this step), the tangential relative velocity vt, the
  * normal force fn and the normal stiffness/damping. When the trial force exceeds mu fn the spring is
  * truncated so that it alone carries the Coulomb force (sliding). */
-vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn, double k_secant,
-                          double c_normal);
+static inline vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn, double k_secant,
+                                        double c_normal)
+{
+    /* k_t = kt_ratio k_n (secant k_n for Hertz), c_t = sqrt(kt_ratio) c_n: the same damping ratio
+     * as the normal direction (Canelas et al. 2015 uses 2/7 for both, which changes the ratio). */
+    double kt = law->kt_ratio * k_secant;
+    double ct = law->sqrt_kt_ratio * c_normal;
+    vec3 f = v3_add(v3_scale(*xi, -kt), v3_scale(vt, -ct));
+    double fmax = law->mu * fn;
+    double fm = v3_norm(f);
+    if (fm > fmax) {
+        f = fm > 0.0 ? v3_scale(f, fmax / fm) : v3(0.0, 0.0, 0.0);
+        *xi = kt > 0.0 ? v3_scale(f, -1.0 / kt) : v3(0.0, 0.0, 0.0);
+    }
+    return f;
+}
 
 #endif

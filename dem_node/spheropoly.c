@@ -586,7 +586,7 @@ static int broad_phase(lahar_dem_engine *e)
                                 if ((own && bj->id <= bi.id) || bj->level != lev || bj->c[0] != cx || bj->c[1] != cy ||
                                     bj->c[2] != cz)
                                     continue;
-                                if (sph && sps_is_sphere(e, bi.id) && sps_is_sphere(e, bj->id)) continue;
+                                if (e->geo[bi.id].fast_sphere && e->geo[bj->id].fast_sphere) continue;
                                 double r = bi.bound + bj->bound;
                                 if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
                             }
@@ -601,7 +601,7 @@ static int broad_phase(lahar_dem_engine *e)
         /* a sphere meets the fast path's walls there; only the other fixed bodies here */
         const int *lids = e->large_ids;
         int nl = e->nlarge;
-        if (sph && sps_is_sphere(e, i)) nl = sps_general_large(e, &lids);
+        if (e->geo[i].fast_sphere) nl = sps_general_large(e, &lids);
         for (int l = 0; l < nl; l++) {
             const sp_geo *gl = &e->geo[lids[l]];
             if (c.x + r < gl->aabb_lo.x || c.x - r > gl->aabb_hi.x || c.y + r < gl->aabb_lo.y ||
@@ -778,7 +778,8 @@ static void drift(lahar_dem_engine *e, double h)
             s->q = q_normalize(s->q);
         }
         if (g->motion == LAHAR_MOTION_FREE) body_update_omega(e, i);
-        body_update_world(e, i);
+        if (g->fast_sphere) e->vw[g->v0] = s->x; /* = x + q 0, exactly */
+        else body_update_world(e, i);
     }
 }
 

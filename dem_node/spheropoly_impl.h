@@ -42,6 +42,7 @@ typedef struct {
     lahar_motion motion;
     double mass, inertia[3];
     int isotropic; /* equal principal moments (spheres, cubes): free rotation is a plain rotation */
+    int fast_sphere; /* a free sphere of the fast path (spheropoly_spheres.c): world vertex = centre */
     vec3 aabb_lo, aabb_hi; /* world box of non-free bodies (vertices +- radius) */
 } sp_geo;
 

@@ -205,13 +205,14 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
         goto oom;
     double rmin = DBL_MAX;
     for (int i = 0; i < nb; i++) {
-        const sp_geo *g = &e->geo[i];
+        sp_geo *g = &e->geo[i];
         s->of_body[i] = -1;
         s->wall_of_body[i] = -1;
         vec3 v = e->vb[g->v0];
         if (g->motion == LAHAR_MOTION_FREE && g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 &&
             v.z == 0.0) {
             s->of_body[i] = s->n;
+            e->geo[i].fast_sphere = 1;
             s->body[s->n] = i;
             s->rad[s->n] = g->radius;
             s->mass[s->n] = g->mass;
@@ -423,25 +424,27 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     }
     double d = sqrt(d2);
     vec3 n = d > 1e-12 * rs ? v3_scale(dx, 1.0 / d) : v3(0.0, 0.0, 1.0);
-    vec3 cp = v3_scale(v3_add(v3_axpy(ra, n, sa->x), v3_axpy(-rb, n, sb->x)), 0.5);
+    double delta = rs - d;
+    /* contact point in the middle of the overlap: cp = xa + la n = xb - lb n */
+    double la = ra - 0.5 * delta, lb = rb - 0.5 * delta;
     vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
-    vec3 rpa = v3_sub(cp, sa->x), rpb = v3_sub(cp, sb->x);
-    vec3 vr = v3_sub(v3_add(sb->v, v3_cross(sb->w, rpb)), v3_add(sa->v, v3_cross(sa->w, rpa)));
+    /* v_b(cp) - v_a(cp) = vb - va - (lb wb + la wa) x n */
+    vec3 vr = v3_sub(v3_sub(sb->v, sa->v), v3_cross(v3_axpy(la, sa->w, v3_scale(sb->w, lb)), n));
     double vn = v3_dot(vr, n);
     vec3 vt = v3_axpy(-vn, n, vr);
-    const sp_geo *ga = &e->geo[s->body[a]], *gb = &e->geo[s->body[b]];
-    const dem_pair_law *law = &e->laws[ga->material * e->nmat + gb->material];
+    const dem_pair_law *law = &e->laws[e->geo[s->body[a]].material * e->nmat + e->geo[s->body[b]].material];
     double ma = s->mass[a], mb = s->mass[b];
-    double ks, cn, delta = rs - d;
+    double ks, cn;
     double fn = dem_normal_force(law, delta, -vn, ma * mb / (ma + mb), ra * rb / rs, 1.0, &ks, &cn);
     xi = v3_axpy(h, vt, xi);
     vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
-    vec3 f = v3_axpy(fn, n, ft);
+    /* torques about the centres: (cp - xa) x (-f) = -la n x ft, (cp - xb) x f = -lb n x ft */
+    vec3 c = v3_cross(n, ft);
     l->touch[p] = 1;
     l->xi[p] = xi;
-    l->f[p] = f;
-    l->ta[p] = v3_neg(v3_cross(rpa, f));
-    l->tb[p] = v3_cross(rpb, f);
+    l->f[p] = v3_axpy(fn, n, ft);
+    l->ta[p] = v3_scale(c, -la);
+    l->tb[p] = v3_scale(c, -lb);
     l->delta[p] = delta;
 }
 
@@ -526,7 +529,8 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
         hist_give(&s->wh, &s->wl);
     }
     sps_list *pl = &s->pl, *wl = &s->wl;
-#pragma omp parallel num_threads(e->nthr) if (pl->n >= SPS_PAR_MIN)
+    int cnt = 0, bad = 0;
+#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad) if (pl->n >= SPS_PAR_MIN)
     {
 #pragma omp for schedule(static)
         for (int p = 0; p < pl->n; p++) pair_force(e, s, p, h);
@@ -536,11 +540,11 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 #pragma omp for schedule(static)
         for (int k = 0; k < n; k++) {
             vec3 f = v3(0.0, 0.0, 0.0), t = v3(0.0, 0.0, 0.0);
-            int cnt = 0;
+            int m = 0;
             for (int q = s->inc_start[k]; q < s->inc_start[k + 1]; q++) {
                 int p = s->inc[q];
                 if (!pl->touch[p]) continue;
-                cnt++;
+                m++;
                 if (pl->a[p] == k) {
                     f = v3_sub(f, pl->f[p]);
                     t = v3_add(t, pl->ta[p]);
@@ -551,20 +555,30 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
             }
             for (int p = s->wstart[k]; p < s->wstart[k + 1]; p++) {
                 if (!wl->touch[p]) continue;
-                cnt++;
+                m++;
                 f = v3_add(f, wl->f[p]);
                 t = v3_add(t, wl->ta[p]);
             }
             s->sf[k] = f;
             s->st[k] = t;
-            s->scnt[k] = cnt;
+            s->scnt[k] = m;
         }
+#pragma omp for schedule(static)
+        for (int p = 0; p < pl->n; p++)
+            if (pl->touch[p]) {
+                cnt++;
+                bad |= pl->delta[p] > e->max_overlap * fmin(s->rad[pl->a[p]], s->rad[pl->b[p]]);
+            }
+#pragma omp for schedule(static)
+        for (int p = 0; p < wl->n; p++)
+            if (wl->touch[p]) {
+                cnt++;
+                bad |= wl->delta[p] > e->max_overlap * fmin(s->rad[wl->a[p]], e->geo[s->wall_body[wl->b[p]]].radius);
+            }
     }
-    /* contact count and the overlap limit, in list order (the first offender is reported) */
-    int cnt = 0;
-    for (int p = 0; p < pl->n; p++) {
+    /* the overlap limit: the first offender in list order is reported */
+    for (int p = 0; bad && p < pl->n; p++) {
         if (!pl->touch[p]) continue;
-        cnt++;
         int a = pl->a[p], b = pl->b[p];
         double rmin = fmin(s->rad[a], s->rad[b]);
         if (pl->delta[p] > e->max_overlap * rmin) {
@@ -572,9 +586,8 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
             return overlap_fault(e, s->body[a], s->body[b], pl->delta[p], rmin, v3_scale(v3_add(xa, xb), 0.5), err, errlen);
         }
     }
-    for (int p = 0; p < wl->n; p++) {
+    for (int p = 0; bad && p < wl->n; p++) {
         if (!wl->touch[p]) continue;
-        cnt++;
         int a = wl->a[p], wb = s->wall_body[wl->b[p]];
         double rmin = fmin(s->rad[a], e->geo[wb].radius);
         if (wl->delta[p] > e->max_overlap * rmin)

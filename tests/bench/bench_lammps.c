@@ -220,6 +220,16 @@ typedef struct {
     double ke0, ke1;    /* kinetic energy (translation + rotation) after the warm-up and at the end */
 } bl_result;
 
+/* The timed steps, a function of its own for
+ * valgrind --tool=callgrind --collect-atstart=no --toggle-collect='bench_lammps_measure*' */
+static __attribute__((noinline)) int bench_lammps_measure(const lahar_dem_engine_ops *ops, lahar_dem_engine *e, int steps,
+                                                          char *err, size_t errlen)
+{
+    for (int k = 0; k < steps; k++)
+        if (ops->advance(e, BL_DT, NULL, err, errlen) != 1) return -1;
+    return 0;
+}
+
 static int bl_run_lahar(const bl_data *d, const lahar_case *c, const bench_lammps_opts *o, bl_result *res)
 {
     const lahar_dem_engine_ops *ops;
@@ -239,12 +249,11 @@ static int bl_run_lahar(const bl_data *d, const lahar_case *c, const bench_lammp
         }
     res->ke0 = ops->kinetic_energy(e);
     double t0 = omp_get_wtime();
-    for (int k = 0; k < o->steps; k++)
-        if (ops->advance(e, BL_DT, NULL, err, sizeof err) != 1) {
-            fprintf(stderr, "bench_dem: lahar: %s\n", err);
-            ops->destroy(e);
-            return -1;
-        }
+    if (bench_lammps_measure(ops, e, o->steps, err, sizeof err)) {
+        fprintf(stderr, "bench_dem: lahar: %s\n", err);
+        ops->destroy(e);
+        return -1;
+    }
     double wall = omp_get_wtime() - t0;
     res->ke1 = ops->kinetic_energy(e);
     res->rate = (double)d->n * o->steps / wall;
