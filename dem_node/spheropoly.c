@@ -594,14 +594,20 @@ static int broad_phase(lahar_dem_engine *e)
             }
         }
     }
+    /* a sphere meets the fast path's walls there; only the other fixed bodies here */
+    const int *sph_large = NULL;
+    int nsph_large = sph ? sps_general_large(e, &sph_large) : 0;
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
-        vec3 c = e->st[i].x;
-        double r = e->geo[i].bound;
-        /* a sphere meets the fast path's walls there; only the other fixed bodies here */
         const int *lids = e->large_ids;
         int nl = e->nlarge;
-        if (e->geo[i].fast_sphere) nl = sps_general_large(e, &lids);
+        if (e->geo[i].fast_sphere) {
+            lids = sph_large;
+            nl = nsph_large;
+        }
+        if (nl == 0) continue;
+        vec3 c = e->st[i].x;
+        double r = e->geo[i].bound;
         for (int l = 0; l < nl; l++) {
             const sp_geo *gl = &e->geo[lids[l]];
             if (c.x + r < gl->aabb_lo.x || c.x - r > gl->aabb_hi.x || c.y + r < gl->aabb_lo.y ||
@@ -729,9 +735,13 @@ static void rotate_about_axis(quat *q, vec3 *pi, const double inertia[3], int k,
 static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 {
     /* each body only writes its own state: bitwise the same on any thread count */
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nfree >= SP_PAR_MIN_BODIES)
-    for (int k = 0; k < e->nfree; k++) {
-        int i = e->free_ids[k];
+    /* free spheres have their own loop (spheropoly_spheres.c), the others are listed in move_ids */
+    if (e->sph) sps_kick(e, half, loads);
+    const int *ids = e->sph ? e->move_ids : e->free_ids;
+    int nids = e->sph ? e->nmove_free : e->nfree;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
+    for (int k = 0; k < nids; k++) {
+        int i = ids[k];
         sp_state *s = &e->st[i];
         double m = e->geo[i].mass;
         vec3 f = v3_axpy(m, e->g, s->fc), t = s->tc;
@@ -751,8 +761,11 @@ static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 
 static void drift(lahar_dem_engine *e, double h)
 {
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nbody >= SP_PAR_MIN_BODIES)
-    for (int i = 0; i < e->nbody; i++) {
+    if (e->sph) sps_drift(e, h);
+    int nids = e->sph ? e->nmove : e->nbody;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
+    for (int k = 0; k < nids; k++) {
+        int i = e->sph ? e->move_ids[k] : k;
         sp_geo *g = &e->geo[i];
         sp_state *s = &e->st[i];
         if (g->motion == LAHAR_MOTION_FIXED) continue;
@@ -778,8 +791,7 @@ static void drift(lahar_dem_engine *e, double h)
             s->q = q_normalize(s->q);
         }
         if (g->motion == LAHAR_MOTION_FREE) body_update_omega(e, i);
-        if (g->fast_sphere) e->vw[g->v0] = s->x; /* = x + q 0, exactly */
-        else body_update_world(e, i);
+        body_update_world(e, i);
     }
 }
 
@@ -791,8 +803,9 @@ static int check_finite(lahar_dem_engine *e, char *err, size_t errlen)
         int i = e->free_ids[k];
         const sp_state *s = &e->st[i];
         double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
+        if (isfinite(sum) && fabs(s->x.x) <= 1e12 && fabs(s->x.y) <= 1e12 && fabs(s->x.z) <= 1e12) continue;
         double far = fmax(fabs(s->x.x), fmax(fabs(s->x.y), fabs(s->x.z)));
-        if (!isfinite(sum) || far > 1e12) {
+        {
             snprintf(err, errlen, "spheropoly: body %d '%s' has a %s state at substep %ld", i, e->names[i],
                      isfinite(sum) ? "runaway (|x| > 1e12 m)" : "non-finite", e->step);
             lahar_dem_fault *f = &e->fault;

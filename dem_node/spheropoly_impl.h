@@ -119,6 +119,8 @@ struct lahar_dem_engine {
     lahar_dem_fault fault;
     int has_fault;
     sp_spheres *sph;          /* sphere fast path, NULL without free spheres */
+    int *move_ids, nmove, nmove_free; /* with sph: the bodies kick/drift move besides the fast
+                                         spheres, the free ones first (nmove_free), then prescribed */
 };
 
 /* ---- sphere fast path (spheropoly_spheres.c) ------------------------------------------------ */
@@ -137,6 +139,9 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen);
 int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, int));
 /* Adds the fast-path forces, torques and contact counts to e->st[].fc/tc, e->ncontact_body. */
 void sps_accumulate(lahar_dem_engine *e);
+/* Leap-frog kick (velocity and angular momentum by `half` of the step) and drift of the free spheres. */
+void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads);
+void sps_drift(lahar_dem_engine *e, double h);
 int sps_ncontacts(const lahar_dem_engine *e);
 int sps_nspheres(const lahar_dem_engine *e);
 /* The fixed/prescribed bodies a sphere meets on the general path (not fast walls). */

@@ -51,6 +51,11 @@ struct sp_spheres {
     int nwall, *wall_body;
     int ngen, *gen_large; /* fixed/prescribed bodies that are not fast walls (general path) */
     double *rad, *mass;
+    int *mat;             /* material */
+    /* hot data of the force loops, a copy of e->st kept by sps_kick / sps_drift (SoA by field,
+     * contiguous by sphere); stale after create and read_restart until sps_forces copies it */
+    vec3 *x, *v, *w;
+    int stale;
     double skin, rmax;
     vec3 *x0;             /* centres at the last build */
     int built;
@@ -190,6 +195,11 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->gen_large = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
     s->rad = malloc(sizeof(double) * (size_t)ns);
     s->mass = malloc(sizeof(double) * (size_t)ns);
+    s->mat = malloc(sizeof(int) * (size_t)ns);
+    s->x = malloc(sizeof(vec3) * (size_t)ns);
+    s->v = malloc(sizeof(vec3) * (size_t)ns);
+    s->w = malloc(sizeof(vec3) * (size_t)ns);
+    s->stale = 1;
     s->x0 = malloc(sizeof(vec3) * (size_t)ns);
     s->inc_start = calloc((size_t)ns + 1, sizeof(int));
     s->wstart = calloc((size_t)ns + 1, sizeof(int));
@@ -200,7 +210,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
-    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 ||
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->x || !s->v || !s->w ||
         !s->inc_start || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
@@ -216,6 +226,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
             s->body[s->n] = i;
             s->rad[s->n] = g->radius;
             s->mass[s->n] = g->mass;
+            s->mat[s->n] = g->material;
             rmin = fmin(rmin, g->radius);
             s->rmax = fmax(s->rmax, g->radius);
             s->n++;
@@ -228,6 +239,13 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
         }
     }
     s->skin = SPS_SKIN_FRACTION * rmin;
+    e->move_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    if (!e->move_ids) goto oom;
+    for (int i = 0; i < nb; i++)
+        if (e->geo[i].motion == LAHAR_MOTION_FREE && !e->geo[i].fast_sphere) e->move_ids[e->nmove++] = i;
+    e->nmove_free = e->nmove;
+    for (int i = 0; i < nb; i++)
+        if (e->geo[i].motion == LAHAR_MOTION_PRESCRIBED) e->move_ids[e->nmove++] = i;
     /* pre-size for a dense pile: ~7 listed partners per sphere (half list), 2 walls */
     if (list_reserve(&s->pl, 8 * s->n + 64) || list_reserve(&s->wl, 2 * s->n + 64) || hist_reserve(&s->ph, 8 * s->n + 64) ||
         hist_reserve(&s->wh, 2 * s->n + 64))
@@ -262,6 +280,10 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->gen_large);
     free(s->rad);
     free(s->mass);
+    free(s->mat);
+    free(s->x);
+    free(s->v);
+    free(s->w);
     free(s->x0);
     free(s->inc_start);
     free(s->inc);
@@ -274,6 +296,8 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->cell_start);
     free(s->cand);
     free(s);
+    free(e->move_ids);
+    e->move_ids = NULL;
     e->sph = NULL;
 }
 
@@ -414,9 +438,8 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
 {
     sps_list *l = &s->pl;
     int a = l->a[p], b = l->b[p];
-    const sp_state *sa = &e->st[s->body[a]], *sb = &e->st[s->body[b]];
     double ra = s->rad[a], rb = s->rad[b], rs = ra + rb;
-    vec3 dx = v3_sub(sb->x, sa->x);
+    vec3 dx = v3_sub(s->x[b], s->x[a]);
     double d2 = v3_norm2(dx);
     if (d2 >= rs * rs) {
         l->touch[p] = 0;
@@ -429,10 +452,10 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     double la = ra - 0.5 * delta, lb = rb - 0.5 * delta;
     vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
     /* v_b(cp) - v_a(cp) = vb - va - (lb wb + la wa) x n */
-    vec3 vr = v3_sub(v3_sub(sb->v, sa->v), v3_cross(v3_axpy(la, sa->w, v3_scale(sb->w, lb)), n));
+    vec3 vr = v3_sub(v3_sub(s->v[b], s->v[a]), v3_cross(v3_axpy(la, s->w[a], v3_scale(s->w[b], lb)), n));
     double vn = v3_dot(vr, n);
     vec3 vt = v3_axpy(-vn, n, vr);
-    const dem_pair_law *law = &e->laws[e->geo[s->body[a]].material * e->nmat + e->geo[s->body[b]].material];
+    const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + s->mat[b]];
     double ma = s->mass[a], mb = s->mass[b];
     double ks, cn;
     double fn = dem_normal_force(law, delta, -vn, ma * mb / (ma + mb), ra * rb / rs, 1.0, &ks, &cn);
@@ -455,32 +478,32 @@ static void wall_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     sps_list *l = &s->wl;
     int a = l->a[p], wb = s->wall_body[l->b[p]];
     const sp_geo *gw = &e->geo[wb];
-    const sp_state *sa = &e->st[s->body[a]];
+    const vec3 xa = s->x[a];
     double ra = s->rad[a], rs = ra + gw->radius;
     int b0 = e->fstart[gw->fs0], m = e->fstart[gw->fs0 + 1] - b0;
     vec3 nrm = e->nw[gw->f0];
-    double dpl = v3_dot(v3_sub(sa->x, e->fw[b0]), nrm);
+    double dpl = v3_dot(v3_sub(xa, e->fw[b0]), nrm);
     l->fall[p] = 0;
     if (fabs(dpl) >= rs) {
         l->touch[p] = 0;
         return;
     }
     vec3 c;
-    if (!geom_point_polygon_inside(sa->x, e->fw + b0, m, nrm, &c)) {
+    if (!geom_point_polygon_inside(xa, e->fw + b0, m, nrm, &c)) {
         l->touch[p] = 0;
         l->fall[p] = 1;
         return;
     }
     double d = fabs(dpl);
     vec3 n = dpl >= 0.0 ? nrm : v3_neg(nrm); /* from the wall to the sphere */
-    if (d > 1e-12 * rs) n = v3_scale(v3_sub(sa->x, c), 1.0 / d);
-    vec3 cp = v3_scale(v3_add(v3_axpy(gw->radius, n, c), v3_axpy(-ra, n, sa->x)), 0.5);
+    if (d > 1e-12 * rs) n = v3_scale(v3_sub(xa, c), 1.0 / d);
+    vec3 cp = v3_scale(v3_add(v3_axpy(gw->radius, n, c), v3_axpy(-ra, n, xa)), 0.5);
     vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
-    vec3 rpa = v3_sub(cp, sa->x);
-    vec3 vr = v3_add(sa->v, v3_cross(sa->w, rpa)); /* the wall is fixed */
+    vec3 rpa = v3_sub(cp, xa);
+    vec3 vr = v3_add(s->v[a], v3_cross(s->w[a], rpa)); /* the wall is fixed */
     double vn = v3_dot(vr, n);
     vec3 vt = v3_axpy(-vn, n, vr);
-    const dem_pair_law *law = &e->laws[e->geo[s->body[a]].material * e->nmat + gw->material];
+    const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + gw->material];
     double ks, cn, delta = rs - d;
     /* vertex-face: R* = the sphere's radius, m* = the sphere's mass (README, contact laws) */
     double fn = dem_normal_force(law, delta, -vn, s->mass[a], ra, 1.0, &ks, &cn);
@@ -512,12 +535,21 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
     sp_spheres *s = e->sph;
     const int n = s->n;
+    if (s->stale) {
+        for (int k = 0; k < n; k++) {
+            const sp_state *st = &e->st[s->body[k]];
+            s->x[k] = st->x;
+            s->v[k] = st->v;
+            s->w[k] = st->w;
+        }
+        s->stale = 0;
+    }
     /* rebuild when a sphere moved more than skin/2 since the last build */
     double lim2 = 0.25 * s->skin * s->skin, worst = 0.0;
     if (s->built) {
 #pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(max : worst) if (n >= SPS_PAR_MIN)
         for (int k = 0; k < n; k++) {
-            double d2 = v3_norm2(v3_sub(e->st[s->body[k]].x, s->x0[k]));
+            double d2 = v3_norm2(v3_sub(s->x[k], s->x0[k]));
             worst = d2 > worst ? d2 : worst;
         }
     }
@@ -533,9 +565,23 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 #pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad) if (pl->n >= SPS_PAR_MIN)
     {
 #pragma omp for schedule(static)
-        for (int p = 0; p < pl->n; p++) pair_force(e, s, p, h);
+        for (int p = 0; p < pl->n; p++) {
+            pair_force(e, s, p, h);
+            if (pl->touch[p]) {
+                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
+                cnt++;
+                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
 #pragma omp for schedule(static)
-        for (int p = 0; p < wl->n; p++) wall_force(e, s, p, h);
+        for (int p = 0; p < wl->n; p++) {
+            wall_force(e, s, p, h);
+            if (wl->touch[p]) {
+                double ra = s->rad[wl->a[p]], rb = e->geo[s->wall_body[wl->b[p]]].radius;
+                cnt++;
+                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
         /* each sphere sums its own entries in ascending partner order, then its walls */
 #pragma omp for schedule(static)
         for (int k = 0; k < n; k++) {
@@ -563,18 +609,6 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
             s->st[k] = t;
             s->scnt[k] = m;
         }
-#pragma omp for schedule(static)
-        for (int p = 0; p < pl->n; p++)
-            if (pl->touch[p]) {
-                cnt++;
-                bad |= pl->delta[p] > e->max_overlap * fmin(s->rad[pl->a[p]], s->rad[pl->b[p]]);
-            }
-#pragma omp for schedule(static)
-        for (int p = 0; p < wl->n; p++)
-            if (wl->touch[p]) {
-                cnt++;
-                bad |= wl->delta[p] > e->max_overlap * fmin(s->rad[wl->a[p]], e->geo[s->wall_body[wl->b[p]]].radius);
-            }
     }
     /* the overlap limit: the first offender in list order is reported */
     for (int p = 0; bad && p < pl->n; p++) {
@@ -631,6 +665,60 @@ void sps_accumulate(lahar_dem_engine *e)
 }
 
 /* ---------------------------------------------------------------------------------------------- */
+/* Integration of the free spheres: the same kick-drift-kick as the general bodies (README,
+ * "Integration") with the sphere's equal moments: w = L / I, and the drift turns the orientation by
+ * the single exact rotation exp(h L / I) (2D: about z). Each sphere writes only its own state. */
+
+void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
+{
+    const sp_spheres *s = e->sph;
+    const vec3 g = e->g;
+    const int two_d = e->dim == 2;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        int i = s->body[k];
+        sp_state *st = &e->st[i];
+        double m = s->mass[k];
+        vec3 f = v3_axpy(m, g, st->fc), t = st->tc;
+        if (loads) {
+            f = v3_add(f, v3_load(loads[i].force));
+            t = v3_add(t, v3_load(loads[i].torque));
+        }
+        if (two_d) {
+            f.z = 0.0;
+            t.x = t.y = 0.0;
+        }
+        st->v = v3_axpy(half / m, f, st->v);
+        st->L = v3_axpy(half, t, st->L);
+        const double *in = e->geo[i].inertia;
+        st->w = two_d ? v3(0.0, 0.0, st->L.z / in[2]) : v3_scale(st->L, 1.0 / in[0]);
+        s->v[k] = st->v;
+        s->w[k] = st->w;
+    }
+}
+
+void sps_drift(lahar_dem_engine *e, double h)
+{
+    const sp_spheres *s = e->sph;
+    const int two_d = e->dim == 2;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        int i = s->body[k];
+        const sp_geo *g = &e->geo[i];
+        sp_state *st = &e->st[i];
+        st->x = v3_axpy(h, st->v, st->x);
+        if (two_d) {
+            st->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * st->L.z / g->inertia[2]), st->q));
+        } else {
+            double ln = v3_norm(st->L);
+            if (ln > 0.0) st->q = q_normalize(q_mul(q_axis_angle(v3_scale(st->L, 1.0 / ln), ln / g->inertia[0] * h), st->q));
+        }
+        e->vw[g->v0] = st->x; /* the vertex is the centre: x + q 0 */
+        s->x[k] = st->x;
+    }
+}
+
+/* ---------------------------------------------------------------------------------------------- */
 /* Restart: the touching entries (sphere a, partner b, spring) of both lists.                      */
 
 static int hist_write(const sps_list *l, FILE *f)
@@ -675,6 +763,7 @@ int sps_read_restart(lahar_dem_engine *e, FILE *f)
     if (!s) return 0;
     if (fread(&s->ncontact, sizeof(int), 1, f) != 1) return -1;
     if (hist_read(&s->ph, f, s->n, s->n) || hist_read(&s->wh, f, s->n, s->nwall)) return -1;
+    s->stale = 1;
     s->built = 0; /* the next evaluation builds the lists at the restart positions and takes ph/wh */
     return 0;
 }
