@@ -34,30 +34,55 @@ double dem_damping_for_restitution(lahar_contact_model model, double e);
 /* The two force laws are inline: they are the inner loop of both narrow phases (general and the
  * sphere fast path). */
 
+/* The per-pair constants of the normal law (they depend on m* and R* only, so a neighbour list can
+ * keep them): Hertz k0 = k_H = 4/3 E* sqrt(R*), c0 = alpha sqrt(m* k_H); linear k0 = kn,
+ * c0 = 2 zeta sqrt(kn m*). */
+typedef struct {
+    double k0, c0;
+} dem_pair_consts;
+
+static inline dem_pair_consts dem_pair_consts_make(const dem_pair_law *law, double mstar, double rstar)
+{
+    dem_pair_consts pc;
+    if (law->model == LAHAR_CONTACT_HERTZ) {
+        pc.k0 = 4.0 / 3.0 * law->estar * sqrt(rstar);
+        pc.c0 = law->damp * sqrt(mstar * pc.k0);
+    } else {
+        pc.k0 = law->kn;
+        pc.c0 = 2.0 * law->damp * sqrt(law->kn * mstar);
+    }
+    return pc;
+}
+
 /* Normal force magnitude (>= 0, clipped) for overlap delta > 0 and overlap rate delta_dot
  * (> 0 approaching), the dashpot multiplied by damp_scale (1 for a single contact point); also the
  * current normal stiffness (secant for Hertz) and damping coefficient used for the tangential ones. */
-static inline double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
-                                      double rstar, double damp_scale, double *k_secant, double *c_normal)
+static inline double dem_normal_force_pc(const dem_pair_law *law, const dem_pair_consts *pc, double delta,
+                                         double delta_dot, double damp_scale, double *k_secant, double *c_normal)
 {
-    double f, k, c;
+    double k, c;
     if (law->model == LAHAR_CONTACT_HERTZ) {
         /* Canelas et al. 2015 eq. 14-15 with exponent 3/2 (the printed 3/4 is a typo, shared/papers/README):
          * F = k_H delta^(3/2) + alpha sqrt(m* k_H) delta^(1/4) delta_dot, k_H = 4/3 E* sqrt(R*) */
-        double kh = 4.0 / 3.0 * law->estar * sqrt(rstar);
         double sd = sqrt(delta);
-        k = kh * sd;
-        c = damp_scale * law->damp * sqrt(mstar * kh) * sqrt(sd);
-        f = k * delta + c * delta_dot;
+        k = pc->k0 * sd;
+        c = damp_scale * pc->c0 * sqrt(sd);
     } else {
         /* linear spring-dashpot, c = 2 zeta sqrt(kn m*) (reference 06 sec. 6.2) */
-        k = law->kn;
-        c = damp_scale * 2.0 * law->damp * sqrt(law->kn * mstar);
-        f = k * delta + c * delta_dot;
+        k = pc->k0;
+        c = damp_scale * pc->c0;
     }
+    double f = k * delta + c * delta_dot;
     *k_secant = k;
     *c_normal = c;
     return f > 0.0 ? f : 0.0;
+}
+
+static inline double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
+                                      double rstar, double damp_scale, double *k_secant, double *c_normal)
+{
+    dem_pair_consts pc = dem_pair_consts_make(law, mstar, rstar);
+    return dem_normal_force_pc(law, &pc, delta, delta_dot, damp_scale, k_secant, c_normal);
 }
 
 /* Elastic contact period of the pair: linear 2 pi sqrt(m* / kn), twice the contact duration; Hertz: the elastic

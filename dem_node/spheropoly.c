@@ -672,12 +672,17 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
         snprintf(err, errlen, "spheropoly: out of memory for the contact history");
         return -1;
     }
-    /* serial accumulation in contact order: bitwise deterministic for any thread count */
-    for (int i = 0; i < e->nbody; i++) {
+    /* serial accumulation in contact order: bitwise deterministic for any thread count. The fast
+     * path's spheres start from their fast-path sums (sps_accumulate), the other bodies from 0. */
+    if (e->sph) sps_accumulate(e);
+    int nother = e->sph ? e->nother : e->nbody;
+    for (int k = 0; k < nother; k++) {
+        int i = e->sph ? e->other_ids[k] : k;
         e->st[i].fc = v3(0.0, 0.0, 0.0);
         e->st[i].tc = v3(0.0, 0.0, 0.0);
         e->ncontact_body[i] = 0;
     }
+    if (e->sph) sps_accumulate_walls(e);
     for (int k = 0; k < n; k++) {
         const sp_contact *c = &e->prev[k];
         sp_state *sa = &e->st[c->a], *sb = &e->st[c->b];
@@ -705,7 +710,6 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
             return -1;
         }
     }
-    if (e->sph) sps_accumulate(e);
     if (e->dim == 2)
         for (int i = 0; i < e->nbody; i++) {
             e->st[i].fc.z = 0.0;

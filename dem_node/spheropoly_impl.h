@@ -119,6 +119,7 @@ struct lahar_dem_engine {
     lahar_dem_fault fault;
     int has_fault;
     sp_spheres *sph;          /* sphere fast path, NULL without free spheres */
+    int *other_ids, nother;   /* with sph: the bodies that are not fast spheres */
     int *move_ids, nmove, nmove_free; /* with sph: the bodies kick/drift move besides the fast
                                          spheres, the free ones first (nmove_free), then prescribed */
 };
@@ -137,8 +138,10 @@ int sps_is_wall(const lahar_dem_engine *e, int i);
 int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen);
 /* Appends the marked sphere-wall pairs to e->pairs (add_pair). */
 int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, int));
-/* Adds the fast-path forces, torques and contact counts to e->st[].fc/tc, e->ncontact_body. */
+/* Sets the spheres' e->st[].fc/tc and e->ncontact_body to their fast-path sums (before the general
+ * contacts are added); sps_accumulate_walls adds the reactions to the fast walls. */
 void sps_accumulate(lahar_dem_engine *e);
+void sps_accumulate_walls(lahar_dem_engine *e);
 /* Leap-frog kick (velocity and angular momentum by `half` of the step) and drift of the free spheres. */
 void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads);
 void sps_drift(lahar_dem_engine *e, double h);

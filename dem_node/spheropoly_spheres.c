@@ -35,6 +35,7 @@ typedef struct {
     unsigned char *fall;  /* wall list: the centre is beyond the face's rim, general path */
     vec3 *f, *ta, *tb;    /* force on b (wall list: on the sphere), torque on a and on b */
     double *delta;
+    dem_pair_consts *pc;  /* normal-law constants of the pair (m*, R* fixed) */
 } sps_list;
 
 typedef struct {
@@ -62,6 +63,7 @@ struct sp_spheres {
     sps_list pl, wl;      /* sphere-sphere and sphere-wall lists */
     sps_hist ph, wh;      /* history hand-over */
     int *inc_start, *inc, inc_cap; /* per sphere its sphere-sphere entries (CSR, ascending) */
+    int *inc_mid;         /* per sphere: entries [inc_start, inc_mid) have it as b, the rest as a */
     int *wstart;          /* per sphere its wall entries [wstart[k], wstart[k+1]) */
     vec3 *sf, *st;        /* per sphere: fast-path force and torque */
     int *scnt;
@@ -97,7 +99,9 @@ static int list_reserve(sps_list *l, int need)
     if (p[7]) l->tb = p[7];
     p[8] = realloc(l->delta, sizeof(double) * (size_t)c);
     if (p[8]) l->delta = p[8];
-    for (int k = 0; k < 9; k++)
+    p[9] = realloc(l->pc, sizeof(dem_pair_consts) * (size_t)c);
+    if (p[9]) l->pc = p[9];
+    for (int k = 0; k < 10; k++)
         if (!p[k]) return -1;
     l->cap = c;
     return 0;
@@ -114,6 +118,7 @@ static void list_free(sps_list *l)
     free(l->ta);
     free(l->tb);
     free(l->delta);
+    free(l->pc);
 }
 
 static int hist_reserve(sps_hist *h, int need)
@@ -157,6 +162,7 @@ static void hist_give(const sps_hist *h, sps_list *l)
         l->touch[p] = 0;
         l->xi[p] = v3(0.0, 0.0, 0.0);
         l->fall[p] = 0;
+        l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
         while (j < h->n && (h->a[j] < l->a[p] || (h->a[j] == l->a[p] && h->b[j] < l->b[p]))) j++;
         if (j < h->n && h->a[j] == l->a[p] && h->b[j] == l->b[p]) {
             l->touch[p] = 1;
@@ -202,6 +208,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->stale = 1;
     s->x0 = malloc(sizeof(vec3) * (size_t)ns);
     s->inc_start = calloc((size_t)ns + 1, sizeof(int));
+    s->inc_mid = calloc((size_t)ns + 1, sizeof(int));
     s->wstart = calloc((size_t)ns + 1, sizeof(int));
     s->sf = malloc(sizeof(vec3) * (size_t)ns);
     s->st = malloc(sizeof(vec3) * (size_t)ns);
@@ -211,7 +218,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
     if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->x || !s->v || !s->w ||
-        !s->inc_start || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
+        !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
     for (int i = 0; i < nb; i++) {
@@ -240,7 +247,10 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     }
     s->skin = SPS_SKIN_FRACTION * rmin;
     e->move_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
-    if (!e->move_ids) goto oom;
+    e->other_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    if (!e->move_ids || !e->other_ids) goto oom;
+    for (int i = 0; i < nb; i++)
+        if (!e->geo[i].fast_sphere) e->other_ids[e->nother++] = i;
     for (int i = 0; i < nb; i++)
         if (e->geo[i].motion == LAHAR_MOTION_FREE && !e->geo[i].fast_sphere) e->move_ids[e->nmove++] = i;
     e->nmove_free = e->nmove;
@@ -286,6 +296,7 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->w);
     free(s->x0);
     free(s->inc_start);
+    free(s->inc_mid);
     free(s->inc);
     free(s->wstart);
     free(s->sf);
@@ -297,7 +308,8 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->cand);
     free(s);
     free(e->move_ids);
-    e->move_ids = NULL;
+    free(e->other_ids);
+    e->move_ids = e->other_ids = NULL;
     e->sph = NULL;
 }
 
@@ -374,8 +386,12 @@ static int build_lists(lahar_dem_engine *e)
         if (m > 1) qsort(s->cand, (size_t)m, sizeof(int), cmp_int);
         if (list_reserve(pl, pl->n + m)) return -1;
         for (int q = 0; q < m; q++) {
+            int b = s->cand[q];
+            double ma = s->mass[a], mb = s->mass[b], ra = s->rad[a], rb = s->rad[b];
             pl->a[pl->n] = a;
-            pl->b[pl->n] = s->cand[q];
+            pl->b[pl->n] = b;
+            pl->pc[pl->n] = dem_pair_consts_make(&e->laws[s->mat[a] * e->nmat + s->mat[b]], ma * mb / (ma + mb),
+                                                 ra * rb / (ra + rb));
             pl->n++;
         }
     }
@@ -400,6 +416,11 @@ static int build_lists(lahar_dem_engine *e)
     }
     for (int k = n; k > 0; k--) s->inc_start[k] = s->inc_start[k - 1];
     s->inc_start[0] = 0;
+    for (int k = 0; k < n; k++) { /* the entries with partner a < k come first (smaller index) */
+        int q = s->inc_start[k];
+        while (q < s->inc_start[k + 1] && pl->b[s->inc[q]] == k) q++;
+        s->inc_mid[k] = q;
+    }
     /* sphere-wall: walls whose plane is within the skin of the sphere's surface */
     sps_list *wl = &s->wl;
     wl->n = 0;
@@ -412,6 +433,8 @@ static int build_lists(lahar_dem_engine *e)
             if (list_reserve(wl, wl->n + 1)) return -1;
             wl->a[wl->n] = a;
             wl->b[wl->n] = w;
+            /* vertex-face: m* = the sphere's mass, R* = its radius (README, contact laws) */
+            wl->pc[wl->n] = dem_pair_consts_make(&e->laws[s->mat[a] * e->nmat + g->material], s->mass[a], s->rad[a]);
             wl->n++;
         }
     }
@@ -442,7 +465,10 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     vec3 dx = v3_sub(s->x[b], s->x[a]);
     double d2 = v3_norm2(dx);
     if (d2 >= rs * rs) {
-        l->touch[p] = 0;
+        if (l->touch[p]) { /* the sums add every entry: one out of contact holds +0 */
+            l->touch[p] = 0;
+            l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
+        }
         return;
     }
     double d = sqrt(d2);
@@ -456,9 +482,8 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     double vn = v3_dot(vr, n);
     vec3 vt = v3_axpy(-vn, n, vr);
     const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + s->mat[b]];
-    double ma = s->mass[a], mb = s->mass[b];
     double ks, cn;
-    double fn = dem_normal_force(law, delta, -vn, ma * mb / (ma + mb), ra * rb / rs, 1.0, &ks, &cn);
+    double fn = dem_normal_force_pc(law, &l->pc[p], delta, -vn, 1.0, &ks, &cn);
     xi = v3_axpy(h, vt, xi);
     vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
     /* torques about the centres: (cp - xa) x (-f) = -la n x ft, (cp - xb) x f = -lb n x ft */
@@ -505,8 +530,7 @@ static void wall_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     vec3 vt = v3_axpy(-vn, n, vr);
     const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + gw->material];
     double ks, cn, delta = rs - d;
-    /* vertex-face: R* = the sphere's radius, m* = the sphere's mass (README, contact laws) */
-    double fn = dem_normal_force(law, delta, -vn, s->mass[a], ra, 1.0, &ks, &cn);
+    double fn = dem_normal_force_pc(law, &l->pc[p], delta, -vn, 1.0, &ks, &cn);
     xi = v3_axpy(h, vt, xi);
     vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
     vec3 f = v3_axpy(fn, n, ft);
@@ -587,17 +611,19 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
         for (int k = 0; k < n; k++) {
             vec3 f = v3(0.0, 0.0, 0.0), t = v3(0.0, 0.0, 0.0);
             int m = 0;
-            for (int q = s->inc_start[k]; q < s->inc_start[k + 1]; q++) {
+            /* entries out of contact hold +0 (pair_force), adding them changes no bit of a sum
+             * that starts at +0, so there is no branch on the contact state */
+            for (int q = s->inc_start[k]; q < s->inc_mid[k]; q++) {
                 int p = s->inc[q];
-                if (!pl->touch[p]) continue;
-                m++;
-                if (pl->a[p] == k) {
-                    f = v3_sub(f, pl->f[p]);
-                    t = v3_add(t, pl->ta[p]);
-                } else {
-                    f = v3_add(f, pl->f[p]);
-                    t = v3_add(t, pl->tb[p]);
-                }
+                m += pl->touch[p];
+                f = v3_add(f, pl->f[p]);
+                t = v3_add(t, pl->tb[p]);
+            }
+            for (int q = s->inc_mid[k]; q < s->inc_start[k + 1]; q++) {
+                int p = s->inc[q];
+                m += pl->touch[p];
+                f = v3_sub(f, pl->f[p]);
+                t = v3_add(t, pl->ta[p]);
             }
             for (int p = s->wstart[k]; p < s->wstart[k + 1]; p++) {
                 if (!wl->touch[p]) continue;
@@ -649,10 +675,15 @@ void sps_accumulate(lahar_dem_engine *e)
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
     for (int k = 0; k < s->n; k++) {
         sp_state *st = &e->st[s->body[k]];
-        st->fc = v3_add(st->fc, s->sf[k]);
-        st->tc = v3_add(st->tc, s->st[k]);
-        e->ncontact_body[s->body[k]] += s->scnt[k];
+        st->fc = s->sf[k];
+        st->tc = s->st[k];
+        e->ncontact_body[s->body[k]] = s->scnt[k];
     }
+}
+
+void sps_accumulate_walls(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
     /* the walls feel the reaction, summed in list order */
     const sps_list *wl = &s->wl;
     for (int p = 0; p < wl->n; p++) {
