@@ -102,8 +102,9 @@ static inline vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 
     double ct = law->sqrt_kt_ratio * c_normal;
     vec3 f = v3_add(v3_scale(*xi, -kt), v3_scale(vt, -ct));
     double fmax = law->mu * fn;
-    double fm = v3_norm(f);
-    if (fm > fmax) {
+    double fm2 = v3_norm2(f);
+    if (fm2 > fmax * fmax) { /* squares: the root only when sliding */
+        double fm = sqrt(fm2);
         f = fm > 0.0 ? v3_scale(f, fmax / fm) : v3(0.0, 0.0, 0.0);
         *xi = kt > 0.0 ? v3_scale(f, -1.0 / kt) : v3(0.0, 0.0, 0.0);
     }

@@ -803,6 +803,17 @@ static void drift(lahar_dem_engine *e, double h)
  * of 1e300 would overflow). */
 static int check_finite(lahar_dem_engine *e, char *err, size_t errlen)
 {
+    /* quick pass: the spheres on their compact copy, then the other free bodies; the full loop
+     * below only runs to name the first offender */
+    if (e->sph && sps_finite(e)) {
+        int ok = 1;
+        for (int k = 0; k < e->nmove_free && ok; k++) {
+            const sp_state *s = &e->st[e->move_ids[k]];
+            double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
+            ok = isfinite(sum) && fabs(s->x.x) <= 1e12 && fabs(s->x.y) <= 1e12 && fabs(s->x.z) <= 1e12;
+        }
+        if (ok) return 0;
+    }
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
         const sp_state *s = &e->st[i];
@@ -834,7 +845,10 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
     double r = dt / e->dt_stable;
     int n = r <= 1.0 ? 1 : (int)ceil(r);
     double h = dt / n;
-    for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
+    /* the report averages fc + load over the substeps; one substep without loads: the state's fc/tc */
+    int average = !(n == 1 && !loads);
+    if (average)
+        for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
     for (int k = 0; k < n; k++) {
         kick(e, 0.5 * h, loads);
         drift(e, h);
@@ -842,6 +856,7 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
         if (check_finite(e, err, errlen) || compute_forces(e, h, err, errlen)) return -1;
         kick(e, 0.5 * h, loads);
         if (check_finite(e, err, errlen)) return -1;
+        if (!average) continue;
         for (int i = 0; i < e->nbody; i++) {
             vec3 f = e->st[i].fc, t = e->st[i].tc;
             if (loads) {
@@ -852,11 +867,11 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
             e->rep_t[i] = v3_add(e->rep_t[i], t);
         }
     }
-    for (int i = 0; i < e->nbody; i++) {
+    for (int i = 0; average && i < e->nbody; i++) {
         e->rep_f[i] = v3_scale(e->rep_f[i], 1.0 / n);
         e->rep_t[i] = v3_scale(e->rep_t[i], 1.0 / n);
     }
-    e->rep_n = n;
+    e->rep_n = average ? n : 0;
     return n;
 }
 

@@ -145,6 +145,9 @@ void sps_accumulate_walls(lahar_dem_engine *e);
 /* Leap-frog kick (velocity and angular momentum by `half` of the step) and drift of the free spheres. */
 void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads);
 void sps_drift(lahar_dem_engine *e, double h);
+/* 1 when every sphere's centre, velocity and angular velocity are finite and |x| <= 1e12 m (on the
+ * compact copy; 0 also when the copy is not up to date). */
+int sps_finite(const lahar_dem_engine *e);
 int sps_ncontacts(const lahar_dem_engine *e);
 int sps_nspheres(const lahar_dem_engine *e);
 /* The fixed/prescribed bodies a sphere meets on the general path (not fast walls). */

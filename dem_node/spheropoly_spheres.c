@@ -450,11 +450,11 @@ static int build_lists(lahar_dem_engine *e)
  * general path's contact_emit). */
 static inline vec3 spring_rotate(vec3 xi, vec3 n)
 {
-    double m0 = v3_norm(xi);
+    double m0 = v3_norm2(xi);
     if (m0 == 0.0) return xi;
     vec3 r = v3_axpy(-v3_dot(xi, n), n, xi);
-    double m1 = v3_norm(r);
-    return m1 > 0.0 ? v3_scale(r, m0 / m1) : r;
+    double m1 = v3_norm2(r);
+    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
 }
 
 static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
@@ -747,6 +747,20 @@ void sps_drift(lahar_dem_engine *e, double h)
         e->vw[g->v0] = st->x; /* the vertex is the centre: x + q 0 */
         s->x[k] = st->x;
     }
+}
+
+int sps_finite(const lahar_dem_engine *e)
+{
+    const sp_spheres *s = e->sph;
+    if (s->stale) return 0;
+    int ok = 1;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(& : ok) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        vec3 x = s->x[k], v = s->v[k], w = s->w[k];
+        double sum = x.x + x.y + x.z + v.x + v.y + v.z + w.x + w.y + w.z;
+        ok &= isfinite(sum) && fabs(x.x) <= 1e12 && fabs(x.y) <= 1e12 && fabs(x.z) <= 1e12;
+    }
+    return ok;
 }
 
 /* ---------------------------------------------------------------------------------------------- */
