@@ -597,8 +597,11 @@ static int broad_phase(lahar_dem_engine *e)
     /* a sphere meets the fast path's walls there; only the other fixed bodies here */
     const int *sph_large = NULL;
     int nsph_large = sph ? sps_general_large(e, &sph_large) : 0;
-    for (int k = 0; k < e->nfree; k++) {
-        int i = e->free_ids[k];
+    /* without such bodies only the free bodies that are not spheres are visited */
+    const int *fids = sph && nsph_large == 0 ? e->move_ids : e->free_ids;
+    int nf = sph && nsph_large == 0 ? e->nmove_free : e->nfree;
+    for (int k = 0; k < nf; k++) {
+        int i = fids[k];
         const int *lids = e->large_ids;
         int nl = e->nlarge;
         if (e->geo[i].fast_sphere) {
