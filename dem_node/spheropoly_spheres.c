@@ -53,6 +53,8 @@ struct sp_spheres {
     int ngen, *gen_large; /* fixed/prescribed bodies that are not fast walls (general path) */
     double *rad, *mass;
     int *mat;             /* material */
+    double *iner;         /* moment of inertia (3D: the equal moments; 2D: about z) */
+    int *v0;              /* index of the sphere's vertex in e->vw */
     /* hot data of the force loops, a copy of e->st kept by sps_kick / sps_drift (SoA by field,
      * contiguous by sphere); stale after create and read_restart until sps_forces copies it */
     vec3 *x, *v, *w;
@@ -202,6 +204,8 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->rad = malloc(sizeof(double) * (size_t)ns);
     s->mass = malloc(sizeof(double) * (size_t)ns);
     s->mat = malloc(sizeof(int) * (size_t)ns);
+    s->iner = malloc(sizeof(double) * (size_t)ns);
+    s->v0 = malloc(sizeof(int) * (size_t)ns);
     s->x = malloc(sizeof(vec3) * (size_t)ns);
     s->v = malloc(sizeof(vec3) * (size_t)ns);
     s->w = malloc(sizeof(vec3) * (size_t)ns);
@@ -217,7 +221,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
-    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->x || !s->v || !s->w ||
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->v0 || !s->x || !s->v || !s->w ||
         !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
@@ -234,6 +238,8 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
             s->rad[s->n] = g->radius;
             s->mass[s->n] = g->mass;
             s->mat[s->n] = g->material;
+            s->iner[s->n] = e->dim == 2 ? g->inertia[2] : g->inertia[0];
+            s->v0[s->n] = g->v0;
             rmin = fmin(rmin, g->radius);
             s->rmax = fmax(s->rmax, g->radius);
             s->n++;
@@ -291,6 +297,8 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->rad);
     free(s->mass);
     free(s->mat);
+    free(s->iner);
+    free(s->v0);
     free(s->x);
     free(s->v);
     free(s->w);
@@ -721,8 +729,7 @@ void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
         }
         st->v = v3_axpy(half / m, f, st->v);
         st->L = v3_axpy(half, t, st->L);
-        const double *in = e->geo[i].inertia;
-        st->w = two_d ? v3(0.0, 0.0, st->L.z / in[2]) : v3_scale(st->L, 1.0 / in[0]);
+        st->w = two_d ? v3(0.0, 0.0, st->L.z / s->iner[k]) : v3_scale(st->L, 1.0 / s->iner[k]);
         s->v[k] = st->v;
         s->w[k] = st->w;
     }
@@ -734,17 +741,15 @@ void sps_drift(lahar_dem_engine *e, double h)
     const int two_d = e->dim == 2;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
     for (int k = 0; k < s->n; k++) {
-        int i = s->body[k];
-        const sp_geo *g = &e->geo[i];
-        sp_state *st = &e->st[i];
+        sp_state *st = &e->st[s->body[k]];
         st->x = v3_axpy(h, st->v, st->x);
         if (two_d) {
-            st->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * st->L.z / g->inertia[2]), st->q));
+            st->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * st->L.z / s->iner[k]), st->q));
         } else {
             double ln = v3_norm(st->L);
-            if (ln > 0.0) st->q = q_normalize(q_mul(q_axis_angle(v3_scale(st->L, 1.0 / ln), ln / g->inertia[0] * h), st->q));
+            if (ln > 0.0) st->q = q_normalize(q_mul(q_axis_angle(v3_scale(st->L, 1.0 / ln), ln / s->iner[k] * h), st->q));
         }
-        e->vw[g->v0] = st->x; /* the vertex is the centre: x + q 0 */
+        e->vw[s->v0[k]] = st->x; /* the vertex is the centre: x + q 0 */
         s->x[k] = st->x;
     }
 }
