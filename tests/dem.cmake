@@ -15,6 +15,7 @@ lahar_dem_test(test_dem_freebody fast)
 lahar_dem_test(test_dem_stack fast)
 lahar_dem_test(test_dem_restart fast)
 lahar_dem_test(test_dem_prescribed fast)
+lahar_dem_test(test_dem_spheres fast)
 
 # The settling pile of the benchmark (tests/bench/dem_pile.h), also used by test_dem_noalloc.
 add_library(lahar_dem_pile STATIC ${LAHAR_TEST_DIR}/bench/dem_pile.c ${LAHAR_TEST_DIR}/dem_test_util.c)
