@@ -108,7 +108,7 @@ int main(void)
             return 1;
         }
         travel += h * 1.0;
-        if (k % 100 == 0) {
+        if (k % 150 == 0) {
             int got = ops->ncontacts(e), want = brute_contacts(ops, e, rad);
             checks++;
             maxc = want > maxc ? want : maxc;
