@@ -24,8 +24,9 @@
 
 /* Skin: this fraction of the smallest sphere radius (LAMMPS's bench uses 0.1 d). */
 #define SPS_SKIN_FRACTION 0.2
-/* Parallel loops from this many list entries / spheres on (a team's fork/join costs more below). */
-enum { SPS_PAR_MIN = 512 };
+/* Parallel loops from this many spheres on: below, a team's fork/join per loop costs more than the
+ * loop (512 spheres on 2 threads took twice the CPU time of 1 thread; 10,000 gained, dem_speed.md). */
+enum { SPS_PAR_MIN = 2048 };
 
 typedef struct {
     int n, cap;
@@ -594,7 +595,7 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
     }
     sps_list *pl = &s->pl, *wl = &s->wl;
     int cnt = 0, bad = 0;
-#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad) if (pl->n >= SPS_PAR_MIN)
+#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad) if (n >= SPS_PAR_MIN)
     {
 #pragma omp for schedule(static)
         for (int p = 0; p < pl->n; p++) {
