@@ -466,7 +466,11 @@ static inline vec3 spring_rotate(vec3 xi, vec3 n)
     return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
 }
 
-static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
+/* direct = 1 (one thread): the force goes straight into the two spheres' sums (sf, st, scnt) instead
+ * of the entry. In list order each sphere then receives its partners in ascending order, the
+ * order of the per-sphere sums of the threaded path: the same bits. */
+static inline __attribute__((always_inline)) void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h,
+                                                             int direct)
 {
     sps_list *l = &s->pl;
     int a = l->a[p], b = l->b[p];
@@ -476,7 +480,7 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     if (d2 >= rs * rs) {
         if (l->touch[p]) { /* the sums add every entry: one out of contact holds +0 */
             l->touch[p] = 0;
-            l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
+            if (!direct) l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
         }
         return;
     }
@@ -499,10 +503,20 @@ static void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
     vec3 c = v3_cross(n, ft);
     l->touch[p] = 1;
     l->xi[p] = xi;
-    l->f[p] = v3_axpy(fn, n, ft);
-    l->ta[p] = v3_scale(c, -la);
-    l->tb[p] = v3_scale(c, -lb);
     l->delta[p] = delta;
+    vec3 f = v3_axpy(fn, n, ft), ta = v3_scale(c, -la), tb = v3_scale(c, -lb);
+    if (direct) {
+        s->sf[a] = v3_sub(s->sf[a], f);
+        s->st[a] = v3_add(s->st[a], ta);
+        s->scnt[a]++;
+        s->sf[b] = v3_add(s->sf[b], f);
+        s->st[b] = v3_add(s->st[b], tb);
+        s->scnt[b]++;
+    } else {
+        l->f[p] = f;
+        l->ta[p] = ta;
+        l->tb[p] = tb;
+    }
 }
 
 /* Sphere a against wall w: vertex-face when the centre projects inside the face, else the pair
@@ -595,11 +609,37 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
     }
     sps_list *pl = &s->pl, *wl = &s->wl;
     int cnt = 0, bad = 0;
-#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad) if (n >= SPS_PAR_MIN)
+    if (e->nthr == 1 || n < SPS_PAR_MIN) {
+        /* one thread: forces straight into the sums (pair_force, direct), walls after the pairs */
+        memset(s->sf, 0, sizeof(vec3) * (size_t)n);
+        memset(s->st, 0, sizeof(vec3) * (size_t)n);
+        memset(s->scnt, 0, sizeof(int) * (size_t)n);
+        for (int p = 0; p < pl->n; p++) {
+            pair_force(e, s, p, h, 1);
+            if (pl->touch[p]) {
+                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
+                cnt++;
+                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
+        for (int p = 0; p < wl->n; p++) {
+            wall_force(e, s, p, h);
+            if (wl->touch[p]) {
+                int a = wl->a[p];
+                double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
+                cnt++;
+                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+                s->sf[a] = v3_add(s->sf[a], wl->f[p]);
+                s->st[a] = v3_add(s->st[a], wl->ta[p]);
+                s->scnt[a]++;
+            }
+        }
+    } else {
+#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad)
     {
 #pragma omp for schedule(static)
         for (int p = 0; p < pl->n; p++) {
-            pair_force(e, s, p, h);
+            pair_force(e, s, p, h, 0);
             if (pl->touch[p]) {
                 double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
                 cnt++;
@@ -644,6 +684,7 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
             s->st[k] = t;
             s->scnt[k] = m;
         }
+    }
     }
     /* the overlap limit: the first offender in list order is reported */
     for (int p = 0; bad && p < pl->n; p++) {
