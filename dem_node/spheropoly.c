@@ -677,7 +677,14 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
     }
     /* serial accumulation in contact order: bitwise deterministic for any thread count. The fast
      * path's spheres start from their fast-path sums (sps_accumulate), the other bodies from 0. */
-    if (e->sph) sps_accumulate(e);
+    if (e->sph) {
+        /* no general contact on a sphere: its force is its fast-path sum, which the next kick
+         * takes straight from the fast path (sps_kick) instead of a pass over the body states */
+        int defer = 1;
+        for (int k = 0; k < n && defer; k++) defer = !e->geo[e->prev[k].a].fast_sphere && !e->geo[e->prev[k].b].fast_sphere;
+        if (defer) sps_defer(e);
+        else sps_accumulate(e);
+    }
     int nother = e->sph ? e->nother : e->nbody;
     for (int k = 0; k < nother; k++) {
         int i = e->sph ? e->other_ids[k] : k;
@@ -1281,6 +1288,7 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     e->dt_stable = stable_dt_of(e, c);
     if (sps_create(e, err, errlen)) goto fail;
     if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;
+    if (e->sph) sps_accumulate(e); /* the body states hold the forces between advances */
     return e;
 fail:
     sp_destroy(e);

@@ -142,6 +142,8 @@ int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, 
  * contacts are added); sps_accumulate_walls adds the reactions to the fast walls. */
 void sps_accumulate(lahar_dem_engine *e);
 void sps_accumulate_walls(lahar_dem_engine *e);
+/* Instead of sps_accumulate: the next sps_kick takes the sums and writes the body states. */
+void sps_defer(lahar_dem_engine *e);
 /* Leap-frog kick (velocity and angular momentum by `half` of the step) and drift of the free spheres. */
 void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads);
 void sps_drift(lahar_dem_engine *e, double h);

@@ -74,6 +74,7 @@ struct sp_spheres {
     int *cell_start, *cell_of, *order, ncell_cap;
     int *cand, cand_cap;
     int ncontact;
+    int deferred;         /* the spheres' forces are in sf/st/scnt, not yet in the body states */
 };
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -719,9 +720,12 @@ int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, 
     return 0;
 }
 
+void sps_defer(lahar_dem_engine *e) { e->sph->deferred = 1; }
+
 void sps_accumulate(lahar_dem_engine *e)
 {
     sp_spheres *s = e->sph;
+    s->deferred = 0;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
     for (int k = 0; k < s->n; k++) {
         sp_state *st = &e->st[s->body[k]];
@@ -752,14 +756,23 @@ void sps_accumulate_walls(lahar_dem_engine *e)
 
 void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 {
-    const sp_spheres *s = e->sph;
+    sp_spheres *s = e->sph;
     const vec3 g = e->g;
-    const int two_d = e->dim == 2;
+    const int two_d = e->dim == 2, deferred = s->deferred;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
     for (int k = 0; k < s->n; k++) {
         int i = s->body[k];
         sp_state *st = &e->st[i];
         double m = s->mass[k];
+        if (deferred) { /* what sps_accumulate (and compute_forces' 2D projection) would have written */
+            st->fc = s->sf[k];
+            st->tc = s->st[k];
+            if (two_d) {
+                st->fc.z = 0.0;
+                st->tc.x = st->tc.y = 0.0;
+            }
+            e->ncontact_body[i] = s->scnt[k];
+        }
         vec3 f = v3_axpy(m, g, st->fc), t = st->tc;
         if (loads) {
             f = v3_add(f, v3_load(loads[i].force));
@@ -775,6 +788,7 @@ void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
         s->v[k] = st->v;
         s->w[k] = st->w;
     }
+    s->deferred = 0;
 }
 
 void sps_drift(lahar_dem_engine *e, double h)
@@ -856,6 +870,7 @@ int sps_read_restart(lahar_dem_engine *e, FILE *f)
     if (fread(&s->ncontact, sizeof(int), 1, f) != 1) return -1;
     if (hist_read(&s->ph, f, s->n, s->n) || hist_read(&s->wh, f, s->n, s->nwall)) return -1;
     s->stale = 1;
+    s->deferred = 0;
     s->built = 0; /* the next evaluation builds the lists at the restart positions and takes ph/wh */
     return 0;
 }
