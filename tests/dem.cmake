@@ -14,6 +14,7 @@ lahar_dem_test(test_dem_freebody fast)
 lahar_dem_test(test_dem_stack fast)
 lahar_dem_test(test_dem_restart fast)
 lahar_dem_test(test_dem_prescribed fast)
+lahar_dem_test(test_dem_spheres fast)
 
 # The settling pile of the benchmark (tests/bench/dem_pile.h), also used by test_dem_noalloc.
 add_library(lahar_dem_pile STATIC ${LAHAR_TEST_DIR}/bench/dem_pile.c ${LAHAR_TEST_DIR}/dem_test_util.c)
@@ -28,7 +29,24 @@ lahar_test(test_dem_noalloc COMMAND test_dem_noalloc LABELS fast dem TIMEOUT 300
 
 # Benchmarks (tests/bench/, not ctest tests: they print a table and never fail on time).
 # `cmake --build <dir> --target bench` builds and runs bench_dem with its default sizes.
-add_executable(bench_dem EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem.c)
+add_executable(bench_dem ${LAHAR_TEST_DIR}/bench/bench_dem.c ${LAHAR_TEST_DIR}/bench/bench_lammps.c)
 target_link_libraries(bench_dem PRIVATE lahar_dem_pile)
+# bench_dem --lammps-data also runs LAMMPS through its C library when liblammps-dev is installed
+# (-DLAHAR_BENCH_LAMMPS=OFF: without it, e.g. for valgrind, which stops on liblammps's start-up code)
+option(LAHAR_BENCH_LAMMPS "bench_dem runs LAMMPS through liblammps when it is installed" ON)
+if(LAHAR_BENCH_LAMMPS)
+  pkg_check_modules(LAMMPS IMPORTED_TARGET liblammps)
+endif()
+if(LAHAR_BENCH_LAMMPS AND LAMMPS_FOUND)
+  target_link_libraries(bench_dem PRIVATE PkgConfig::LAMMPS)
+  target_compile_definitions(bench_dem PRIVATE LAHAR_HAVE_LAMMPS)
+endif()
 add_custom_target(bench COMMAND bench_dem DEPENDS bench_dem WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} USES_TERMINAL
   COMMENT "bench_dem: DEM step cost for 500/2000/8000 bodies on 1 and 2 threads")
+
+# The sphere fast path against LAMMPS on a small settled pile (contact count, KE decay); skipped
+# without lmp / liblammps (tests/dem_lammps_check.sh).
+add_test(NAME dem_lammps_pile COMMAND sh ${LAHAR_TEST_DIR}/dem_lammps_check.sh $<TARGET_FILE:bench_dem>
+  ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_pile)
+set_tests_properties(dem_lammps_pile PROPERTIES LABELS "slow;dem" TIMEOUT 300 SKIP_RETURN_CODE 77
+  ENVIRONMENT "OMP_WAIT_POLICY=passive")

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 packages=(cmake make gcc pkg-config libglib2.0-dev liblcm-dev liblcm-bin libhdf5-dev hdf5-tools
-          libyaml-dev libcjson-dev libsodium-dev libmatheval-dev liblammps-dev nftables iproute2 python3 python3-h5py python3-matplotlib python3-yaml
+          libyaml-dev libcjson-dev libsodium-dev libmatheval-dev liblammps-dev lammps nftables iproute2 python3 python3-h5py python3-matplotlib python3-yaml
           python3-numpy)
 # libFuzzer: clang, its runtime libclang_rt.fuzzer (libclang-rt-14-dev) and clang's OpenMP (libomp-dev)
 if [ "${LAHAR_FUZZ:-0}" = 1 ]; then

@@ -26,6 +26,7 @@ int dem_pair_law_make(const lahar_material *a, const lahar_material *b, dem_pair
     if (b->young > 0.0) inv += (1.0 - b->poisson * b->poisson) / b->young;
     out->estar = inv > 0.0 ? 1.0 / inv : 0.0;
     out->kt_ratio = 0.5 * (a->kt_ratio + b->kt_ratio);
+    out->sqrt_kt_ratio = sqrt(out->kt_ratio);
     out->e = a->restitution < b->restitution ? a->restitution : b->restitution;
     out->mu = a->friction < b->friction ? a->friction : b->friction;
     if (out->model == LAHAR_CONTACT_HERTZ && !(out->estar > 0.0)) {
@@ -104,29 +105,6 @@ double dem_damping_for_restitution(lahar_contact_model model, double e)
     return 0.5 * (lo + hi);
 }
 
-double dem_normal_force(const dem_pair_law *law, double delta, double delta_dot, double mstar,
-                        double rstar, double damp_scale, double *k_secant, double *c_normal)
-{
-    double f, k, c;
-    if (law->model == LAHAR_CONTACT_HERTZ) {
-        /* Canelas et al. 2015 eq. 14-15 with exponent 3/2 (the printed 3/4 is a typo, shared/papers/README):
-         * F = k_H delta^(3/2) + alpha sqrt(m* k_H) delta^(1/4) delta_dot, k_H = 4/3 E* sqrt(R*) */
-        double kh = 4.0 / 3.0 * law->estar * sqrt(rstar);
-        double sd = sqrt(delta);
-        k = kh * sd;
-        c = damp_scale * law->damp * sqrt(mstar * kh) * sqrt(sd);
-        f = k * delta + c * delta_dot;
-    } else {
-        /* linear spring-dashpot, c = 2 zeta sqrt(kn m*) (reference 06 sec. 6.2) */
-        k = law->kn;
-        c = damp_scale * 2.0 * law->damp * sqrt(law->kn * mstar);
-        f = k * delta + c * delta_dot;
-    }
-    *k_secant = k;
-    *c_normal = c;
-    return f > 0.0 ? f : 0.0;
-}
-
 double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, double v_impact)
 {
     if (law->model == LAHAR_CONTACT_HERTZ) {
@@ -134,23 +112,6 @@ double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, d
         return 2.0 * 2.868266 * pow(x, 0.2);
     }
     return 2.0 * M_PI * sqrt(mstar / law->kn);
-}
-
-vec3 dem_tangential_force(const dem_pair_law *law, vec3 *xi, vec3 vt, double fn, double k_secant,
-                          double c_normal)
-{
-    /* k_t = kt_ratio k_n (secant k_n for Hertz), c_t = sqrt(kt_ratio) c_n: the same damping ratio
-     * as the normal direction (Canelas et al. 2015 uses 2/7 for both, which changes the ratio). */
-    double kt = law->kt_ratio * k_secant;
-    double ct = sqrt(law->kt_ratio) * c_normal;
-    vec3 f = v3_add(v3_scale(*xi, -kt), v3_scale(vt, -ct));
-    double fmax = law->mu * fn;
-    double fm = v3_norm(f);
-    if (fm > fmax) {
-        f = fm > 0.0 ? v3_scale(f, fmax / fm) : v3(0.0, 0.0, 0.0);
-        *xi = kt > 0.0 ? v3_scale(f, -1.0 / kt) : v3(0.0, 0.0, 0.0);
-    }
-    return f;
 }
 
 double dem_impact_speed(double vmax, double gravity, double extent)

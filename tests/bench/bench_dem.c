@@ -4,8 +4,12 @@
  * bodies, contacts, substeps/s, microseconds per body-substep, threads, and a digest of the final
  * body states (equal digest = bitwise equal result). Never fails on time.
  *
- *   bench_dem [--hertz] [--layers n] [--warm s] [--meas s] [--threads 1,2] [n ...]  (default 500 2000 8000)
+ *   bench_dem [--hertz] [--kind mixed|spheres|boxes|rocks] [--layers n] [--warm s] [--meas s] [--threads 1,2] [n ...]  (default 500 2000 8000)
  *   bench_dem --case cases/dem_drop_3d.yaml [--warm s] [--meas s]           (a case file as is)
+ *   bench_dem --lammps-data FILE [--warm-steps n] [--steps n] [--threads t] [--no-lammps]
+ *             [--check-ke factor] [--check-contacts rel]
+ *     a settled LAMMPS pile (atom_style sphere data file), timed against LAMMPS on the same file in
+ *     the same run when built with liblammps (bench_lammps.h); the checks make it a test
  *   --restart FILE (one scene only): read the warmed-up state from FILE when it exists, else
  *   write it there after the warm-up (profiling runs then skip the warm-up).
  *
@@ -14,7 +18,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "case.h"
+#include "bench_lammps.h"
 #include "dem_engine.h"
 #include "dem_pile.h"
 #include "dem_test_util.h"
@@ -32,6 +38,14 @@ static __attribute__((noinline)) long bench_measure(const lahar_dem_engine_ops *
         nsub += n;
     }
     return nsub;
+}
+
+/* CPU time of the process (all threads): on a shared machine the wall time is mostly waiting. */
+static double bench_cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* FNV-1a over every body state: equal digests = bitwise equal runs (threads, optimisations). */
@@ -99,16 +113,17 @@ static int bench_scene(const lahar_case *c, double warm, double meas, const int 
             fprintf(stderr, "bench_dem: cannot read the restart\n");
             rc = -1;
         } else {
-            double t0 = omp_get_wtime();
+            double t0 = omp_get_wtime(), c0 = bench_cpu_seconds();
             long nsub = bench_measure(ops, e, nmeas, dt, err, sizeof err);
-            double wall = omp_get_wtime() - t0;
+            double wall = omp_get_wtime() - t0, cpu = bench_cpu_seconds() - c0;
             if (nsub <= 0) {
                 fprintf(stderr, "bench_dem: %s\n", err);
                 rc = -1;
             } else {
                 int nb = ops->nbody(e);
-                printf("| %-14s | %6d | %8d | %10.1f | %15.3f | %7d | %016llx |\n", label, nb, ops->ncontacts(e),
-                       nsub / wall, 1e6 * wall / ((double)nsub * nb), thr[t], bench_digest(ops, e));
+                printf("| %-14s | %6d | %8d | %6.2f | %10.1f | %15.3f | %15.3f | %7d | %016llx |\n", label, nb,
+                       ops->ncontacts(e), (double)ops->ncontacts(e) / nb, nsub / wall, 1e6 * wall / ((double)nsub * nb),
+                       1e6 * cpu / ((double)nsub * nb), thr[t], bench_digest(ops, e));
                 fflush(stdout);
             }
         }
@@ -120,11 +135,26 @@ static int bench_scene(const lahar_case *c, double warm, double meas, const int 
 
 int main(int argc, char **argv)
 {
-    int hertz = 0, nthr = 0, thr[8], nn = 0, ns[32], layers = 4;
+    int kind = 0, hertz = 0, nthr = 0, thr[8], nn = 0, ns[32], layers = 4;
     double warm = 0.3, meas = 0.05;
     const char *casefile = NULL, *restart = NULL;
+    bench_lammps_opts lo = {.warm = 1000, .steps = 1000, .threads = 1, .lammps = 1};
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--hertz")) hertz = 1;
+        else if (!strcmp(argv[i], "--lammps-data") && i + 1 < argc) lo.file = argv[++i];
+        else if (!strcmp(argv[i], "--kind") && i + 1 < argc) {
+            const char *k = argv[++i];
+            kind = !strcmp(k, "spheres") ? 1 : !strcmp(k, "boxes") ? 2 : !strcmp(k, "rocks") ? 3 : !strcmp(k, "mixed") ? 0 : -1;
+            if (kind < 0) {
+                fprintf(stderr, "bench_dem: --kind %s: expected mixed, spheres, boxes or rocks\n", k);
+                return 2;
+            }
+        }
+        else if (!strcmp(argv[i], "--warm-steps") && i + 1 < argc) lo.warm = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--steps") && i + 1 < argc) lo.steps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--no-lammps")) lo.lammps = 0;
+        else if (!strcmp(argv[i], "--check-ke") && i + 1 < argc) lo.ke_tol = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--check-contacts") && i + 1 < argc) lo.contact_tol = atof(argv[++i]);
         else if (!strcmp(argv[i], "--warm") && i + 1 < argc) warm = atof(argv[++i]);
         else if (!strcmp(argv[i], "--layers") && i + 1 < argc) layers = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--meas") && i + 1 < argc) meas = atof(argv[++i]);
@@ -134,9 +164,17 @@ int main(int argc, char **argv)
             for (char *s = strtok(argv[++i], ","); s && nthr < 8; s = strtok(NULL, ",")) thr[nthr++] = atoi(s);
         } else if (nn < 32 && atoi(argv[i]) > 0) ns[nn++] = atoi(argv[i]);
         else {
-            fprintf(stderr, "usage: bench_dem [--hertz] [--layers n] [--warm s] [--meas s] [--threads 1,2] [--restart file] [n ...] | --case file\n");
+            fprintf(stderr, "usage: bench_dem [--hertz] [--kind mixed|spheres|boxes|rocks] [--layers n] [--warm s] [--meas s] [--threads 1,2] [--restart file] [n ...] | --case file | --lammps-data file [--warm-steps n] [--steps n] [--no-lammps] [--check-ke f] [--check-contacts r]\n");
             return 2;
         }
+    }
+    if (lo.file) {
+        lo.threads = nthr > 0 ? thr[0] : 1;
+        if (lo.steps < 1 || lo.warm < 0) {
+            fprintf(stderr, "bench_dem: --steps must be >= 1 and --warm-steps >= 0\n");
+            return 2;
+        }
+        return bench_lammps_run(&lo);
     }
     if (nthr == 0) {
         thr[nthr++] = 1;
@@ -147,8 +185,8 @@ int main(int argc, char **argv)
         ns[nn++] = 2000;
         ns[nn++] = 8000;
     }
-    printf("| scene          | bodies | contacts | substeps/s | us/body-substep | threads | state digest     |\n");
-    printf("|----------------|--------|----------|------------|-----------------|---------|------------------|\n");
+    printf("| scene          | bodies | contacts | per body | substeps/s | us/body-substep | core-us/body-substep (CPU) | threads | state digest     |\n");
+    printf("|----------------|--------|----------|--------|------------|-----------------|-----------------|---------|------------------|\n");
     int rc = 0;
     if (casefile) {
         lahar_case c;
@@ -159,8 +197,11 @@ int main(int argc, char **argv)
     }
     for (int k = 0; k < nn; k++) {
         lahar_case c;
-        dem_pile_case(&c, ns[k], layers, hertz, 12345u);
-        rc |= bench_scene(&c, warm, meas, thr, nthr, hertz ? "pile hertz" : "pile linear", nn == 1 ? restart : NULL);
+        dem_pile_case_kind(&c, ns[k], layers, hertz, 12345u, kind);
+        static const char *kname[4] = {"", " spheres", " boxes", " rocks"};
+        char label[32];
+        snprintf(label, sizeof label, "pile %s%s", hertz ? "hertz" : "linear", kname[kind]);
+        rc |= bench_scene(&c, warm, meas, thr, nthr, label, nn == 1 ? restart : NULL);
         dem_test_case_free(&c);
     }
     return rc ? 1 : 0;

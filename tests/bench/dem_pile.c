@@ -51,6 +51,11 @@ static void pile_rock(lahar_case *c, int mat, const double x[3], unsigned *seed)
 
 void dem_pile_case(lahar_case *c, int n, int layers, int hertz, unsigned seed)
 {
+    dem_pile_case_kind(c, n, layers, hertz, seed, 0);
+}
+
+void dem_pile_case_kind(lahar_case *c, int n, int layers, int hertz, unsigned seed, int only)
+{
     const double g[3] = {0, 0, -9.81};
     dem_test_case_init(c, 3, g, n + 5);
     int m = hertz ? dem_test_material(c, "rock", LAHAR_CONTACT_HERTZ, 2650.0, 0.0, 1e8, 0.25, 0.5, 0.5)
@@ -74,7 +79,7 @@ void dem_pile_case(lahar_case *c, int n, int layers, int hertz, unsigned seed)
         double x[3] = {-half + 0.02 + (ix + 0.5) * spacing, -half + 0.02 + (iy + 0.5) * spacing, 0.01 + (iz + 0.5) * spacing};
         char name[16];
         snprintf(name, sizeof name, "b%d", k);
-        int kind = k % 3;
+        int kind = only > 0 ? only - 1 : k % 3;
         if (kind == 0) {
             dem_test_sphere(c, name, m, 0.03 + 0.007 * pile_rand(&seed), x, LAHAR_MOTION_FREE);
         } else {

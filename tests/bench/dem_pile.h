@@ -10,5 +10,7 @@
  * floor and 4 walls. hertz = 0: linear kn = 2e5 N/m; 1: Hertz E = 1e8 Pa, nu = 0.25 (the drop
  * case's rock). e = 0.5, mu = 0.5. Deterministic for a given n and seed. Exits on failure. */
 void dem_pile_case(lahar_case *c, int n, int layers, int hertz, unsigned seed);
+/* The same pile of one kind of body only: 0 mixed (as dem_pile_case), 1 spheres, 2 boxes, 3 rocks. */
+void dem_pile_case_kind(lahar_case *c, int n, int layers, int hertz, unsigned seed, int kind);
 
 #endif

@@ -4,7 +4,7 @@
  * One LAMMPS instance per engine, serial (lammps_open_no_mpi). Free bodies are atoms of
  * atom_style sphere (tag = 1 + index among the free bodies); fixed planes (3D) and segments (2D)
  * are `fix wall/gran/region` on a `region plane`. The contact law of every pair of materials is
- * the one of dem_node/dem_contact.c (dem_pair_law_make: E*, kn, e -> calibrated damping, mu,
+ * the one of dem_node/contact/dem_contact.c (dem_pair_law_make: E*, kn, e -> calibrated damping, mu,
  * kt_ratio), written as `pair_style granular` coefficients per pair of atom types:
  *   linear: hooke kn c_n, c_n = 2 zeta sqrt(kn m*), tangential linear_history kt_ratio kn,
  *           sqrt(kt_ratio) c_n, mu, damping velocity   -> F = kn d + c_n d'

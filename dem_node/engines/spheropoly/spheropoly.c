@@ -4,6 +4,7 @@
  * leap-frog for translation and an exactly rotating splitting (NO_SQUISH / Dullweber-Leimkuhler-
  * McLachlan 1997) for rotation. Conventions are documented in dem_node/README.md. */
 #include "spheropoly.h"
+#include "spheropoly_impl.h"
 #include <float.h>
 #include <limits.h>
 #include <math.h>
@@ -14,115 +15,6 @@
 #include "dem_contact.h"
 #include "geometry.h"
 
-/* Contact types: which features of body a (lower index) and b meet. */
-enum { SP_VF = 0, SP_FV, SP_EE, SP_VE, SP_EV, SP_VV };
-
-/* Bodies with more features than this get a feature grid. */
-enum { SP_GRID_MIN_FEATURES = 64 };
-
-/* Per-body loops (kick, drift) run on the thread team from this many bodies on: below it the
- * fork/join of a team costs more than the loop (README, "Performance"). */
-enum { SP_PAR_MIN_BODIES = 1024 };
-
-typedef struct {
-    int a, b, type, fa, fb;
-    vec3 xi;     /* tangential spring (world), kept across steps while the contact lasts */
-    vec3 f;      /* force on b (a gets -f), world */
-    vec3 cp;     /* contact point, world */
-    vec3 n;      /* unit normal from a to b */
-    double delta;
-    double rstar; /* effective curvature radius (Hertz) */
-} sp_contact;
-
-typedef struct {
-    int nv, ne, nf;
-    int v0;      /* first vertex in vb/vw/vadj_start pools (vadj_start has nv+1 per body at va0) */
-    int va0;
-    int e0;      /* first edge in the edge pools */
-    int f0;      /* first face in fstart (nf+1 entries at fs0) and face normal pools */
-    int fs0;
-    double radius, bound; /* sweep radius; bounding radius about the centre of mass */
-    int grid;    /* index into e->grids or -1 */
-    int material;
-    lahar_motion motion;
-    double mass, inertia[3];
-    int isotropic; /* equal principal moments (spheres, cubes): free rotation is a plain rotation */
-    vec3 aabb_lo, aabb_hi; /* world box of non-free bodies (vertices +- radius) */
-} sp_geo;
-
-typedef struct {
-    vec3 x, v, L, w; /* position, velocity, angular momentum and velocity (world) */
-    quat q;
-    vec3 fc, tc;     /* contact force / torque of the last evaluation */
-} sp_state;
-
-/* A free body in the broad-phase grid (64 bytes: one cache line). */
-typedef struct {
-    long long c[3]; /* cell */
-    vec3 x;
-    double bound;
-    int id, level;
-} sp_bin;
-
-typedef struct {
-    sp_contact *c;
-    int n, cap;
-    geom_feature_query fq;
-    int *keep[2][3]; /* per side of a pair: features near the other body (vertex, edge, face) */
-    vec3 *emid;      /* edge-edge prefilter: midpoints and half-lengths of the kept edges of b */
-    double *ehalf;
-    int oom;
-} sp_thread;
-
-struct lahar_dem_engine {
-    int dim, nbody, nmat;
-    vec3 g;
-    double dt_stable;
-    long step;                /* substeps taken since creation */
-    sp_geo *geo;
-    sp_state *st;
-    char (*names)[LAHAR_NAME_MAX];
-    dem_pair_law *laws;       /* nmat x nmat */
-    /* geometry pools */
-    vec3 *vb, *vw;            /* body-frame and world vertices */
-    int *vadj_start, *vadj;   /* vertex neighbours (local vertex ids) */
-    int (*edge)[2];           /* local vertex ids */
-    int (*edge_face)[2];      /* local face ids adjacent to each edge, -1 if none */
-    int *fstart;              /* per body nf+1 offsets into fv/fw (global) */
-    int *fv;                  /* local vertex ids */
-    vec3 *fw;                 /* world copy of the face polygons */
-    vec3 *nb, *nw;            /* face normals body / world */
-    geom_feature_grid *grids;
-    int ngrid;
-    /* broad phase */
-    int nfree, *free_ids, nlarge, *large_ids;
-    int nlevel;               /* grid levels: cell of level l = D 2^(l - nlevel + 1), D the largest diameter */
-    double cell_inv[21];
-    int level_count[21];
-    int *level;               /* per free body (index into free_ids) */
-    long long (*cellc)[3];
-    int *bucket_of, *bucket_start, nbucket, bucket_cap, nhash, dense;
-    long long dlo[3], dn[3];  /* dense grid: first cell and cells per axis */
-    sp_bin *bins;             /* free bodies sorted by bucket */
-    int (*pairs)[2];
-    int npair, pair_cap;
-    /* contacts: previous evaluation (history) and hash over it */
-    sp_contact *prev, *cur;
-    int nprev, contact_cap;
-    int *hash, *vhash, hash_cap; /* by full key; by (pair, touching vertex); allocated size */
-    int hash_n;               /* table size in use: a power of 2 >= 2 nprev (cost of a rebuild ~ contacts) */
-    sp_thread *thr;
-    int nthr;
-    /* report accumulators over the substeps of one advance */
-    vec3 *rep_f, *rep_t;
-    int rep_n;
-    int *ncontact_body;
-    long long contacts_evaluated; /* work counter: contacts summed over every force evaluation */
-    /* instability report of the last failed advance (lahar_dem_fault) */
-    double max_overlap;       /* overlap limit, fraction of the smaller sweep radius (stability.max_overlap) */
-    lahar_dem_fault fault;
-    int has_fault;
-};
 
 /* ---------------------------------------------------------------------------------------------- */
 
@@ -614,7 +506,10 @@ static inline int bucket_of_level_cell(const lahar_dem_engine *e, int lev, long 
 static int broad_phase(lahar_dem_engine *e)
 {
     e->npair = 0;
-    if (e->nfree > 0) {
+    const sp_spheres *sph = e->sph;
+    /* free spheres meet each other on the fast path (spheropoly_spheres.c): with no other free
+     * body there is nothing to bin */
+    if (e->nfree > 0 && !(sph && e->nfree == sps_nspheres(e))) {
         long long lo[3] = {LLONG_MAX, LLONG_MAX, LLONG_MAX}, hi[3] = {LLONG_MIN, LLONG_MIN, LLONG_MIN};
         for (int k = 0; k < e->nfree; k++) {
             const sp_state *s = &e->st[e->free_ids[k]];
@@ -691,6 +586,7 @@ static int broad_phase(lahar_dem_engine *e)
                                 if ((own && bj->id <= bi.id) || bj->level != lev || bj->c[0] != cx || bj->c[1] != cy ||
                                     bj->c[2] != cz)
                                     continue;
+                                if (e->geo[bi.id].fast_sphere && e->geo[bj->id].fast_sphere) continue;
                                 double r = bi.bound + bj->bound;
                                 if (v3_norm2(v3_sub(bj->x, bi.x)) < r * r && add_pair(e, bi.id, bj->id)) return -1;
                             }
@@ -698,18 +594,33 @@ static int broad_phase(lahar_dem_engine *e)
             }
         }
     }
-    for (int k = 0; k < e->nfree; k++) {
-        int i = e->free_ids[k];
+    /* a sphere meets the fast path's walls there; only the other fixed bodies here */
+    const int *sph_large = NULL;
+    int nsph_large = sph ? sps_general_large(e, &sph_large) : 0;
+    /* without such bodies only the free bodies that are not spheres are visited */
+    const int *fids = sph && nsph_large == 0 ? e->move_ids : e->free_ids;
+    int nf = sph && nsph_large == 0 ? e->nmove_free : e->nfree;
+    for (int k = 0; k < nf; k++) {
+        int i = fids[k];
+        const int *lids = e->large_ids;
+        int nl = e->nlarge;
+        if (e->geo[i].fast_sphere) {
+            lids = sph_large;
+            nl = nsph_large;
+        }
+        if (nl == 0) continue;
         vec3 c = e->st[i].x;
         double r = e->geo[i].bound;
-        for (int l = 0; l < e->nlarge; l++) {
-            const sp_geo *gl = &e->geo[e->large_ids[l]];
+        for (int l = 0; l < nl; l++) {
+            const sp_geo *gl = &e->geo[lids[l]];
             if (c.x + r < gl->aabb_lo.x || c.x - r > gl->aabb_hi.x || c.y + r < gl->aabb_lo.y ||
                 c.y - r > gl->aabb_hi.y || c.z + r < gl->aabb_lo.z || c.z - r > gl->aabb_hi.z)
                 continue;
-            if (add_pair(e, i, e->large_ids[l])) return -1;
+            if (add_pair(e, i, lids[l])) return -1;
         }
     }
+    /* spheres beyond the rim of a fast-path wall: edges and corners of the face */
+    if (sph && sps_fallback_pairs(e, add_pair)) return -1;
     return 0;
 }
 
@@ -720,6 +631,7 @@ static int broad_phase(lahar_dem_engine *e)
  * (advances the tangential springs). Returns 0, or -1 with err set. */
 static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
+    if (e->sph && sps_forces(e, h, err, errlen)) return -1;
     if (broad_phase(e)) {
         snprintf(err, errlen, "spheropoly: out of memory in the broad phase");
         return -1;
@@ -763,12 +675,24 @@ static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errle
         snprintf(err, errlen, "spheropoly: out of memory for the contact history");
         return -1;
     }
-    /* serial accumulation in contact order: bitwise deterministic for any thread count */
-    for (int i = 0; i < e->nbody; i++) {
+    /* serial accumulation in contact order: bitwise deterministic for any thread count. The fast
+     * path's spheres start from their fast-path sums (sps_accumulate), the other bodies from 0. */
+    if (e->sph) {
+        /* no general contact on a sphere: its force is its fast-path sum, which the next kick
+         * takes straight from the fast path (sps_kick) instead of a pass over the body states */
+        int defer = 1;
+        for (int k = 0; k < n && defer; k++) defer = !e->geo[e->prev[k].a].fast_sphere && !e->geo[e->prev[k].b].fast_sphere;
+        if (defer) sps_defer(e);
+        else sps_accumulate(e);
+    }
+    int nother = e->sph ? e->nother : e->nbody;
+    for (int k = 0; k < nother; k++) {
+        int i = e->sph ? e->other_ids[k] : k;
         e->st[i].fc = v3(0.0, 0.0, 0.0);
         e->st[i].tc = v3(0.0, 0.0, 0.0);
         e->ncontact_body[i] = 0;
     }
+    if (e->sph) sps_accumulate_walls(e);
     for (int k = 0; k < n; k++) {
         const sp_contact *c = &e->prev[k];
         sp_state *sa = &e->st[c->a], *sb = &e->st[c->b];
@@ -825,9 +749,13 @@ static void rotate_about_axis(quat *q, vec3 *pi, const double inertia[3], int k,
 static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 {
     /* each body only writes its own state: bitwise the same on any thread count */
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nfree >= SP_PAR_MIN_BODIES)
-    for (int k = 0; k < e->nfree; k++) {
-        int i = e->free_ids[k];
+    /* free spheres have their own loop (spheropoly_spheres.c), the others are listed in move_ids */
+    if (e->sph) sps_kick(e, half, loads);
+    const int *ids = e->sph ? e->move_ids : e->free_ids;
+    int nids = e->sph ? e->nmove_free : e->nfree;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
+    for (int k = 0; k < nids; k++) {
+        int i = ids[k];
         sp_state *s = &e->st[i];
         double m = e->geo[i].mass;
         vec3 f = v3_axpy(m, e->g, s->fc), t = s->tc;
@@ -847,8 +775,11 @@ static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 
 static void drift(lahar_dem_engine *e, double h)
 {
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (e->nbody >= SP_PAR_MIN_BODIES)
-    for (int i = 0; i < e->nbody; i++) {
+    if (e->sph) sps_drift(e, h);
+    int nids = e->sph ? e->nmove : e->nbody;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
+    for (int k = 0; k < nids; k++) {
+        int i = e->sph ? e->move_ids[k] : k;
         sp_geo *g = &e->geo[i];
         sp_state *s = &e->st[i];
         if (g->motion == LAHAR_MOTION_FIXED) continue;
@@ -882,12 +813,24 @@ static void drift(lahar_dem_engine *e, double h)
  * of 1e300 would overflow). */
 static int check_finite(lahar_dem_engine *e, char *err, size_t errlen)
 {
+    /* quick pass: the spheres on their compact copy, then the other free bodies; the full loop
+     * below only runs to name the first offender */
+    if (e->sph && sps_finite(e)) {
+        int ok = 1;
+        for (int k = 0; k < e->nmove_free && ok; k++) {
+            const sp_state *s = &e->st[e->move_ids[k]];
+            double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
+            ok = isfinite(sum) && fabs(s->x.x) <= 1e12 && fabs(s->x.y) <= 1e12 && fabs(s->x.z) <= 1e12;
+        }
+        if (ok) return 0;
+    }
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
         const sp_state *s = &e->st[i];
         double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
+        if (isfinite(sum) && fabs(s->x.x) <= 1e12 && fabs(s->x.y) <= 1e12 && fabs(s->x.z) <= 1e12) continue;
         double far = fmax(fabs(s->x.x), fmax(fabs(s->x.y), fabs(s->x.z)));
-        if (!isfinite(sum) || far > 1e12) {
+        {
             snprintf(err, errlen, "spheropoly: body %d '%s' has a %s state at substep %ld", i, e->names[i],
                      isfinite(sum) ? "runaway (|x| > 1e12 m)" : "non-finite", e->step);
             lahar_dem_fault *f = &e->fault;
@@ -911,7 +854,10 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
     }
     int n = (int)dem_substeps(dt, e->dt_stable);
     double h = dt / n;
-    for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
+    /* the report averages fc + load over the substeps; one substep without loads: the state's fc/tc */
+    int average = !(n == 1 && !loads);
+    if (average)
+        for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
     for (int k = 0; k < n; k++) {
         kick(e, 0.5 * h, loads);
         drift(e, h);
@@ -919,6 +865,7 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
         if (check_finite(e, err, errlen) || compute_forces(e, h, err, errlen)) return -1;
         kick(e, 0.5 * h, loads);
         if (check_finite(e, err, errlen)) return -1;
+        if (!average) continue;
         for (int i = 0; i < e->nbody; i++) {
             vec3 f = e->st[i].fc, t = e->st[i].tc;
             if (loads) {
@@ -929,11 +876,11 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
             e->rep_t[i] = v3_add(e->rep_t[i], t);
         }
     }
-    for (int i = 0; i < e->nbody; i++) {
+    for (int i = 0; average && i < e->nbody; i++) {
         e->rep_f[i] = v3_scale(e->rep_f[i], 1.0 / n);
         e->rep_t[i] = v3_scale(e->rep_t[i], 1.0 / n);
     }
-    e->rep_n = n;
+    e->rep_n = average ? n : 0;
     return n;
 }
 
@@ -950,6 +897,7 @@ static int sp_fault(const lahar_dem_engine *e, lahar_dem_fault *out)
 static void sp_destroy(lahar_dem_engine *e)
 {
     if (!e) return;
+    sps_destroy(e);
     for (int i = 0; i < e->ngrid; i++) geom_feature_grid_free(&e->grids[i]);
     if (e->thr)
         for (int t = 0; t < e->nthr; t++) {
@@ -1321,7 +1269,9 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         snprintf(err, errlen, "spheropoly: out of memory");
         goto fail;
     }
+    if (sps_create(e, err, errlen)) goto fail;
     if (check_finite(e, err, errlen) || compute_forces(e, 0.0, err, errlen)) goto fail;
+    if (e->sph) sps_accumulate(e); /* the body states hold the forces between advances */
     return e;
 fail:
     sp_destroy(e);
@@ -1333,7 +1283,7 @@ fail:
 
 static double sp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
 static int sp_nbody(const lahar_dem_engine *e) { return e->nbody; }
-static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev; }
+static int sp_ncontacts(const lahar_dem_engine *e) { return e->nprev + sps_ncontacts(e); }
 static long long sp_contacts_evaluated(const lahar_dem_engine *e) { return e->contacts_evaluated; }
 
 static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
@@ -1368,7 +1318,8 @@ static double sp_kinetic_energy(const lahar_dem_engine *e)
     return k;
 }
 
-static const char sp_magic[8] = {'L', 'H', 'R', 'S', 'P', 'R', 'S', '1'};
+/* version 2: followed by the springs of the sphere fast path */
+static const char sp_magic[8] = {'L', 'H', 'R', 'S', 'P', 'R', 'S', '2'};
 
 static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
 {
@@ -1379,6 +1330,7 @@ static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
     ok = ok && fwrite(&e->nprev, sizeof(int), 1, f) == 1;
     ok = ok && fwrite(e->prev, sizeof(sp_contact), (size_t)e->nprev, f) == (size_t)e->nprev;
     ok = ok && fwrite(e->ncontact_body, sizeof(int), (size_t)e->nbody, f) == (size_t)e->nbody;
+    ok = ok && sps_write_restart(e, f) == 0;
     return ok ? 0 : -1;
 }
 
@@ -1398,6 +1350,7 @@ static int sp_read_restart(lahar_dem_engine *e, FILE *f)
     e->contact_cap = cap < cap2 ? cap : cap2;
     if (fread(e->prev, sizeof(sp_contact), (size_t)n, f) != (size_t)n) return -1;
     if (fread(e->ncontact_body, sizeof(int), (size_t)nbody, f) != (size_t)nbody) return -1;
+    if (sps_read_restart(e, f)) return -1;
     e->nprev = n;
     e->step = step;
     e->rep_n = 0;

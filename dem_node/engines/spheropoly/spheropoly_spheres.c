@@ -1,0 +1,876 @@
+/* The sphere fast path of the spheropoly engine (dem_node/README.md, "Sphere fast path").
+ *
+ * A free body with one vertex at its centre and no edge or face is a sphere (a disc in 2D). Pairs
+ * of such spheres, and a sphere against a fixed flat wall (one face, 3D), skip the feature
+ * machinery of the general narrow phase: the contact is the centre line (sphere-sphere) or the
+ * projection of the centre on the face (vertex-face), with the same contact laws (dem_contact.h)
+ * and the same conventions as the general path (overlap, contact point in the middle of the
+ * overlap, R*, m*, tangential spring rotated onto the tangent plane).
+ *
+ * Verlet list with skin: the pairs whose swept surfaces are closer than `skin` are listed, sorted
+ * by (sphere a, sphere b), and the list is rebuilt only when a sphere moved more than skin/2 since
+ * the last build (two spheres then closed at most `skin`). The spring of a pair lives in the list
+ * entry; a rebuild hands the springs of the touching pairs over by merging the two sorted lists.
+ * Each sphere sums its contacts in ascending partner order (pair index order of the sorted list),
+ * so the result does not depend on when the list was built: a restart rebuilds the list and
+ * continues bit for bit, and the per-pair and per-sphere loops run on OpenMP threads without
+ * changing a bit (every thread writes only its own entries). */
+#include <float.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include "spheropoly_impl.h"
+
+/* Skin: this fraction of the smallest sphere radius (LAMMPS's bench uses 0.1 d). */
+#define SPS_SKIN_FRACTION 0.2
+/* Parallel loops from this many spheres on: below, a team's fork/join per loop costs more than the
+ * loop (512 spheres on 2 threads took twice the CPU time of 1 thread; 10,000 gained, dem_speed.md). */
+enum { SPS_PAR_MIN = 2048 };
+
+typedef struct {
+    int n, cap;
+    int *a, *b;           /* sphere a, and sphere b > a (sphere list) or wall index (wall list) */
+    vec3 *xi;             /* tangential spring */
+    unsigned char *touch; /* in contact at the last evaluation (xi is its spring, else 0) */
+    unsigned char *fall;  /* wall list: the centre is beyond the face's rim, general path */
+    vec3 *f, *ta, *tb;    /* force on b (wall list: on the sphere), torque on a and on b */
+    double *delta;
+    dem_pair_consts *pc;  /* normal-law constants of the pair (m*, R* fixed) */
+} sps_list;
+
+typedef struct {
+    int n, cap;
+    int *a, *b;
+    vec3 *xi;
+} sps_hist; /* the touching entries of a list, sorted: carried over a rebuild or a restart */
+
+struct sp_spheres {
+    int n;                /* free spheres */
+    int *body;            /* body of sphere k, ascending */
+    int *of_body;         /* per body: sphere index, or -1 */
+    int *wall_of_body;    /* per body: wall index, or -1 */
+    int nwall, *wall_body;
+    int ngen, *gen_large; /* fixed/prescribed bodies that are not fast walls (general path) */
+    double *rad, *mass;
+    int *mat;             /* material */
+    double *iner;         /* moment of inertia (3D: the equal moments; 2D: about z) */
+    int *v0;              /* index of the sphere's vertex in e->vw */
+    /* hot data of the force loops, a copy of e->st kept by sps_kick / sps_drift (SoA by field,
+     * contiguous by sphere); stale after create and read_restart until sps_forces copies it */
+    vec3 *x, *v, *w;
+    int stale;
+    double skin, rmax;
+    vec3 *x0;             /* centres at the last build */
+    int built;
+    sps_list pl, wl;      /* sphere-sphere and sphere-wall lists */
+    sps_hist ph, wh;      /* history hand-over */
+    int *inc_start, *inc, inc_cap; /* per sphere its sphere-sphere entries (CSR, ascending) */
+    int *inc_mid;         /* per sphere: entries [inc_start, inc_mid) have it as b, the rest as a */
+    int *wstart;          /* per sphere its wall entries [wstart[k], wstart[k+1]) */
+    vec3 *sf, *st;        /* per sphere: fast-path force and torque */
+    int *scnt;
+    /* build grid */
+    int *cell_start, *cell_of, *order, ncell_cap;
+    int *cand, cand_cap;
+    int ncontact;
+    int deferred;         /* the spheres' forces are in sf/st/scnt, not yet in the body states */
+};
+
+/* ---------------------------------------------------------------------------------------------- */
+
+static int list_reserve(sps_list *l, int need)
+{
+    if (need <= l->cap) return 0;
+    int c = l->cap > 0 ? l->cap : 256;
+    while (c < need) c *= 2;
+    void *p[10];
+    p[0] = realloc(l->a, sizeof(int) * (size_t)c);
+    if (p[0]) l->a = p[0];
+    p[1] = realloc(l->b, sizeof(int) * (size_t)c);
+    if (p[1]) l->b = p[1];
+    p[2] = realloc(l->xi, sizeof(vec3) * (size_t)c);
+    if (p[2]) l->xi = p[2];
+    p[3] = realloc(l->touch, (size_t)c);
+    if (p[3]) l->touch = p[3];
+    p[4] = realloc(l->fall, (size_t)c);
+    if (p[4]) l->fall = p[4];
+    p[5] = realloc(l->f, sizeof(vec3) * (size_t)c);
+    if (p[5]) l->f = p[5];
+    p[6] = realloc(l->ta, sizeof(vec3) * (size_t)c);
+    if (p[6]) l->ta = p[6];
+    p[7] = realloc(l->tb, sizeof(vec3) * (size_t)c);
+    if (p[7]) l->tb = p[7];
+    p[8] = realloc(l->delta, sizeof(double) * (size_t)c);
+    if (p[8]) l->delta = p[8];
+    p[9] = realloc(l->pc, sizeof(dem_pair_consts) * (size_t)c);
+    if (p[9]) l->pc = p[9];
+    for (int k = 0; k < 10; k++)
+        if (!p[k]) return -1;
+    l->cap = c;
+    return 0;
+}
+
+static void list_free(sps_list *l)
+{
+    free(l->a);
+    free(l->b);
+    free(l->xi);
+    free(l->touch);
+    free(l->fall);
+    free(l->f);
+    free(l->ta);
+    free(l->tb);
+    free(l->delta);
+    free(l->pc);
+}
+
+static int hist_reserve(sps_hist *h, int need)
+{
+    if (need <= h->cap) return 0;
+    int c = h->cap > 0 ? h->cap : 256;
+    while (c < need) c *= 2;
+    int *a = realloc(h->a, sizeof(int) * (size_t)c);
+    if (a) h->a = a;
+    int *b = realloc(h->b, sizeof(int) * (size_t)c);
+    if (b) h->b = b;
+    vec3 *x = realloc(h->xi, sizeof(vec3) * (size_t)c);
+    if (x) h->xi = x;
+    if (!a || !b || !x) return -1;
+    h->cap = c;
+    return 0;
+}
+
+/* The touching entries of list l (already sorted) into h. */
+static int hist_take(sps_hist *h, const sps_list *l)
+{
+    int n = 0;
+    for (int p = 0; p < l->n; p++) n += l->touch[p];
+    if (hist_reserve(h, n)) return -1;
+    h->n = 0;
+    for (int p = 0; p < l->n; p++)
+        if (l->touch[p]) {
+            h->a[h->n] = l->a[p];
+            h->b[h->n] = l->b[p];
+            h->xi[h->n] = l->xi[p];
+            h->n++;
+        }
+    return 0;
+}
+
+/* Hand the springs of h to the equal (a, b) entries of the new list l (both sorted). */
+static void hist_give(const sps_hist *h, sps_list *l)
+{
+    int j = 0;
+    for (int p = 0; p < l->n; p++) {
+        l->touch[p] = 0;
+        l->xi[p] = v3(0.0, 0.0, 0.0);
+        l->fall[p] = 0;
+        l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
+        while (j < h->n && (h->a[j] < l->a[p] || (h->a[j] == l->a[p] && h->b[j] < l->b[p]))) j++;
+        if (j < h->n && h->a[j] == l->a[p] && h->b[j] == l->b[p]) {
+            l->touch[p] = 1;
+            l->xi[p] = h->xi[j];
+        }
+    }
+}
+
+int sps_is_sphere(const lahar_dem_engine *e, int i) { return e->sph && e->sph->of_body[i] >= 0; }
+int sps_is_wall(const lahar_dem_engine *e, int i) { return e->sph && e->sph->wall_of_body[i] >= 0; }
+int sps_ncontacts(const lahar_dem_engine *e) { return e->sph ? e->sph->ncontact : 0; }
+int sps_nspheres(const lahar_dem_engine *e) { return e->sph ? e->sph->n : 0; }
+int sps_general_large(const lahar_dem_engine *e, const int **ids)
+{
+    *ids = e->sph->gen_large;
+    return e->sph->ngen;
+}
+
+int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
+{
+    int ns = 0;
+    for (int k = 0; k < e->nfree; k++) {
+        const sp_geo *g = &e->geo[e->free_ids[k]];
+        vec3 v = e->vb[g->v0];
+        ns += g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 && v.z == 0.0;
+    }
+    if (ns == 0) return 0;
+    sp_spheres *s = calloc(1, sizeof *s);
+    e->sph = s;
+    if (!s) goto oom;
+    int nb = e->nbody;
+    s->of_body = malloc(sizeof(int) * (size_t)nb);
+    s->wall_of_body = malloc(sizeof(int) * (size_t)nb);
+    s->body = malloc(sizeof(int) * (size_t)ns);
+    s->wall_body = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    s->gen_large = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    s->rad = malloc(sizeof(double) * (size_t)ns);
+    s->mass = malloc(sizeof(double) * (size_t)ns);
+    s->mat = malloc(sizeof(int) * (size_t)ns);
+    s->iner = malloc(sizeof(double) * (size_t)ns);
+    s->v0 = malloc(sizeof(int) * (size_t)ns);
+    s->x = malloc(sizeof(vec3) * (size_t)ns);
+    s->v = malloc(sizeof(vec3) * (size_t)ns);
+    s->w = malloc(sizeof(vec3) * (size_t)ns);
+    s->stale = 1;
+    s->x0 = malloc(sizeof(vec3) * (size_t)ns);
+    s->inc_start = calloc((size_t)ns + 1, sizeof(int));
+    s->inc_mid = calloc((size_t)ns + 1, sizeof(int));
+    s->wstart = calloc((size_t)ns + 1, sizeof(int));
+    s->sf = malloc(sizeof(vec3) * (size_t)ns);
+    s->st = malloc(sizeof(vec3) * (size_t)ns);
+    s->scnt = malloc(sizeof(int) * (size_t)ns);
+    s->cell_of = malloc(sizeof(int) * (size_t)ns);
+    s->order = malloc(sizeof(int) * (size_t)ns);
+    s->ncell_cap = 8 * ns + 1024 + 1;
+    s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->v0 || !s->x || !s->v || !s->w ||
+        !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
+        goto oom;
+    double rmin = DBL_MAX;
+    for (int i = 0; i < nb; i++) {
+        sp_geo *g = &e->geo[i];
+        s->of_body[i] = -1;
+        s->wall_of_body[i] = -1;
+        vec3 v = e->vb[g->v0];
+        if (g->motion == LAHAR_MOTION_FREE && g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 &&
+            v.z == 0.0) {
+            s->of_body[i] = s->n;
+            e->geo[i].fast_sphere = 1;
+            s->body[s->n] = i;
+            s->rad[s->n] = g->radius;
+            s->mass[s->n] = g->mass;
+            s->mat[s->n] = g->material;
+            s->iner[s->n] = e->dim == 2 ? g->inertia[2] : g->inertia[0];
+            s->v0[s->n] = g->v0;
+            rmin = fmin(rmin, g->radius);
+            s->rmax = fmax(s->rmax, g->radius);
+            s->n++;
+        } else if (g->motion == LAHAR_MOTION_FIXED && e->dim == 3 && g->nf == 1 && g->grid < 0 &&
+                   e->fstart[g->fs0 + 1] - e->fstart[g->fs0] >= 3) {
+            s->wall_of_body[i] = s->nwall;
+            s->wall_body[s->nwall++] = i;
+        } else if (g->motion != LAHAR_MOTION_FREE) {
+            s->gen_large[s->ngen++] = i;
+        }
+    }
+    s->skin = SPS_SKIN_FRACTION * rmin;
+    e->move_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    e->other_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
+    if (!e->move_ids || !e->other_ids) goto oom;
+    for (int i = 0; i < nb; i++)
+        if (!e->geo[i].fast_sphere) e->other_ids[e->nother++] = i;
+    for (int i = 0; i < nb; i++)
+        if (e->geo[i].motion == LAHAR_MOTION_FREE && !e->geo[i].fast_sphere) e->move_ids[e->nmove++] = i;
+    e->nmove_free = e->nmove;
+    for (int i = 0; i < nb; i++)
+        if (e->geo[i].motion == LAHAR_MOTION_PRESCRIBED) e->move_ids[e->nmove++] = i;
+    /* pre-size for a dense pile: ~7 listed partners per sphere (half list), 2 walls */
+    if (list_reserve(&s->pl, 8 * s->n + 64) || list_reserve(&s->wl, 2 * s->n + 64) || hist_reserve(&s->ph, 8 * s->n + 64) ||
+        hist_reserve(&s->wh, 2 * s->n + 64))
+        goto oom;
+    s->inc_cap = 2 * s->pl.cap;
+    s->inc = malloc(sizeof(int) * (size_t)s->inc_cap);
+    s->cand_cap = 256;
+    s->cand = malloc(sizeof(int) * (size_t)s->cand_cap);
+    if (!s->inc || !s->cand) goto oom;
+    return 0;
+oom:
+    snprintf(err, errlen, "spheropoly: out of memory for the sphere fast path");
+    return -1;
+}
+
+void sps_destroy(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
+    if (!s) return;
+    list_free(&s->pl);
+    list_free(&s->wl);
+    free(s->ph.a);
+    free(s->ph.b);
+    free(s->ph.xi);
+    free(s->wh.a);
+    free(s->wh.b);
+    free(s->wh.xi);
+    free(s->of_body);
+    free(s->wall_of_body);
+    free(s->body);
+    free(s->wall_body);
+    free(s->gen_large);
+    free(s->rad);
+    free(s->mass);
+    free(s->mat);
+    free(s->iner);
+    free(s->v0);
+    free(s->x);
+    free(s->v);
+    free(s->w);
+    free(s->x0);
+    free(s->inc_start);
+    free(s->inc_mid);
+    free(s->inc);
+    free(s->wstart);
+    free(s->sf);
+    free(s->st);
+    free(s->scnt);
+    free(s->cell_of);
+    free(s->order);
+    free(s->cell_start);
+    free(s->cand);
+    free(s);
+    free(e->move_ids);
+    free(e->other_ids);
+    e->move_ids = e->other_ids = NULL;
+    e->sph = NULL;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* List build                                                                                      */
+
+static int cmp_int(const void *a, const void *b) { return (*(const int *)a > *(const int *)b) - (*(const int *)a < *(const int *)b); }
+
+static int build_lists(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
+    const int n = s->n;
+    /* dense grid over the spheres' box, cell >= the largest listed distance of centres */
+    double cs = 2.0 * s->rmax + s->skin;
+    vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
+    for (int k = 0; k < n; k++) {
+        vec3 x = e->st[s->body[k]].x;
+        lo = v3(fmin(lo.x, x.x), fmin(lo.y, x.y), fmin(lo.z, x.z));
+        hi = v3(fmax(hi.x, x.x), fmax(hi.y, x.y), fmax(hi.z, x.z));
+    }
+    long long dn[3];
+    for (;;) { /* coarser cells until the grid fits its pre-sized arrays (a long flume) */
+        dn[0] = (long long)floor((hi.x - lo.x) / cs) + 1;
+        dn[1] = (long long)floor((hi.y - lo.y) / cs) + 1;
+        dn[2] = e->dim == 3 ? (long long)floor((hi.z - lo.z) / cs) + 1 : 1;
+        if ((double)dn[0] * (double)dn[1] * (double)dn[2] <= (double)(s->ncell_cap - 1)) break;
+        cs *= 1.5;
+    }
+    int nc = (int)(dn[0] * dn[1] * dn[2]);
+    memset(s->cell_start, 0, sizeof(int) * (size_t)(nc + 1));
+    for (int k = 0; k < n; k++) {
+        vec3 x = e->st[s->body[k]].x;
+        long long cx = (long long)((x.x - lo.x) / cs), cy = (long long)((x.y - lo.y) / cs);
+        long long cz = e->dim == 3 ? (long long)((x.z - lo.z) / cs) : 0;
+        cx = cx < dn[0] ? cx : dn[0] - 1;
+        cy = cy < dn[1] ? cy : dn[1] - 1;
+        cz = cz < dn[2] ? cz : dn[2] - 1;
+        s->cell_of[k] = (int)((cz * dn[1] + cy) * dn[0] + cx);
+        s->cell_start[s->cell_of[k] + 1]++;
+        s->x0[k] = x;
+    }
+    for (int c = 0; c < nc; c++) s->cell_start[c + 1] += s->cell_start[c];
+    for (int k = 0; k < n; k++) s->order[s->cell_start[s->cell_of[k]]++] = k; /* ascending k per cell */
+    for (int c = nc; c > 0; c--) s->cell_start[c] = s->cell_start[c - 1];
+    s->cell_start[0] = 0;
+    /* sphere-sphere: for each a (ascending) the partners b > a within the skin, ascending */
+    sps_list *pl = &s->pl;
+    pl->n = 0;
+    int zr = e->dim == 3 ? 1 : 0;
+    for (int a = 0; a < n; a++) {
+        int c = s->cell_of[a];
+        long long cx = c % dn[0], cy = (c / dn[0]) % dn[1], cz = c / (dn[0] * dn[1]);
+        vec3 xa = s->x0[a];
+        int m = 0;
+        for (long long z = cz - zr; z <= cz + zr; z++)
+            for (long long y = cy - 1; y <= cy + 1; y++)
+                for (long long x = cx - 1; x <= cx + 1; x++) {
+                    if (x < 0 || y < 0 || z < 0 || x >= dn[0] || y >= dn[1] || z >= dn[2]) continue;
+                    int cc = (int)((z * dn[1] + y) * dn[0] + x);
+                    for (int q = s->cell_start[cc]; q < s->cell_start[cc + 1]; q++) {
+                        int b = s->order[q];
+                        if (b <= a) continue;
+                        double r = s->rad[a] + s->rad[b] + s->skin;
+                        if (v3_norm2(v3_sub(s->x0[b], xa)) >= r * r) continue;
+                        if (m == s->cand_cap) {
+                            int *p = realloc(s->cand, sizeof(int) * (size_t)(2 * s->cand_cap));
+                            if (!p) return -1;
+                            s->cand = p;
+                            s->cand_cap *= 2;
+                        }
+                        s->cand[m++] = b;
+                    }
+                }
+        if (m > 1) qsort(s->cand, (size_t)m, sizeof(int), cmp_int);
+        if (list_reserve(pl, pl->n + m)) return -1;
+        for (int q = 0; q < m; q++) {
+            int b = s->cand[q];
+            double ma = s->mass[a], mb = s->mass[b], ra = s->rad[a], rb = s->rad[b];
+            pl->a[pl->n] = a;
+            pl->b[pl->n] = b;
+            pl->pc[pl->n] = dem_pair_consts_make(&e->laws[s->mat[a] * e->nmat + s->mat[b]], ma * mb / (ma + mb),
+                                                 ra * rb / (ra + rb));
+            pl->n++;
+        }
+    }
+    /* incidence: each sphere's entries in ascending entry index (= ascending partner) */
+    if (2 * pl->n > s->inc_cap) {
+        int c = s->inc_cap;
+        while (c < 2 * pl->n) c *= 2;
+        int *p = realloc(s->inc, sizeof(int) * (size_t)c);
+        if (!p) return -1;
+        s->inc = p;
+        s->inc_cap = c;
+    }
+    memset(s->inc_start, 0, sizeof(int) * (size_t)(n + 1));
+    for (int p = 0; p < pl->n; p++) {
+        s->inc_start[pl->a[p] + 1]++;
+        s->inc_start[pl->b[p] + 1]++;
+    }
+    for (int k = 0; k < n; k++) s->inc_start[k + 1] += s->inc_start[k];
+    for (int p = 0; p < pl->n; p++) { /* p ascending: each sphere's run stays ascending */
+        s->inc[s->inc_start[pl->a[p]]++] = p;
+        s->inc[s->inc_start[pl->b[p]]++] = p;
+    }
+    for (int k = n; k > 0; k--) s->inc_start[k] = s->inc_start[k - 1];
+    s->inc_start[0] = 0;
+    for (int k = 0; k < n; k++) { /* the entries with partner a < k come first (smaller index) */
+        int q = s->inc_start[k];
+        while (q < s->inc_start[k + 1] && pl->b[s->inc[q]] == k) q++;
+        s->inc_mid[k] = q;
+    }
+    /* sphere-wall: walls whose plane is within the skin of the sphere's surface */
+    sps_list *wl = &s->wl;
+    wl->n = 0;
+    for (int a = 0; a < n; a++) {
+        s->wstart[a] = wl->n;
+        for (int w = 0; w < s->nwall; w++) {
+            const sp_geo *g = &e->geo[s->wall_body[w]];
+            double dpl = v3_dot(v3_sub(s->x0[a], e->fw[e->fstart[g->fs0]]), e->nw[g->f0]);
+            if (fabs(dpl) >= s->rad[a] + g->radius + s->skin) continue;
+            if (list_reserve(wl, wl->n + 1)) return -1;
+            wl->a[wl->n] = a;
+            wl->b[wl->n] = w;
+            /* vertex-face: m* = the sphere's mass, R* = its radius (README, contact laws) */
+            wl->pc[wl->n] = dem_pair_consts_make(&e->laws[s->mat[a] * e->nmat + g->material], s->mass[a], s->rad[a]);
+            wl->n++;
+        }
+    }
+    s->wstart[n] = wl->n;
+    s->built = 1;
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Forces                                                                                          */
+
+/* The spring of the last step rotated onto the current tangent plane, magnitude kept (as the
+ * general path's contact_emit). */
+static inline vec3 spring_rotate(vec3 xi, vec3 n)
+{
+    double m0 = v3_norm2(xi);
+    if (m0 == 0.0) return xi;
+    vec3 r = v3_axpy(-v3_dot(xi, n), n, xi);
+    double m1 = v3_norm2(r);
+    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
+}
+
+/* direct = 1 (one thread): the force goes straight into the two spheres' sums (sf, st, scnt) instead
+ * of the entry. In list order each sphere then receives its partners in ascending order, the
+ * order of the per-sphere sums of the threaded path: the same bits. */
+static inline __attribute__((always_inline)) void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h,
+                                                             int direct)
+{
+    sps_list *l = &s->pl;
+    int a = l->a[p], b = l->b[p];
+    double ra = s->rad[a], rb = s->rad[b], rs = ra + rb;
+    vec3 dx = v3_sub(s->x[b], s->x[a]);
+    double d2 = v3_norm2(dx);
+    if (d2 >= rs * rs) {
+        if (l->touch[p]) { /* the sums add every entry: one out of contact holds +0 */
+            l->touch[p] = 0;
+            if (!direct) l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
+        }
+        return;
+    }
+    double d = sqrt(d2);
+    vec3 n = d > 1e-12 * rs ? v3_scale(dx, 1.0 / d) : v3(0.0, 0.0, 1.0);
+    double delta = rs - d;
+    /* contact point in the middle of the overlap: cp = xa + la n = xb - lb n */
+    double la = ra - 0.5 * delta, lb = rb - 0.5 * delta;
+    vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
+    /* v_b(cp) - v_a(cp) = vb - va - (lb wb + la wa) x n */
+    vec3 vr = v3_sub(v3_sub(s->v[b], s->v[a]), v3_cross(v3_axpy(la, s->w[a], v3_scale(s->w[b], lb)), n));
+    double vn = v3_dot(vr, n);
+    vec3 vt = v3_axpy(-vn, n, vr);
+    const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + s->mat[b]];
+    double ks, cn;
+    double fn = dem_normal_force_pc(law, &l->pc[p], delta, -vn, 1.0, &ks, &cn);
+    xi = v3_axpy(h, vt, xi);
+    vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
+    /* torques about the centres: (cp - xa) x (-f) = -la n x ft, (cp - xb) x f = -lb n x ft */
+    vec3 c = v3_cross(n, ft);
+    l->touch[p] = 1;
+    l->xi[p] = xi;
+    l->delta[p] = delta;
+    vec3 f = v3_axpy(fn, n, ft), ta = v3_scale(c, -la), tb = v3_scale(c, -lb);
+    if (direct) {
+        s->sf[a] = v3_sub(s->sf[a], f);
+        s->st[a] = v3_add(s->st[a], ta);
+        s->scnt[a]++;
+        s->sf[b] = v3_add(s->sf[b], f);
+        s->st[b] = v3_add(s->st[b], tb);
+        s->scnt[b]++;
+    } else {
+        l->f[p] = f;
+        l->ta[p] = ta;
+        l->tb[p] = tb;
+    }
+}
+
+/* Sphere a against wall w: vertex-face when the centre projects inside the face, else the pair
+ * goes to the general narrow phase (edges and corners of the face). Force on the sphere. */
+static void wall_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
+{
+    sps_list *l = &s->wl;
+    int a = l->a[p], wb = s->wall_body[l->b[p]];
+    const sp_geo *gw = &e->geo[wb];
+    const vec3 xa = s->x[a];
+    double ra = s->rad[a], rs = ra + gw->radius;
+    int b0 = e->fstart[gw->fs0], m = e->fstart[gw->fs0 + 1] - b0;
+    vec3 nrm = e->nw[gw->f0];
+    double dpl = v3_dot(v3_sub(xa, e->fw[b0]), nrm);
+    l->fall[p] = 0;
+    if (fabs(dpl) >= rs) {
+        l->touch[p] = 0;
+        return;
+    }
+    vec3 c;
+    if (!geom_point_polygon_inside(xa, e->fw + b0, m, nrm, &c)) {
+        l->touch[p] = 0;
+        l->fall[p] = 1;
+        return;
+    }
+    double d = fabs(dpl);
+    vec3 n = dpl >= 0.0 ? nrm : v3_neg(nrm); /* from the wall to the sphere */
+    if (d > 1e-12 * rs) n = v3_scale(v3_sub(xa, c), 1.0 / d);
+    vec3 cp = v3_scale(v3_add(v3_axpy(gw->radius, n, c), v3_axpy(-ra, n, xa)), 0.5);
+    vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
+    vec3 rpa = v3_sub(cp, xa);
+    vec3 vr = v3_add(s->v[a], v3_cross(s->w[a], rpa)); /* the wall is fixed */
+    double vn = v3_dot(vr, n);
+    vec3 vt = v3_axpy(-vn, n, vr);
+    const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + gw->material];
+    double ks, cn, delta = rs - d;
+    double fn = dem_normal_force_pc(law, &l->pc[p], delta, -vn, 1.0, &ks, &cn);
+    xi = v3_axpy(h, vt, xi);
+    vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
+    vec3 f = v3_axpy(fn, n, ft);
+    l->touch[p] = 1;
+    l->xi[p] = xi;
+    l->f[p] = f;
+    l->ta[p] = v3_cross(rpa, f);
+    l->tb[p] = v3_cross(v3_sub(cp, e->st[wb].x), v3_neg(f));
+    l->delta[p] = delta;
+}
+
+static int overlap_fault(lahar_dem_engine *e, int a, int b, double delta, double rmin, vec3 cp, char *err, size_t errlen)
+{
+    snprintf(err, errlen,
+             "spheropoly: overlap %.3g m between bodies %d '%s' and %d '%s' exceeds %g x the smaller sweep radius %.3g m "
+             "at substep %ld (time step too large or bodies interpenetrating)",
+             delta, a, e->names[a], b, e->names[b], e->max_overlap, rmin, e->step);
+    e->fault = (lahar_dem_fault){.body = a, .other = b, .value = delta, .limit = e->max_overlap * rmin, .substep = e->step};
+    snprintf(e->fault.what, sizeof e->fault.what, "overlap");
+    v3_store(cp, e->fault.x);
+    e->has_fault = 1;
+    return -1;
+}
+
+int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
+{
+    sp_spheres *s = e->sph;
+    const int n = s->n;
+    if (s->stale) {
+        for (int k = 0; k < n; k++) {
+            const sp_state *st = &e->st[s->body[k]];
+            s->x[k] = st->x;
+            s->v[k] = st->v;
+            s->w[k] = st->w;
+        }
+        s->stale = 0;
+    }
+    /* rebuild when a sphere moved more than skin/2 since the last build */
+    double lim2 = 0.25 * s->skin * s->skin, worst = 0.0;
+    if (s->built) {
+#pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(max : worst) if (n >= SPS_PAR_MIN)
+        for (int k = 0; k < n; k++) {
+            double d2 = v3_norm2(v3_sub(s->x[k], s->x0[k]));
+            worst = d2 > worst ? d2 : worst;
+        }
+    }
+    if (!s->built || worst > lim2) {
+        /* hand the springs over (after a restart the history is already in ph/wh) */
+        if (s->built && (hist_take(&s->ph, &s->pl) || hist_take(&s->wh, &s->wl))) goto oom;
+        if (build_lists(e)) goto oom;
+        hist_give(&s->ph, &s->pl);
+        hist_give(&s->wh, &s->wl);
+    }
+    sps_list *pl = &s->pl, *wl = &s->wl;
+    int cnt = 0, bad = 0;
+    if (e->nthr == 1 || n < SPS_PAR_MIN) {
+        /* one thread: forces straight into the sums (pair_force, direct), walls after the pairs */
+        memset(s->sf, 0, sizeof(vec3) * (size_t)n);
+        memset(s->st, 0, sizeof(vec3) * (size_t)n);
+        memset(s->scnt, 0, sizeof(int) * (size_t)n);
+        for (int p = 0; p < pl->n; p++) {
+            pair_force(e, s, p, h, 1);
+            if (pl->touch[p]) {
+                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
+                cnt++;
+                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
+        for (int p = 0; p < wl->n; p++) {
+            wall_force(e, s, p, h);
+            if (wl->touch[p]) {
+                int a = wl->a[p];
+                double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
+                cnt++;
+                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+                s->sf[a] = v3_add(s->sf[a], wl->f[p]);
+                s->st[a] = v3_add(s->st[a], wl->ta[p]);
+                s->scnt[a]++;
+            }
+        }
+    } else {
+#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad)
+    {
+#pragma omp for schedule(static)
+        for (int p = 0; p < pl->n; p++) {
+            pair_force(e, s, p, h, 0);
+            if (pl->touch[p]) {
+                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
+                cnt++;
+                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
+#pragma omp for schedule(static)
+        for (int p = 0; p < wl->n; p++) {
+            wall_force(e, s, p, h);
+            if (wl->touch[p]) {
+                double ra = s->rad[wl->a[p]], rb = e->geo[s->wall_body[wl->b[p]]].radius;
+                cnt++;
+                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+            }
+        }
+        /* each sphere sums its own entries in ascending partner order, then its walls */
+#pragma omp for schedule(static)
+        for (int k = 0; k < n; k++) {
+            vec3 f = v3(0.0, 0.0, 0.0), t = v3(0.0, 0.0, 0.0);
+            int m = 0;
+            /* entries out of contact hold +0 (pair_force), adding them changes no bit of a sum
+             * that starts at +0, so there is no branch on the contact state */
+            for (int q = s->inc_start[k]; q < s->inc_mid[k]; q++) {
+                int p = s->inc[q];
+                m += pl->touch[p];
+                f = v3_add(f, pl->f[p]);
+                t = v3_add(t, pl->tb[p]);
+            }
+            for (int q = s->inc_mid[k]; q < s->inc_start[k + 1]; q++) {
+                int p = s->inc[q];
+                m += pl->touch[p];
+                f = v3_sub(f, pl->f[p]);
+                t = v3_add(t, pl->ta[p]);
+            }
+            for (int p = s->wstart[k]; p < s->wstart[k + 1]; p++) {
+                if (!wl->touch[p]) continue;
+                m++;
+                f = v3_add(f, wl->f[p]);
+                t = v3_add(t, wl->ta[p]);
+            }
+            s->sf[k] = f;
+            s->st[k] = t;
+            s->scnt[k] = m;
+        }
+    }
+    }
+    /* the overlap limit: the first offender in list order is reported */
+    for (int p = 0; bad && p < pl->n; p++) {
+        if (!pl->touch[p]) continue;
+        int a = pl->a[p], b = pl->b[p];
+        double rmin = fmin(s->rad[a], s->rad[b]);
+        if (pl->delta[p] > e->max_overlap * rmin) {
+            vec3 xa = e->st[s->body[a]].x, xb = e->st[s->body[b]].x;
+            return overlap_fault(e, s->body[a], s->body[b], pl->delta[p], rmin, v3_scale(v3_add(xa, xb), 0.5), err, errlen);
+        }
+    }
+    for (int p = 0; bad && p < wl->n; p++) {
+        if (!wl->touch[p]) continue;
+        int a = wl->a[p], wb = s->wall_body[wl->b[p]];
+        double rmin = fmin(s->rad[a], e->geo[wb].radius);
+        if (wl->delta[p] > e->max_overlap * rmin)
+            return overlap_fault(e, s->body[a], wb, wl->delta[p], rmin, e->st[s->body[a]].x, err, errlen);
+    }
+    s->ncontact = cnt;
+    e->contacts_evaluated += cnt;
+    return 0;
+oom:
+    snprintf(err, errlen, "spheropoly: out of memory for the sphere neighbour list");
+    return -1;
+}
+
+int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, int))
+{
+    sp_spheres *s = e->sph;
+    for (int p = 0; p < s->wl.n; p++)
+        if (s->wl.fall[p] && add(e, s->body[s->wl.a[p]], s->wall_body[s->wl.b[p]])) return -1;
+    return 0;
+}
+
+void sps_defer(lahar_dem_engine *e) { e->sph->deferred = 1; }
+
+void sps_accumulate(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
+    s->deferred = 0;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        sp_state *st = &e->st[s->body[k]];
+        st->fc = s->sf[k];
+        st->tc = s->st[k];
+        e->ncontact_body[s->body[k]] = s->scnt[k];
+    }
+}
+
+void sps_accumulate_walls(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
+    /* the walls feel the reaction, summed in list order */
+    const sps_list *wl = &s->wl;
+    for (int p = 0; p < wl->n; p++) {
+        if (!wl->touch[p]) continue;
+        int wb = s->wall_body[wl->b[p]];
+        e->st[wb].fc = v3_sub(e->st[wb].fc, wl->f[p]);
+        e->st[wb].tc = v3_add(e->st[wb].tc, wl->tb[p]);
+        e->ncontact_body[wb]++;
+    }
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Integration of the free spheres: the same kick-drift-kick as the general bodies (README,
+ * "Integration") with the sphere's equal moments: w = L / I, and the drift turns the orientation by
+ * the single exact rotation exp(h L / I) (2D: about z). Each sphere writes only its own state. */
+
+void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
+{
+    sp_spheres *s = e->sph;
+    const vec3 g = e->g;
+    const int two_d = e->dim == 2, deferred = s->deferred;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        int i = s->body[k];
+        sp_state *st = &e->st[i];
+        double m = s->mass[k];
+        if (deferred) { /* what sps_accumulate (and compute_forces' 2D projection) would have written */
+            st->fc = s->sf[k];
+            st->tc = s->st[k];
+            if (two_d) {
+                st->fc.z = 0.0;
+                st->tc.x = st->tc.y = 0.0;
+            }
+            e->ncontact_body[i] = s->scnt[k];
+        }
+        vec3 f = v3_axpy(m, g, st->fc), t = st->tc;
+        if (loads) {
+            f = v3_add(f, v3_load(loads[i].force));
+            t = v3_add(t, v3_load(loads[i].torque));
+        }
+        if (two_d) {
+            f.z = 0.0;
+            t.x = t.y = 0.0;
+        }
+        st->v = v3_axpy(half / m, f, st->v);
+        st->L = v3_axpy(half, t, st->L);
+        st->w = two_d ? v3(0.0, 0.0, st->L.z / s->iner[k]) : v3_scale(st->L, 1.0 / s->iner[k]);
+        s->v[k] = st->v;
+        s->w[k] = st->w;
+    }
+    s->deferred = 0;
+}
+
+void sps_drift(lahar_dem_engine *e, double h)
+{
+    const sp_spheres *s = e->sph;
+    const int two_d = e->dim == 2;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        sp_state *st = &e->st[s->body[k]];
+        st->x = v3_axpy(h, st->v, st->x);
+        if (two_d) {
+            st->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * st->L.z / s->iner[k]), st->q));
+        } else {
+            double ln = v3_norm(st->L);
+            if (ln > 0.0) st->q = q_normalize(q_mul(q_axis_angle(v3_scale(st->L, 1.0 / ln), ln / s->iner[k] * h), st->q));
+        }
+        e->vw[s->v0[k]] = st->x; /* the vertex is the centre: x + q 0 */
+        s->x[k] = st->x;
+    }
+}
+
+int sps_finite(const lahar_dem_engine *e)
+{
+    const sp_spheres *s = e->sph;
+    if (s->stale) return 0;
+    int ok = 1;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(& : ok) if (s->n >= SPS_PAR_MIN)
+    for (int k = 0; k < s->n; k++) {
+        vec3 x = s->x[k], v = s->v[k], w = s->w[k];
+        double sum = x.x + x.y + x.z + v.x + v.y + v.z + w.x + w.y + w.z;
+        ok &= isfinite(sum) && fabs(x.x) <= 1e12 && fabs(x.y) <= 1e12 && fabs(x.z) <= 1e12;
+    }
+    return ok;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Restart: the touching entries (sphere a, partner b, spring) of both lists.                      */
+
+static int hist_write(const sps_list *l, FILE *f)
+{
+    int n = 0;
+    for (int p = 0; p < l->n; p++) n += l->touch[p];
+    if (fwrite(&n, sizeof n, 1, f) != 1) return -1;
+    for (int p = 0; p < l->n; p++) {
+        if (!l->touch[p]) continue;
+        int ab[2] = {l->a[p], l->b[p]};
+        if (fwrite(ab, sizeof(int), 2, f) != 2 || fwrite(&l->xi[p], sizeof(vec3), 1, f) != 1) return -1;
+    }
+    return 0;
+}
+
+static int hist_read(sps_hist *h, FILE *f, int na, int nb)
+{
+    int n;
+    if (fread(&n, sizeof n, 1, f) != 1 || n < 0 || hist_reserve(h, n)) return -1;
+    h->n = n;
+    for (int k = 0; k < n; k++) {
+        int ab[2];
+        if (fread(ab, sizeof(int), 2, f) != 2 || fread(&h->xi[k], sizeof(vec3), 1, f) != 1) return -1;
+        if (ab[0] < 0 || ab[0] >= na || ab[1] < 0 || ab[1] >= nb) return -1;
+        h->a[k] = ab[0];
+        h->b[k] = ab[1];
+    }
+    return 0;
+}
+
+int sps_write_restart(const lahar_dem_engine *e, FILE *f)
+{
+    const sp_spheres *s = e->sph;
+    if (!s) return 0;
+    if (fwrite(&s->ncontact, sizeof(int), 1, f) != 1) return -1;
+    return hist_write(&s->pl, f) || hist_write(&s->wl, f) ? -1 : 0;
+}
+
+int sps_read_restart(lahar_dem_engine *e, FILE *f)
+{
+    sp_spheres *s = e->sph;
+    if (!s) return 0;
+    if (fread(&s->ncontact, sizeof(int), 1, f) != 1) return -1;
+    if (hist_read(&s->ph, f, s->n, s->n) || hist_read(&s->wh, f, s->n, s->nwall)) return -1;
+    s->stale = 1;
+    s->deferred = 0;
+    s->built = 0; /* the next evaluation builds the lists at the restart positions and takes ph/wh */
+    return 0;
+}
