@@ -353,7 +353,7 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
     double lag = e->lag + (dt - (double)n * e->h_last);
     int same = e->initialized && fabs(lag) <= LMP_CLOCK_EPS * fabs(t_next);
     if (same) h = e->h_last;
-    e->lag = same ? lag : 0.0;
+    e->lag = e->initialized && h == e->h_last ? lag : dt - (double)n * h; /* a new substep: its own residual */
     e->t_req = t_next;
     /* A new substep length needs LAMMPS' init (`run pre yes`): in this version the `timestep`
      * command between runs does not reach the fixes and the pair style, which keep dt from their
