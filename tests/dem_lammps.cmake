@@ -16,9 +16,15 @@ endif()
 
 if(LAHAR_SANITIZE)
   # OpenMPI's start-up state (MPI_Init inside liblammps) is suppressed in tests/lsan.supp by library;
-  # that needs full stacks and the MCA components still loaded at exit to name them
+  # that needs full stacks and the MCA components still loaded at exit to name them. The same for
+  # the conformance suite's run of `lahar-dem --engine lammps` (tests/dem_conformance.cmake), whose
+  # engine process inherits the environment.
   set_tests_properties(test_dem_lammps dem_lammps_engine_option PROPERTIES ENVIRONMENT
     "OMPI_MCA_mca_base_component_disable_dlclose=1;PMIX_MCA_mca_base_component_disable_dlclose=1;ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0;LSAN_OPTIONS=suppressions=${LAHAR_TEST_DIR}/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
+  if(TEST dem_conformance_lammps)
+    get_test_property(test_dem_lammps ENVIRONMENT lahar_lammps_env)
+    set_tests_properties(dem_conformance_lammps PROPERTIES ENVIRONMENT "${lahar_lammps_env}")
+  endif()
 endif()
 
 

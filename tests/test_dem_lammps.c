@@ -8,6 +8,8 @@
  *  - the same bounce as the spheropoly engine (trajectory; with coupling steps of changing
  *    length, which make the engine init LAMMPS again, the rebound as spheropoly's to 1e-9);
  *  - oblique impacts: sliding against the Coulomb impulse, sticking against spheropoly;
+ *  - coupling steps carrying the round-off of the clock (t_next - t): n substeps per step, one
+ *    substep per step and steps of exactly D give the same oblique Hertz bounce (1e-12);
  *  - what the engine cannot hold is refused at create, naming the body.
  * Exit 77 (ctest SKIP) when lahar was built without liblammps. */
 #include <math.h>
@@ -421,6 +423,70 @@ static void oblique_impacts(void)
     }
 }
 
+/* Coupling steps as the coordinator makes them, dt = t_next - t with t = k D (tested by the
+ * conformance suite's `subcycling` too): they differ from D by the round-off of the clock. A Hertz
+ * sphere thrown obliquely at a plane (the tangential spring of the wall contact carries the spin)
+ * is run in three ways: (a) n substeps per step of D from the clock, (b) the same substeps one per
+ * coupling step of D/n from the clock, (c) n substeps per step of exactly D. Every substep has the
+ * same length in all three (to the round-off of the clock), so the states agree; the engine used
+ * to re-initialise LAMMPS (and restart the wall's tangential spring) whenever two steps differed
+ * by one ulp, and (a) and (b) then differed by 1e-3 m. Tolerance 1e-12 of R, |v|, |omega|: far
+ * above the round-off of the clock (4 eps t), far below that failure. */
+static void clock_roundoff(void)
+{
+    const double g[3] = {0, 0, -9.81}, R = 0.05;
+    lahar_body_state st[3];
+    double D = 0.0;
+    int n = 0;
+    for (int run = 0; run < 3; run++) {
+        lahar_case c;
+        dem_test_case_init(&c, 3, g, 2);
+        int m = dem_test_material(&c, "rock", LAHAR_CONTACT_HERTZ, 2650.0, 0, 1e7, 0.25, 0.7, 0.3);
+        const double centre[3] = {0, 0, -0.02}, nrm[3] = {0, 0, 1}, size[2] = {1, 1}, x[3] = {0, 0, 0.052};
+        dem_test_plane(&c, "floor", m, centre, nrm, size, 0.02);
+        int s = dem_test_sphere(&c, "ball", m, R, x, LAHAR_MOTION_FREE);
+        c.bodies[s].v[0] = 0.4;
+        c.bodies[s].v[2] = -1.0;
+        const lahar_dem_engine_ops *ops;
+        lahar_dem_engine *e = make(&c, &ops);
+        if (!e) {
+            dem_test_case_free(&c);
+            return;
+        }
+        if (run == 0) {
+            D = 3.5 * ops->stable_dt(e);
+            n = (int)ceil(D / ops->stable_dt(e));
+        }
+        const int nD = (int)ceil(0.02 / D), per = run == 1 ? n : 1;
+        const double H = D / per;
+        char err[512] = "";
+        int ok = 1, touched = 0;
+        for (int k = 0; k < nD * per && ok; k++) {
+            double dt = run == 2 ? D : (double)(k + 1) * H - (double)k * H;
+            ok = ops->advance(e, dt, NULL, err, sizeof err) == (run == 1 ? 1 : n);
+            touched |= ops->ncontacts(e) > 0;
+        }
+        dem_test_check(ok && touched, "clock round-off run %d: %d substeps per step, contact seen %s", run,
+                       run == 1 ? 1 : n, err);
+        ops->get_state(e, s, &st[run]);
+        ops->destroy(e);
+        dem_test_case_free(&c);
+    }
+    dem_test_check(st[0].v[2] > 0.0 && fabs(st[0].w[1]) > 1.0, "clock round-off: bounced (v_z %g) with spin %g",
+                   st[0].v[2], st[0].w[1]);
+    for (int r = 1; r < 3; r++) {
+        double dx = 0, dv = 0, dw = 0;
+        for (int a = 0; a < 3; a++) {
+            dx = fmax(dx, fabs(st[r].x[a] - st[0].x[a]));
+            dv = fmax(dv, fabs(st[r].v[a] - st[0].v[a]));
+            dw = fmax(dw, fabs(st[r].w[a] - st[0].w[a]));
+        }
+        dem_test_check(dx <= 1e-12 * R && dv <= 1e-12 * 1.1 && dw <= 1e-12 * fabs(st[0].w[1]),
+                       "clock round-off: %s as %d substeps per step of D: |dx| %.2e m, |dv| %.2e m/s, |dw| %.2e rad/s",
+                       r == 1 ? "1 substep per step of D/n" : "steps of exactly D", n, dx, dv, dw);
+    }
+}
+
 static void refused(void)
 {
     const double g[3] = {0, 0, -9.81};
@@ -470,6 +536,7 @@ int main(void)
     resting();
     two_spheres();
     two_spheres_hertz_changing_steps();
+    clock_roundoff();
     bounces();
     loads_both_engines(2);
     oblique_impacts();

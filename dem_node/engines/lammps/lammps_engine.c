@@ -30,6 +30,9 @@
 #include "vec.h"
 
 #define LMP_MAX_TYPES 256 /* atom types (contact classes); pair coefficients grow with the square */
+/* a coupling step within LMP_CLOCK_EPS x t_next of n x the current substep is the same step: twice
+ * the round-off 2 eps t_next of dt = t_next - t (lmp_advance) */
+#define LMP_CLOCK_EPS (4.0 * DBL_EPSILON)
 
 typedef struct {
     int body;        /* index in the scene */
@@ -59,6 +62,7 @@ struct lahar_dem_engine {
     char (*refix_cmd)[1024];
     int *ncontact_body, ncontacts;
     double dt_stable, h_last, max_overlap;
+    double t_req, lag; /* time the engine was asked to reach; that minus LAMMPS' time (see lmp_advance) */
     int64_t step_start;
     long substep;
     int initialized;
@@ -161,7 +165,7 @@ static int law_coeffs(const dem_pair_law *law, double mstar, char *out, size_t n
 
 /* ---- the step ----------------------------------------------------------------------------------- */
 
-/* fix external's callback, at post_force of every substep (and once in the setup of each `run`):
+/* fix external's callback, at post_force of every substep (and once in the setup of a `run pre yes`):
  * contact forces (pairs and walls) are complete in f and torque, gravity not yet added. */
 static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double **x, double **fext)
 {
@@ -337,13 +341,27 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
         return -1;
     }
     double h = dt / (double)n;
+    /* The coupling step dt = t_next - t comes from the coordinator's clock and carries its
+     * round-off: |dt - D| <= ulp(t) + ulp(t_next) <= 2 eps t_next for a nominal step D. Steps that
+     * differ by that much are the same step: LAMMPS keeps its substep h_last, and the engine keeps
+     * the difference between the time it was asked to advance and the time LAMMPS advanced (lag,
+     * the sum of dt - n h_last, exact to eps dt per step). Only when |lag| would exceed twice the
+     * clock's round-off (LMP_CLOCK_EPS x t_next) does the substep change. Without this, a step
+     * that differs from the last by one ulp re-initialised LAMMPS (below) and restarted the
+     * tangential springs of the Hertz walls at every coupling step. */
+    double t_next = e->t_req + dt;
+    double lag = e->lag + (dt - (double)n * e->h_last);
+    int same = e->initialized && fabs(lag) <= LMP_CLOCK_EPS * fabs(t_next);
+    if (same) h = e->h_last;
+    e->lag = e->initialized && h == e->h_last ? lag : dt - (double)n * h; /* a new substep: its own residual */
+    e->t_req = t_next;
     /* A new substep length needs LAMMPS' init (`run pre yes`): in this version the `timestep`
      * command between runs does not reach the fixes and the pair style, which keep dt from their
      * init. The setup of such a run evaluates the forces again with the full-step velocity; the
      * callback puts back those of the last substep (velocity Verlet goes on unchanged). And an
-     * init changes the damping of a fix wall/gran with `damping tsuji` (measured: README.md
-     * "Step"; as if the restitution were converted to the coefficient again): the Hertz wall
-     * fixes are made anew before every init after the first. */
+     * init applies the restitution -> coefficient polynomial of `damping tsuji` again to the
+     * coefficient of a fix wall/gran(/region) (FixWallGran::init overwrites it in place): the
+     * Hertz wall fixes are made anew before every init after the first. */
     int pre = !e->initialized || h != e->h_last;
     if (pre && e->initialized && e->nrefix > 0) lmp_refix(e);
     /* `run pre no` skips the setup: the first half kick uses the forces left by the last substep
