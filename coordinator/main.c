@@ -179,15 +179,25 @@ static int check_memory(const char *cmd, const lahar_case *cs, const lahar_estim
     return -1;
 }
 
-/* The DEM engine the case names must exist in this build (dem_node/engines/dem_engine_registry.c): said at
- * validation, with the case's file and line, not when the DEM node starts. */
+/* The DEM engine the case names must exist in this build (dem_node/engines/dem_engine_registry.c) and
+ * accept the case (its check_case): said at validation, with the case's file and line, not when the
+ * DEM node starts. */
 static int check_dem_engine(const lahar_case *cs)
 {
-    if (lahar_dem_engine_find(cs->dem_engine))
-        return 0;
-    fprintf(stderr, "%s:%d: dem.engine: unknown DEM engine '%s'; engines in this build: %s\n", cs->path,
-            cs->dem_engine_line, cs->dem_engine, lahar_dem_engine_names());
-    return -1;
+    const lahar_dem_engine_ops *eng = lahar_dem_engine_find(cs->dem_engine);
+    if (!eng) {
+        fprintf(stderr, "%s:%d: dem.engine: unknown DEM engine '%s'; engines in this build: %s\n", cs->path,
+                cs->dem_engine_line, cs->dem_engine, lahar_dem_engine_names());
+        return -1;
+    }
+    /* the engine validates what is its own (the shapes and sections it can run) */
+    char err[1024];
+    if (cs->nbody > 0 && eng->check_case && eng->check_case(cs, err, sizeof err) != 0) {
+        fprintf(stderr, "%s:%d: dem.engine: %s cannot run this case: %s\n", cs->path, cs->dem_engine_line,
+                cs->dem_engine, err);
+        return -1;
+    }
+    return 0;
 }
 
 int main(int argc, char **argv)

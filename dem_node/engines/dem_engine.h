@@ -24,6 +24,10 @@ typedef struct {
     const char *version;
     /* Build from the scene (copies what it needs). Returns NULL and fills err on failure. */
     lahar_dem_engine *(*create)(const lahar_case *scene, char *err, size_t errlen);
+    /* Optional (NULL: the engine takes every case the loader accepts). Whether this engine can run
+     * the case: 0, or -1 with a message naming the body or section and what to do. `lahar validate`
+     * and `lahar run` call it before any node starts, so each engine validates what is its own. */
+    int (*check_case)(const lahar_case *scene, char *err, size_t errlen);
     /* Largest stable step of the engine itself (a fraction of the smallest contact period). */
     double (*stable_dt)(const lahar_dem_engine *e);
     /* Advance all bodies by dt, subcycling with n = ceil(dt / stable_dt) equal substeps when

@@ -522,7 +522,9 @@ static int make_wall(const lahar_case *c, int i, lmp_wall *w, char *err, size_t 
     return 0;
 }
 
-static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errlen)
+/* Everything up to LAMMPS itself; with start = 0 the engine is returned before LAMMPS is opened,
+ * so that check_case can run every refusal without starting it. */
+static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, size_t errlen)
 {
     /* everything LAMMPS could refuse is checked before LAMMPS starts (no exceptions in this build) */
     if (c->checkpoint_interval > 0.0 || c->resume) {
@@ -692,6 +694,12 @@ static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errle
         goto fail;
     }
 
+    if (!start) {
+        free(tmat);
+        free(tmass);
+        free(laws);
+        return e;
+    }
     /* ---- LAMMPS ---- */
     const char *args[] = {"lahar-dem", "-log", "none", "-screen", "none", "-nocite"};
     e->lmp = lammps_open_no_mpi((int)(sizeof args / sizeof args[0]), (char **)args, NULL);
@@ -825,6 +833,18 @@ fail:
     return NULL;
 }
 
+static lahar_dem_engine *lmp_create(const lahar_case *c, char *err, size_t errlen) { return lmp_build(c, 1, err, errlen); }
+
+/* The case's bodies, walls, materials and sections this engine can run (lahar validate, lahar run
+ * before any node starts): the refusals of create, without LAMMPS. */
+static int lmp_check_case(const lahar_case *c, char *err, size_t errlen)
+{
+    lahar_dem_engine *e = lmp_build(c, 0, err, errlen);
+    if (!e) return -1;
+    lmp_destroy(e);
+    return 0;
+}
+
 /* ---- queries ------------------------------------------------------------------------------------ */
 
 static double lmp_stable_dt(const lahar_dem_engine *e) { return e->dt_stable; }
@@ -878,6 +898,7 @@ const lahar_dem_engine_ops lahar_dem_lammps_ops = {
     .name = "lammps",
     .version = "LAMMPS 29Sep2021 (liblammps)",
     .create = lmp_create,
+    .check_case = lmp_check_case,
     .stable_dt = lmp_stable_dt,
     .advance = lmp_advance,
     .nbody = lmp_nbody,
