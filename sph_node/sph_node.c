@@ -37,19 +37,16 @@
 #include "shape_build.h"
 #include "transport.h"
 #include "sph_inflow.h"
+#include "sph_eos.h"
 #include "sph_probes.h"
 #include "vec.h"
 
 #define ROLE LAHAR_ROLE_SPH
 
-/* Density of pressure p by the inverse of the case's EOS: linear rho = rho0 + p / c0^2 (Trujillo-Vela et al. 2020
- * eq. 3), Tait rho = rho0 (1 + gamma p / (rho0 c0^2))^(1/gamma) (Canelas et al. 2015 eq. 19). */
+/* Density of pressure p by the inverse of the case's EOS (sph_node/fluid/sph_eos.h). */
 static double sph_node_eos_density(const lahar_case *c, double p)
 {
-    const double rho0 = c->sph_density, c2 = c->sph.c0 * c->sph.c0;
-    if (c->sph.eos == LAHAR_SPH_EOS_TAIT)
-        return rho0 * pow(1.0 + c->sph.gamma * p / (rho0 * c2), 1.0 / c->sph.gamma);
-    return rho0 + p / c2;
+    return sph_eos_get(c->sph.eos)->density(p, c->sph_density, c->sph.c0, c->sph.gamma);
 }
 
 /* Initial densities of the n particles pts of one block into rho. none: rest density. hydrostatic:

@@ -1,5 +1,6 @@
 /* WCSPH solver core (sph_fluid.h). */
 #include "sph_fluid.h"
+#include "sph_eos.h"
 #include "sph_riemann.h"
 #include <math.h>
 #include <stdio.h>
@@ -171,16 +172,12 @@ void sph_fluid_free(sph_fluid *f)
 
 double sph_fluid_pressure(const sph_params *prm, double rho)
 {
-    if (prm->eos == LAHAR_SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 */
-        return prm->rho0 * prm->c0 * prm->c0 / prm->gamma * (pow(rho / prm->rho0, prm->gamma) - 1.0);
-    return prm->c0 * prm->c0 * (rho - prm->rho0); /* Trujillo-Vela et al. 2020, eq. 3 */
+    return sph_eos_get(prm->eos)->pressure(rho, prm->rho0, prm->c0, prm->gamma);
 }
 
 double sph_fluid_density_of_pressure(const sph_params *prm, double p)
 {
-    if (prm->eos == LAHAR_SPH_EOS_TAIT) /* Canelas et al. 2015, eq. 19 inverted */
-        return prm->rho0 * pow(1.0 + prm->gamma * p / (prm->rho0 * prm->c0 * prm->c0), 1.0 / prm->gamma);
-    return prm->rho0 + p / (prm->c0 * prm->c0); /* Trujillo-Vela et al. 2020, eq. 3 inverted */
+    return sph_eos_get(prm->eos)->density(p, prm->rho0, prm->c0, prm->gamma);
 }
 
 static inline int prm_tvf(const sph_fluid *f) { return f->prm.transport_velocity != 0; }
