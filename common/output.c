@@ -255,13 +255,13 @@ static int out_resume_sidecar(const char *h5path, const char *xmfpath, lahar_xdm
 /* ---------------------------------------------------------------- bodies ---------------- */
 
 typedef struct {
-    hid_t file, t, step, force, torque, ncontacts;
+    hid_t file, t, step, force, torque, ncontacts, energy;
     char path[OUT_PATH_MAX + 16];
     int failed;           /* a flush failed: nothing more is written (the rows before stay readable) */
     int nbody;
     int64_t rows;         /* rows on disk */
     int cap, nbuf;        /* buffered rows */
-    double *bt, *bforce, *btorque;
+    double *bt, *bforce, *btorque, *benergy;
     int64_t *bstep;
     int32_t *bncont;
     double last_flush;
@@ -456,11 +456,11 @@ static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_c
 static int forces_open(forces_stream *fs, const char *path, const lahar_case *c, char *err, size_t n)
 {
     memset(fs, 0, sizeof *fs);
-    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = H5I_INVALID_HID;
+    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = fs->energy = H5I_INVALID_HID;
     int nb = c->nbody;
     fs->nbody = nb;
     fs->interval = c->forces_interval > 0.0 ? c->forces_interval : 0.0;
-    size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 52 + 16;
+    size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 76 + 16;
     fs->cap = (int)(FORCES_BUFFER_BYTES / row_bytes);
     if (fs->cap < 1)
         fs->cap = 1;
@@ -471,8 +471,9 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     fs->bstep = malloc(nrow * sizeof *fs->bstep);
     fs->bforce = malloc(nrow * nb3 * sizeof *fs->bforce);
     fs->btorque = malloc(nrow * nb3 * sizeof *fs->btorque);
+    fs->benergy = malloc(nrow * nb3 * sizeof *fs->benergy);
     fs->bncont = malloc(nrow * (size_t)(nb > 0 ? nb : 1) * sizeof *fs->bncont);
-    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont) {
+    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont || !fs->benergy) {
         snprintf(err, n, "out of memory for the force stream buffer");
         return -1;
     }
@@ -489,9 +490,9 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
             snprintf(err, n, "%s: cannot reopen the force stream to continue it", path);
             return -1;
         }
-        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts};
-        const char *names[] = {"t", "step", "force", "torque", "ncontacts"};
-        for (int k = 0; k < 5; k++)
+        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts, &fs->energy};
+        const char *names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
+        for (int k = 0; k < 6; k++)
             if ((*ids[k] = H5Dopen2(fs->file, names[k], H5P_DEFAULT)) < 0) {
                 snprintf(err, n, "%s: no dataset %s to continue", path, names[k]);
                 return -1;
@@ -535,7 +536,8 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
               {&fs->step, "step", H5T_STD_I64LE, 1, ""},
               {&fs->force, "force", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N/m" : "N"},
               {&fs->torque, "torque", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N m/m" : "N m"},
-              {&fs->ncontacts, "ncontacts", H5T_STD_I32LE, 2, ""}};
+              {&fs->ncontacts, "ncontacts", H5T_STD_I32LE, 2, ""},
+              {&fs->energy, "energy", H5T_IEEE_F64LE, 3, c->dim == 2 ? "J/m" : "J"}};
     int rc = 0;
     for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
         hsize_t dims[3] = {0, (hsize_t)nb, 3}, maxd[3] = {H5S_UNLIMITED, (hsize_t)nb, 3};
@@ -564,7 +566,11 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     rc |= out_attr_string(fs->file, "units", "SI");
     rc |= out_attr_string(fs->file, "description",
                           "contact + external force and torque (about the centre of mass) on each body, time "
-                          "average over the step; fixed bodies: the contact force they receive");
+                          "average over the step; fixed bodies: the contact force they receive. energy: per body "
+                          "[E_P, E_K, E_R] at the end of the step: potential energy -m g . x (m g y_B for gravity "
+                          "along -y, Trujillo-Vela et al. 2020 eq. 37; 0 at the origin), translational kinetic "
+                          "energy m |v|^2 / 2 (eq. 38) and rotational kinetic energy w . I w / 2 (0 for fixed "
+                          "bodies)");
     rc |= out_attr_string(fs->file, "lahar_version", LAHAR_VERSION);
     if (rc || H5Fstart_swmr_write(fs->file) < 0) {
         snprintf(err, n, "%s: cannot create the force datasets / start SWMR writing", path);
@@ -583,7 +589,7 @@ static int forces_flush(forces_stream *fs)
     int64_t last_step = fs->bstep[fs->nbuf - 1];
     double last_t = fs->bt[fs->nbuf - 1];
     /* the rows, plus the chunks they may open (one per dataset, FORCES_BUFFER_BYTES in all) */
-    double need = (double)fs->nbuf * (16.0 + 52.0 * fs->nbody) + FORCES_BUFFER_BYTES;
+    double need = (double)fs->nbuf * (16.0 + 76.0 * fs->nbody) + FORCES_BUFFER_BYTES;
     if (out_room(fs->path, need, "the force rows", last_step, last_t) != 0) {
         fs->failed = 1;
         return -1;
@@ -597,6 +603,7 @@ static int forces_flush(forces_stream *fs)
               {fs->force, H5T_NATIVE_DOUBLE, 3, fs->bforce},
               {fs->torque, H5T_NATIVE_DOUBLE, 3, fs->btorque},
               {fs->ncontacts, H5T_NATIVE_INT32, 2, fs->bncont},
+              {fs->energy, H5T_NATIVE_DOUBLE, 3, fs->benergy},
               {fs->t, H5T_NATIVE_DOUBLE, 1, fs->bt}};
     /* /t is extended, written and flushed last: a SWMR reader that sees n rows in /t finds
      * them in every other dataset */
@@ -633,13 +640,13 @@ static void forces_close(forces_stream *fs)
 {
     if (fs->file >= 0) { /* forces_open set every id (invalid until created) */
         forces_flush(fs);
-        hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts};
+        hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts, fs->energy};
         for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
             if (ids[k] >= 0)
                 H5Dclose(ids[k]);
         out_close(fs->file);
     }
-    free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont);
+    free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont), free(fs->benergy);
     memset(fs, 0, sizeof *fs);
     fs->file = H5I_INVALID_HID;
 }
@@ -838,6 +845,7 @@ int lahar_body_output_forces(lahar_body_output *o, int64_t step, double t, const
     for (int b = 0; b < nb; b++) {
         memcpy(fs->bforce + ((size_t)i * nb + b) * 3, r[b].force, 3 * sizeof(double));
         memcpy(fs->btorque + ((size_t)i * nb + b) * 3, r[b].torque, 3 * sizeof(double));
+        memcpy(fs->benergy + ((size_t)i * nb + b) * 3, r[b].energy, 3 * sizeof(double));
         fs->bncont[(size_t)i * nb + b] = r[b].ncontacts;
     }
     fs->nbuf++;
@@ -1267,8 +1275,8 @@ int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_s
         if (!rc && H5Fincrement_filesize(f, 0) < 0)
             rc = -1;
         if (!rc && i == 0) {
-            static const char *const names[] = {"t", "step", "force", "torque", "ncontacts"};
-            rc = out_trim_rows(f, names, 5, step);
+            static const char *const names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
+            rc = out_trim_rows(f, names, 6, step);
         } else if (!rc) {
             hid_t pg = H5Gopen2(f, "probes", H5P_DEFAULT);
             H5G_info_t info;

@@ -264,6 +264,7 @@ typedef struct {
     double force[3];  /* total contact + external force over the last step, N (time average over substeps) */
     double torque[3]; /* about the centre of mass, N m */
     int ncontacts;    /* active contact points at the end of the step */
+    double energy[3]; /* E_P, E_K, E_R at the end of the step (lahar_body_energy, common/energy.h) */
 } lahar_body_report;
 
 #endif

@@ -3,10 +3,18 @@
 # segment chain) and a sphere on a 30 degree .asc heightmap slide at g (sin - mu cos) within 1 %
 # (`lahar check`, reference incline_roll). The parser errors are fixtures in bad_cases/terrain_*.
 add_test(NAME terrain_disc_slide_2d
-  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/disc_slide_2d.yaml
-          ${CMAKE_CURRENT_BINARY_DIR}/terrain/disc_slide_2d)
+  COMMAND $<TARGET_FILE:lahar> check ${LAHAR_TEST_DIR}/terrain/disc_slide_2d.yaml
+          -o ${CMAKE_CURRENT_BINARY_DIR}/terrain/disc_slide_2d --in-process -q --overwrite)
 add_test(NAME terrain_sphere_slide_3d
-  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/sphere_slide_3d.yaml
-          ${CMAKE_CURRENT_BINARY_DIR}/terrain/sphere_slide_3d)
+  COMMAND $<TARGET_FILE:lahar> check ${LAHAR_TEST_DIR}/terrain/sphere_slide_3d.yaml
+          -o ${CMAKE_CURRENT_BINARY_DIR}/terrain/sphere_slide_3d --in-process -q --overwrite)
 set_tests_properties(terrain_disc_slide_2d terrain_sphere_slide_3d PROPERTIES LABELS "fast;terrain" TIMEOUT 300
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Body energies in forces.h5 (dataset energy: E_P, E_K of Trujillo-Vela et al. 2020 eq. 37-38 and the
+# rotational E_R): a spinning disc falling freely for 0.5 s against the closed form (to 1e-9).
+add_test(NAME terrain_body_energy_2d
+  COMMAND sh -c "\"$1\" run \"$2\" -o \"$3\" --in-process -q --overwrite && \"$4\" \"$5\" \"$3\"" sh
+          $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/falling_disc_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/terrain/falling_disc_2d
+          ${LAHAR_TEST_PYTHON} ${LAHAR_TEST_DIR}/terrain/body_energy_check.py)
+set_tests_properties(terrain_body_energy_2d PROPERTIES LABELS "fast;terrain" TIMEOUT 120)
