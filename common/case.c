@@ -2789,6 +2789,93 @@ static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
+/* trackers: [{name, position, rate}] and control_volumes: [{name, box: {lo, hi}, axis, rate}]:
+ * probes of kinds LAHAR_PROBE_TRACKER / LAHAR_PROBE_CONTROL_VOLUME appended to c->probes
+ * (sph_node/sph_gauges.h). */
+static void read_gauges(reader *r, yaml_node_t *tn, yaml_node_t *vn, lahar_case *c)
+{
+    static const char *const tkeys[] = {"name", "position", "rate", NULL};
+    static const char *const vkeys[] = {"name", "box", "axis", "rate", NULL};
+    static const char *const boxkeys[] = {"lo", "hi", NULL};
+    static const char *const axes[] = {"x", "y", "z", NULL};
+    yaml_node_t *secs[2] = {tn, vn};
+    const char *secname[2] = {"trackers", "control_volumes"};
+    const int dim = r->dim;
+    for (int sct = 0; sct < 2 && !r->failed; sct++) {
+        yaml_node_t *n = secs[sct];
+        if (!n)
+            continue;
+        if (n->type != YAML_SEQUENCE_NODE) {
+            rd_fail(r, n, secname[sct], "expected a list (lines starting with `- `), got %s", node_kind(n));
+            return;
+        }
+        if (c->nblock == 0) {
+            rd_fail(r, n, secname[sct], "%s read the SPH particles, but the case has no sph: blocks", secname[sct]);
+            return;
+        }
+        int cnt = seq_len(n);
+        if (cnt == 0)
+            continue;
+        lahar_probe *np = realloc(c->probes, ((size_t)c->nprobe + cnt) * sizeof *np);
+        if (!np) {
+            rd_fail(r, n, secname[sct], "out of memory");
+            return;
+        }
+        c->probes = np;
+        for (int i = 0; i < cnt && !r->failed; i++) {
+            lahar_probe *pr = &c->probes[c->nprobe];
+            memset(pr, 0, sizeof *pr);
+            c->nprobe++;
+            char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+            snprintf(prefix, sizeof prefix, "%s[%d]", secname[sct], i);
+            snprintf(def, sizeof def, "%s%d", sct == 0 ? "tracker" : "cv", i);
+            rmap pm;
+            if (rmap_open(r, seq_item(r, n, i), prefix, &pm) != 0)
+                return;
+            rmap_check_keys(&pm, sct == 0 ? tkeys : vkeys);
+            rmap_name(&pm, "name", 0, def, pr->name);
+            for (int j = 0; j < c->nprobe - 1 && !r->failed; j++)
+                if (strcmp(c->probes[j].name, pr->name) == 0)
+                    rmap_fail(&pm, "name", "'%s' is already the name of a probe, tracker or control volume; names "
+                              "must be unique", pr->name);
+            pr->body = -1;
+            pr->rate = rmap_num(&pm, "rate", 0, 0.0, "10");
+            if (!r->failed && (!(pr->rate >= 0.0) || !isfinite(pr->rate)))
+                rmap_fail(&pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)",
+                          pr->rate);
+            if (sct == 0) {
+                pr->kind = LAHAR_PROBE_TRACKER;
+                rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[10.0, 0.0, 5.0]" : "[10.0, 5.0]");
+                continue;
+            }
+            pr->kind = LAHAR_PROBE_CONTROL_VOLUME;
+            pr->axis = rmap_enum(&pm, "axis", axes, 0, 0);
+            if (!r->failed && pr->axis >= dim) {
+                rmap_fail(&pm, "axis", "'z' is not an axis of a 2D case; use x or y");
+                return;
+            }
+            yaml_node_t *bx = rmap_get(&pm, "box");
+            if (!bx) {
+                rmap_missing(&pm, "box", dim == 3 ? "{lo: [193.1, -10, 0], hi: [193.6, 10, 50]}"
+                                                  : "{lo: [193.1, 0], hi: [193.6, 50]}");
+                return;
+            }
+            char bk[KEY_MAX];
+            key_join(prefix, "box", bk);
+            rmap xm;
+            if (rmap_open(r, bx, bk, &xm) != 0)
+                return;
+            rmap_check_keys(&xm, boxkeys);
+            rmap_vec(&xm, "lo", dim, pr->x, 1, dim == 3 ? "[0, 0, 0]" : "[0, 0]");
+            rmap_vec(&xm, "hi", dim, pr->hi, 1, dim == 3 ? "[0.5, 1, 1]" : "[0.5, 1]");
+            for (int k = 0; k < dim && !r->failed; k++)
+                if (!(pr->hi[k] > pr->x[k]))
+                    rmap_fail(&xm, "hi", "must be > lo in every component (component %d: %g <= %g)", k, pr->hi[k],
+                              pr->x[k]);
+        }
+    }
+}
+
 static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
 {
     static const char *const keys[] = {"fields", "forces", NULL};
@@ -2946,6 +3033,7 @@ static void read_case(reader *r, lahar_case *c)
         check_overlaps(r, bodies, c);
     read_sph(r, sph, c);
     read_probes(r, rmap_get(&m, "probes"), c);
+    read_gauges(r, rmap_get(&m, "trackers"), rmap_get(&m, "control_volumes"), c);
     read_output(r, rmap_get(&m, "output"), c);
     read_check(r, rmap_get(&m, "check"), c);
 }

@@ -134,6 +134,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->body = a->body;
         b->size = a->size;
         b->rate = a->rate;
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        b->axis = (int8_t)a->axis;
     }
     for (int i = 0; i < c->nmaterial; i++) {
         const lahar_material *a = &c->materials[i];
@@ -445,7 +447,8 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         const lahar_probe_t *a = &m->probes[i];
         lahar_probe *b = &c->probes[i];
         if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
-            (a->kind != LAHAR_PROBE_PRESSURE && a->kind != LAHAR_PROBE_LEVEL) ||
+            a->kind < LAHAR_PROBE_PRESSURE || a->kind > LAHAR_PROBE_CONTROL_VOLUME || a->axis < 0 ||
+            a->axis >= m->dim ||
             (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
             snprintf(err, errlen, "malformed scene message (probe %d)", i);
             lahar_case_free(c);
@@ -459,6 +462,8 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         b->body = a->body;
         b->size = a->size;
         b->rate = a->rate;
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        b->axis = a->axis;
     }
     return 0;
 oom:

@@ -18,3 +18,14 @@ add_test(NAME terrain_body_energy_2d
           $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/falling_disc_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/terrain/falling_disc_2d
           ${LAHAR_TEST_PYTHON} ${LAHAR_TEST_DIR}/terrain/body_energy_check.py)
 set_tests_properties(terrain_body_energy_2d PROPERTIES LABELS "fast;terrain" TIMEOUT 120)
+
+# Trackers and control volumes (gauges.h5, sph_node/sph_gauges.h): a water block translating
+# uniformly without gravity, with a free disc riding above it at the same speed; the tracker
+# follows x = x0 + t, the control volumes hold the closed-form mass, kinetic energy (Trujillo-Vela
+# et al. 2020 eq. 39, the disc's included) and mass flux (tests/terrain/gauges_check.py).
+# Run as separate processes, so the scene message carries the new probe fields.
+add_test(NAME terrain_gauges_uniform_2d
+  COMMAND sh -c "\"$1\" run \"$2\" -o \"$3\" -q --overwrite && \"$4\" \"$5\" \"$3\"" sh
+          $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/gauges_uniform_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/terrain/gauges_uniform_2d
+          ${LAHAR_TEST_PYTHON} ${LAHAR_TEST_DIR}/terrain/gauges_check.py)
+set_tests_properties(terrain_gauges_uniform_2d PROPERTIES LABELS "fast;terrain;netns" TIMEOUT 120)
