@@ -44,6 +44,8 @@ typedef struct {
     double (*terrain_pts)[3]; /* 2D: its polyline */
     int terrain_npts;
     lahar_heightmap terrain_hm; /* 3D: its grid (z NULL without one) */
+    double terrain_radius;      /* its sweep radius */
+    double dx;                  /* sph.dx once read (for sph.blocks[i].between) */
 } reader;
 
 static void rd_fail(reader *r, const yaml_node_t *n, const char *key, const char *fmt, ...)
@@ -1258,6 +1260,7 @@ static void read_terrain(reader *r, yaml_node_t *n, lahar_case *c)
     c->bodies = nb;
     lahar_body *b = &c->bodies[c->nbody++];
     memset(b, 0, sizeof *b);
+    r->terrain_radius = radius;
     snprintf(b->name, sizeof b->name, "%s", name);
     b->material = mi;
     b->motion = LAHAR_MOTION_FIXED;
@@ -1549,8 +1552,11 @@ static void read_block_between(reader *r, yaml_node_t *bn, const char *prefix, l
     }
     double(*poly)[3] = NULL;
     int np = 0;
-    if (lahar_profile_between((const double(*)[3])r->terrain_pts, r->terrain_npts, (const double(*)[3])t, nt, &poly,
-                              &np, err, sizeof err) != 0) {
+    /* no particle closer than the coupling's halo dx/2 to the terrain's surface (a particle
+     * starting inside it gets the penalty's kick, which grows as 1/dt) */
+    const double lift = r->terrain_radius + 0.5 * r->dx;
+    if (lahar_profile_between((const double(*)[3])r->terrain_pts, r->terrain_npts, (const double(*)[3])t, nt, lift,
+                              &poly, &np, err, sizeof err) != 0) {
         free(t);
         rd_fail(r, tn, tkey, "%s", err);
         return;
@@ -2283,6 +2289,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     rmap_check_keys(&m, keys);
     c->sph_dx = rmap_num(&m, "dx", 1, 0.0, "0.01");
+    r->dx = c->sph_dx;
     c->sph_density = rmap_num(&m, "density", 0, 1000.0, "1000");
     if (r->failed)
         return;

@@ -758,6 +758,8 @@ static const lahar_check_reference check_references[] = {
      "momentum balance, nothing through the wall", "escaped_particles", 0.0, lahar_check_granular_impact},
     {"darcy", "water driven through a soil: seepage velocity vs Darcy's k_h i", "darcy_velocity_rel_error", 0.05,
      lahar_check_darcy},
+    {"landslide", "soil mass sliding down a terrain profile: nothing through the terrain, mass kept, deposit length "
+     "and thickness against the field's (Yangbaodi)", "escaped_particles", 0.0, lahar_check_landslide},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

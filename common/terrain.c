@@ -453,8 +453,27 @@ static void poly_push(double (*out)[3], int *m, double x, double y)
     ++*m;
 }
 
-int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], int nt, double (**poly)[3],
-                          int *np, char *err, size_t errlen)
+/* The ground raised by `lift` normal to each segment: segment i's line moved up by
+ * lift sqrt(1 + slope_i^2) (vertically), evaluated at x. */
+static double lifted_line(const double (*g)[3], int i, double lift, double x)
+{
+    const double sl = (g[i + 1][1] - g[i][1]) / (g[i + 1][0] - g[i][0]);
+    return g[i][1] + sl * (x - g[i][0]) + lift * sqrt(1.0 + sl * sl);
+}
+
+/* The raised ground at x: the largest of the raised lines of the segments whose x range, widened
+ * by lift, holds x (at a vertex the two neighbours meet at their intersection). */
+static double lifted_ground(const double (*g)[3], int ng, double lift, double x)
+{
+    double y = -INFINITY;
+    for (int i = 0; i + 1 < ng; i++)
+        if (x >= g[i][0] - lift && x <= g[i + 1][0] + lift)
+            y = fmax(y, lifted_line(g, i, lift, x));
+    return y > -INFINITY ? y : lahar_profile_height(g, ng, x);
+}
+
+int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], int nt, double lift,
+                          double (**poly)[3], int *np, char *err, size_t errlen)
 {
     *poly = NULL;
     *np = 0;
@@ -475,30 +494,47 @@ int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], in
                  "terrain", t[0][0], t[nt - 1][0], g[0][0], g[ng - 1][0]);
         return -1;
     }
-    double(*out)[3] = malloc(((size_t)nt + ng + 2) * sizeof *out);
-    if (!out) {
+    /* the lower boundary: the raised ground at the profile's points, at the intersections of
+     * consecutive raised segments (the raised vertices), sorted by x */
+    double(*low)[3] = malloc(((size_t)nt + ng + 2) * sizeof *low);
+    double(*out)[3] = malloc(((size_t)2 * nt + 2 * ng + 4) * sizeof *out);
+    if (!low || !out) {
+        free(low), free(out);
         terr_err(err, errlen, "out of memory");
         return -1;
     }
-    int m = 0, above = 0;
     const double xl = t[0][0], xr = t[nt - 1][0];
+    int nl = 0;
+    for (int i = 1; i + 1 < ng; i++) {
+        /* where the raised lines of segments i - 1 and i cross (the vertex itself when lift = 0) */
+        double s0 = (g[i][1] - g[i - 1][1]) / (g[i][0] - g[i - 1][0]), s1 = (g[i + 1][1] - g[i][1]) / (g[i + 1][0] - g[i][0]);
+        double xv = g[i][0];
+        if (fabs(s1 - s0) > 1e-12)
+            xv = g[i][0] + lift * (sqrt(1.0 + s0 * s0) - sqrt(1.0 + s1 * s1)) / (s1 - s0);
+        if (xv > xl && xv < xr) {
+            low[nl][0] = xv, low[nl][1] = lifted_ground(g, ng, lift, xv), low[nl][2] = 0.0;
+            nl++;
+        }
+    }
+    int m = 0, above = 0;
     for (int i = 0; i < nt; i++) {
-        double yg = lahar_profile_height(g, ng, t[i][0]);
+        double yg = lifted_ground(g, ng, lift, t[i][0]);
         if (t[i][1] > yg)
             above = 1;
         poly_push(out, &m, t[i][0], fmax(t[i][1], yg));
     }
-    poly_push(out, &m, xr, lahar_profile_height(g, ng, xr));
-    for (int i = ng - 1; i >= 0; i--)
-        if (g[i][0] < xr && g[i][0] > xl)
-            poly_push(out, &m, g[i][0], g[i][1]);
-    poly_push(out, &m, xl, lahar_profile_height(g, ng, xl));
+    poly_push(out, &m, xr, lifted_ground(g, ng, lift, xr));
+    for (int i = nl - 1; i >= 0; i--)
+        poly_push(out, &m, low[i][0], low[i][1]);
+    poly_push(out, &m, xl, lifted_ground(g, ng, lift, xl));
+    free(low);
     if (m > 1 && fabs(out[m - 1][0] - out[0][0]) <= 1e-12 * (1 + fabs(out[0][0])) &&
         fabs(out[m - 1][1] - out[0][1]) <= 1e-12 * (1 + fabs(out[0][1])))
         m--;
     if (!above || m < 3) {
         free(out);
-        terr_err(err, errlen, "the profile is nowhere above the terrain; the region between them is empty");
+        terr_err(err, errlen, "the profile is nowhere above the terrain%s; the region between them is empty",
+                 lift > 0 ? " (its surface and the particles' clearance dx/2)" : "");
         return -1;
     }
     *poly = out;

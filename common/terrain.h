@@ -50,11 +50,13 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
 double lahar_profile_height(const double (*p)[3], int n, double x);
 
 /* The polygon between the ground polyline g (x strictly increasing) and the upper profile t (x
- * strictly increasing, within g's x range): t from left to right, then g back from t's right end
- * to its left end (interpolated there). Where t is below g the region is empty: t is raised to g
- * (the polygon's vertices on g). Consecutive duplicate points are dropped. 0, or -1 with a message
- * (out of range, not increasing, empty region). *poly is malloc'ed. */
-int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], int nt, double (**poly)[3],
-                          int *np, char *err, size_t errlen);
+ * strictly increasing, within g's x range): t from left to right, then the ground back from t's
+ * right end to its left end. The ground is raised by `lift` normal to each of its segments (the
+ * terrain's sweep radius plus the particles' clearance dx/2: no particle starts closer than dx/2
+ * to the terrain's surface); where t is below it the region is empty (t is raised to it).
+ * Consecutive duplicate points are dropped. 0, or -1 with a message (out of range, not
+ * increasing, empty region). *poly is malloc'ed. */
+int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], int nt, double lift,
+                          double (**poly)[3], int *np, char *err, size_t errlen);
 
 #endif
