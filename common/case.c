@@ -1535,7 +1535,7 @@ static void read_block_between(reader *r, yaml_node_t *bn, const char *prefix, l
             rd_fail(r, tn, tkey, "%s (paths are relative to the case file's directory)", err);
             return;
         }
-        if (lahar_heightmap_block(&r->terrain_hm, &top, full, pb, err, sizeof err) != 0)
+        if (lahar_heightmap_block(&r->terrain_hm, &top, full, r->terrain_radius + 0.5 * r->dx, pb, err, sizeof err) != 0)
             rd_fail(r, tn, tkey, "%s", err);
         lahar_heightmap_free(&top);
         return;

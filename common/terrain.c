@@ -259,7 +259,17 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
     return rc;
 }
 
-int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path,
+/* Slope factor sqrt(1 + |grad z|^2) at node (i, j): central differences, one-sided at the edges. */
+static double grid_slope_factor(const lahar_heightmap *h, int i, int j)
+{
+    const int nc = h->ncols, nr = h->nrows;
+    int j0 = j > 0 ? j - 1 : j, j1 = j + 1 < nc ? j + 1 : j, i0 = i > 0 ? i - 1 : i, i1 = i + 1 < nr ? i + 1 : i;
+    double gx = (h->z[(size_t)i * nc + j1] - h->z[(size_t)i * nc + j0]) / ((j1 - j0) * h->cellsize);
+    double gy = (h->z[(size_t)i1 * nc + j] - h->z[(size_t)i0 * nc + j]) / ((i1 - i0) * h->cellsize);
+    return sqrt(1.0 + gx * gx + gy * gy);
+}
+
+int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
                           lahar_particle_block *pb, char *err, size_t errlen)
 {
     const double tol = 1e-9 * (bot->cellsize + fabs(bot->x0) + fabs(bot->y0));
@@ -295,7 +305,8 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     for (int i = 0; i < nr; i++)
         for (int j = 0; j < nc; j++) {
             int k = i * nc + j;
-            double zb = bot->z[k], zt = lahar_heightmap_valid(top, i, j) ? top->z[k] : zb;
+            double zb = bot->z[k] + lift * grid_slope_factor(bot, i, j);
+            double zt = lahar_heightmap_valid(top, i, j) ? top->z[k] : zb;
             if (zt > zb)
                 any = 1;
             else

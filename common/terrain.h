@@ -35,10 +35,11 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
 
 /* The closed region between the terrain `bot` and the upper surface `top` (same grid): top
  * triangles, bottom triangles and side walls around the grid's boundary, as a mesh block
- * (LAHAR_BLOCK_MESH: vert, tri, bounds). A top node below the terrain counts as on it (no soil
- * there); a NODATA top node also. Every bottom node must have data. 0, or -1 with a message
- * naming top_path. */
-int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path,
+ * (LAHAR_BLOCK_MESH: vert, tri, bounds). The terrain is raised by `lift` along its normal
+ * (lift sqrt(1 + |grad z|^2) vertically at each node: the sweep radius plus the particles'
+ * clearance dx/2). A top node below the raised terrain counts as on it (no soil there); a NODATA
+ * top node also. Every bottom node must have data. 0, or -1 with a message naming top_path. */
+int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
                           lahar_particle_block *pb, char *err, size_t errlen);
 
 /* A 2D profile from a CSV file: one point "x,y" per line (also ';', tab or space separated), '#'

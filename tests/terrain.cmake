@@ -29,3 +29,28 @@ add_test(NAME terrain_gauges_uniform_2d
           $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/gauges_uniform_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/terrain/gauges_uniform_2d
           ${LAHAR_TEST_PYTHON} ${LAHAR_TEST_DIR}/terrain/gauges_check.py)
 set_tests_properties(terrain_gauges_uniform_2d PROPERTIES LABELS "fast;terrain;netns" TIMEOUT 120)
+
+# Regions between the terrain and an upper surface (sph.blocks[i].between): the lattice fills a
+# flat slab exactly, dx/2 clear of the terrain's surface (2D profile: 540 particles; 3D heightmaps:
+# 2700), counted by `lahar validate`.
+foreach(name between_2d between_3d)
+  if(name STREQUAL "between_2d")
+    set(count 540)
+  else()
+    set(count 2700)
+  endif()
+  add_test(NAME terrain_${name}
+    COMMAND sh -c "\"$1\" validate \"$2\" | grep -q \"^  $3 particles \"" sh
+            $<TARGET_FILE:lahar> ${LAHAR_TEST_DIR}/terrain/${name}.yaml ${count})
+  set_tests_properties(terrain_${name} PROPERTIES LABELS "fast;terrain" TIMEOUT 60)
+endforeach()
+
+# The Yangbaodi landslide (cases/yangbaodi_2d.yaml, Trujillo-Vela et al. 2020 5.4) at a CI
+# resolution (dx = 0.76 m, 5 s): nothing through the terrain, no particle lost (`lahar check`,
+# reference landslide). The full case (dx = 0.38 m, 30 s) is run once by hand; its numbers are
+# in cases/README.md ("Yangbaodi").
+add_test(NAME terrain_yangbaodi_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/yangbaodi_2d.yaml
+          ${CMAKE_CURRENT_BINARY_DIR}/terrain/yangbaodi_2d dx=0.76 end=5 threads=2)
+set_tests_properties(terrain_yangbaodi_2d PROPERTIES LABELS "slow;validation;terrain" TIMEOUT 900
+  ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
