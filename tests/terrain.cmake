@@ -54,3 +54,9 @@ add_test(NAME terrain_yangbaodi_2d
           ${CMAKE_CURRENT_BINARY_DIR}/terrain/yangbaodi_2d dx=0.76 end=5 threads=2)
 set_tests_properties(terrain_yangbaodi_2d PROPERTIES LABELS "slow;validation;terrain" TIMEOUT 900
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# Trackers, control volumes and body energies continue bitwise across `lahar resume`.
+add_test(NAME terrain_gauges_resume_2d
+  COMMAND sh ${LAHAR_TEST_DIR}/terrain/resume_check.sh $<TARGET_FILE:lahar> ${LAHAR_TEST_PYTHON} ${CMAKE_SOURCE_DIR}
+          ${CMAKE_CURRENT_BINARY_DIR}/terrain/gauges_resume_2d)
+set_tests_properties(terrain_gauges_resume_2d PROPERTIES LABELS "fast;terrain;checkpoint" TIMEOUT 120)
