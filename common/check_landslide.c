@@ -1,5 +1,5 @@
 /* landslide: a 2D soil mass sliding down a terrain profile (case section terrain:) and
- * depositing on it (Trujillo-Vela et al. 2020 §5.4, the Yangbaodi landslide; cases/yangbaodi_2d.yaml).
+ * depositing on it (Trujillo-Vela et al. 2020 section 5.4, the Yangbaodi landslide; cases/yangbaodi_2d.yaml).
  *
  * The terrain is the fixed body named "terrain" (a polyline whose x increases); its core line
  * y_g(x) (the polyline) and surface y_g(x) + R / cos(slope) (R its sweep radius) come from the case.
@@ -9,12 +9,15 @@
  *   mass_change         |n_end - n_0| / n_0, soil particles (equal masses) (bound 0)
  *   deposit_length_m    horizontal extent of the deposit at the end, between the x below which 1 %
  *                       and the x below which 99 % of the soil lies (single particles sprayed
- *                       ahead or left behind do not count), and deposit_length_rel_diff its
- *                       relative difference to the field's 140 m (Trujillo-Vela et al. 2020 §5.4)
+ *                       ahead or left behind do not count), deposit_length_rel_diff its signed
+ *                       relative difference to the field's 140 m (Trujillo-Vela et al. 2020 section 5.4)
+ *                       and deposit_length_rel_error its absolute value (a metric: the bound is the
+ *                       case's; the paper's SPH overestimates the run-out)
  *   runout_m            how far the front (99 % quantile of x) moved; front_x_m where it stopped
  *   deposit_thickness_max_m, deposit_thickness_mean_m  vertical thickness at the end, per column of
  *                       width dx (the highest particle + dx/2 above the terrain's surface), max and
- *                       mean over the columns between the 1 % and 99 % quantiles; the field: 1-5 m
+ *                       mean over the columns between the 1 % and 99 % quantiles; the field: 1-5 m;
+ *                       deposit_thickness_outside_field_m = max(0, 1 m - mean, max - 5 m) (a metric)
  *   kinetic_energy_rel  kinetic energy of the soil at the end / its largest value (settled: small)
  *   speed_max_m_s       the largest particle speed over the snapshots
  * The deposit's surface against the terrain and the initial mass is drawn in check.png. */
@@ -26,7 +29,9 @@
 #include "case.h"
 #include "check.h"
 
-#define LANDSLIDE_FIELD_LENGTH 140.0 /* m, the Yangbaodi deposit (Trujillo-Vela et al. 2020 §5.4) */
+#define LANDSLIDE_FIELD_LENGTH 140.0 /* m, the Yangbaodi deposit (Trujillo-Vela et al. 2020 section 5.4) */
+#define LANDSLIDE_FIELD_THICK_LO 1.0 /* m, its thickness: 1-5 m */
+#define LANDSLIDE_FIELD_THICK_HI 5.0
 
 static double terrain_y(const lahar_shape *s, double x)
 {
@@ -109,6 +114,26 @@ int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_
     lahar_check_curve(r, pl, 0, "terrain (surface)");
     for (int i = 0; i < ts->nv; i++)
         lahar_check_point(r, ts->v[i][0], terrain_surface(ts, ts->v[i][0]));
+    {   /* the initial mass's surface: the highest particle + dx/2 per column of dx */
+        const double xa = xs[0], xb = xs[n0 - 1];
+        const int nc0 = (int)ceil((xb - xa) / dx) + 1;
+        double *top0 = malloc((size_t)nc0 * sizeof *top0);
+        if (top0) {
+            for (int k = 0; k < nc0; k++)
+                top0[k] = -INFINITY;
+            for (int64_t i = 0; i < p->cur_n; i++)
+                if (p->phase[i] == 1) {
+                    int col = (int)floor((p->x[i] - xa) / dx);
+                    if (col >= 0 && col < nc0)
+                        top0[col] = fmax(top0[col], p->y[i] + 0.5 * dx);
+                }
+            lahar_check_curve(r, pl, 0, "initial mass (surface)");
+            for (int k = 0; k < nc0; k++)
+                if (top0[k] > -INFINITY)
+                    lahar_check_point(r, xa + (k + 0.5) * dx, top0[k]);
+            free(top0);
+        }
+    }
     int64_t escaped = 0;
     double ke_max = 0.0, ke_last = 0.0, vmax = 0.0;
     for (int64_t k = 0; k < p->nsnap; k++) {
@@ -167,11 +192,15 @@ int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_
     lahar_check_value(r, "deposit_length_m", L);
     lahar_check_value(r, "deposit_length_field_m", LANDSLIDE_FIELD_LENGTH);
     lahar_check_value(r, "deposit_length_rel_diff", (L - LANDSLIDE_FIELD_LENGTH) / LANDSLIDE_FIELD_LENGTH);
+    lahar_check_value(r, "deposit_length_rel_error", fabs(L - LANDSLIDE_FIELD_LENGTH) / LANDSLIDE_FIELD_LENGTH);
     lahar_check_value(r, "deposit_rear_x_m", x01);
     lahar_check_value(r, "front_x_m", x99);
     lahar_check_value(r, "runout_m", x99 - front0);
     lahar_check_value(r, "deposit_thickness_max_m", tmax);
-    lahar_check_value(r, "deposit_thickness_mean_m", tn > 0 ? tsum / tn : 0.0);
+    const double tmean = tn > 0 ? tsum / tn : 0.0;
+    lahar_check_value(r, "deposit_thickness_mean_m", tmean);
+    lahar_check_value(r, "deposit_thickness_outside_field_m",
+                      fmax(0.0, fmax(LANDSLIDE_FIELD_THICK_LO - tmean, tmax - LANDSLIDE_FIELD_THICK_HI)));
     lahar_check_value(r, "kinetic_energy_rel", ke_max > 0.0 ? ke_last / ke_max : 0.0);
     lahar_check_value(r, "speed_max_m_s", vmax);
     snprintf(r->note, sizeof r->note, "field deposit (Yangbaodi, Trujillo-Vela et al. 2020 section 5.4): about 140 m "
