@@ -332,7 +332,7 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
             t += 4;
         }
     /* side walls: walk the boundary nodes once around */
-    int prev = -1, first = -1;
+    int prev = -1;
     for (int s = 0; s <= nbound; s++) {
         int k, m = s % nbound;
         if (m < nc - 1)
@@ -343,8 +343,6 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
             k = (nr - 1) * nc + (nc - 1 - (m - (nc - 1) - (nr - 1))); /* north row, east to west */
         else
             k = (nr - 1 - (m - 2 * (nc - 1) - (nr - 1))) * nc; /* west column, north to south */
-        if (s == 0)
-            first = k;
         if (prev >= 0) {
             int q[2][3] = {{prev, k, N + k}, {prev, N + k, N + prev}};
             memcpy(pb->tri[t], q, sizeof q);
@@ -352,7 +350,6 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
         }
         prev = k;
     }
-    (void)first;
     pb->kind = LAHAR_BLOCK_MESH;
     pb->nvert = 2 * N;
     pb->ntri = t;
