@@ -48,7 +48,7 @@ endforeach()
 # The Yangbaodi landslide (cases/yangbaodi_2d.yaml, Trujillo-Vela et al. 2020 5.4) at a CI
 # resolution (dx = 0.76 m, 5 s, 16 s on 2 cores): nothing through the terrain, no particle lost
 # (`lahar check`, reference landslide). At 5 s the mass is still on the slope, so the deposit's
-# bounds are lifted in the copy; the full case (dx = 0.38 m, 30 s, 27 min on 2 cores) is run by
+# bounds are lifted in the copy; the full case (dx = 0.38 m, 30 s, 6 min on 2 cores) is run by
 # hand and its numbers are in cases/README.md ("Yangbaodi landslide").
 add_test(NAME terrain_yangbaodi_2d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/yangbaodi_2d.yaml
