@@ -495,7 +495,7 @@ static void coord_take_work(coord_node *n, const lahar_status_t *s)
 }
 
 /* summary.json "flow": the open boundaries' counters of the last SPH STATUS (only for a case with
- * inlets, outlets or a domain box; names in common/output.h) */
+ * inlets, outlets or a domain box; names in common/io/output.h) */
 static void coord_summary_flow(const coord *co, cJSON *root)
 {
     const lahar_case *c = co->c;

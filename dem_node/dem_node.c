@@ -16,6 +16,7 @@
 #include "case.h"
 #include "checkpoint.h"
 #include "dem_engine.h"
+#include "energy.h"
 #include "instability.h"
 #include "node_cli.h"
 #include "lahar_body_state_t.h"
@@ -356,8 +357,10 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
         dem_node_get_states(d);
         if (has_sph && moving > 0 && !st.error)
             dem_node_send_body_state(d, k, step.t_next);
-        for (int i = 0; i < d->ns.scene.nbody; i++)
+        for (int i = 0; i < d->ns.scene.nbody; i++) {
             d->ops->get_report(d->engine, i, &d->reports[i]);
+            lahar_body_energy(&d->ns.scene.bodies[i], &d->states[i], d->ns.scene.gravity, d->reports[i].energy);
+        }
         if (lahar_body_output_forces(d->out, k + 1, step.t_next, d->reports) != 0 && !st.error) {
             st.error = 1;
             snprintf(err, sizeof err, "cannot append to forces.h5 in %s", d->ns.output_dir);

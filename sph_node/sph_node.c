@@ -956,8 +956,10 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
         }
         c->near_valid = 0;
     }
-    if (s->probes.n > 0)
+    if (s->probes.n > 0) {
         lahar_ckpt_i64(f, "probe_next_slot", s->probes.next_slot, s->probes.n);
+        lahar_ckpt_i64(f, "probe_target", s->probes.target, s->probes.n); /* trackers' particles */
+    }
     if (s->has_flow)
         sph_inflow_state_io(&s->flow, p, f);
     return f->failed ? -1 : 0;

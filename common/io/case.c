@@ -21,6 +21,7 @@
 #include "case_keys.h"
 #include "geometry.h"
 #include "kernel.h"
+#include "terrain.h"
 #include "vec.h"
 
 #ifndef M_PI
@@ -39,6 +40,13 @@ typedef struct {
     char *err;
     size_t errlen;
     int dim;
+    /* the terrain: section (terrain.h), kept for sph.blocks[i].between */
+    yaml_node_t *terrain_node;
+    double (*terrain_pts)[3]; /* 2D: its polyline */
+    int terrain_npts;
+    lahar_heightmap terrain_hm; /* 3D: its grid (z NULL without one) */
+    double terrain_radius;      /* its sweep radius */
+    double dx;                  /* sph.dx once read (for sph.blocks[i].between) */
 } reader;
 
 static void rd_fail(reader *r, const yaml_node_t *n, const char *key, const char *fmt, ...)
@@ -1172,6 +1180,103 @@ static void read_bodies(reader *r, yaml_node_t *n, lahar_case *c, mass_cache *mc
     }
 }
 
+/* terrain: {file | points, material, radius, name}: one fixed body appended to the bodies, a chain
+ * of segments (2D: the points, or a CSV of x,y) or two triangles per grid cell (3D: an ESRI ASCII
+ * grid .asc); terrain.h. The polyline / grid stays in the reader for sph.blocks[i].between. */
+static void read_terrain(reader *r, yaml_node_t *n, lahar_case *c)
+{
+    if (!n || r->failed)
+        return;
+    r->terrain_node = n;
+    rmap m;
+    if (rmap_open(r, n, "terrain", &m) != 0)
+        return;
+    rmap_section(&m, "terrain");
+    const int dim = r->dim;
+    char name[LAHAR_NAME_MAX];
+    rmap_name(&m, "name", 0, "terrain", name);
+    const char *mat = rmap_str(&m, "material", 1, NULL, c->nmaterial ? c->materials[0].name : "bed");
+    double radius = rmap_num(&m, "radius", 1, 0.0, "0.05");
+    yaml_node_t *fn = rmap_get(&m, "file"), *pn = rmap_get(&m, "points");
+    if (r->failed)
+        return;
+    if (!(radius > 0)) {
+        rmap_fail(&m, "radius", "must be > 0 m (got %g); it is the sweep radius of the terrain surface (the "
+                  "surface lies radius above the points), e.g. dx/4", radius);
+        return;
+    }
+    if (lahar_case_find_body(c, name) >= 0) {
+        rmap_fail(&m, "name", "'%s' is already the name of a body; give the terrain another name", name);
+        return;
+    }
+    int mi = lahar_case_find_material(c, mat);
+    if (mi < 0 || c->materials[mi].model == LAHAR_CONTACT_SOIL) {
+        rmap_fail(&m, "material", mi < 0 ? "unknown material '%s'; define it in the materials: section"
+                                         : "'%s' is an SPH soil; the terrain needs a DEM material (model: hertz or "
+                                           "linear; its friction is mu_phi against soil)", mat);
+        return;
+    }
+    if (!!fn == !!pn) {
+        rd_fail(r, n, "terrain", dim == 2 ? "give exactly one of points: [[x, y], ...] or file: profile.csv"
+                                          : "give file: terrain.asc (an ESRI ASCII grid)");
+        return;
+    }
+    if (dim == 3 && pn) {
+        rmap_fail(&m, "points", "a 3D terrain is a heightmap: give file: terrain.asc (an ESRI ASCII grid)");
+        return;
+    }
+    char err[1024] = "", full[2048] = "";
+    if (fn) {
+        const char *file = rmap_str(&m, "file", 1, NULL, "terrain.asc");
+        if (r->failed)
+            return;
+        snprintf(full, sizeof full, "%s%s", file[0] == '/' ? "" : r->dir, file);
+    }
+    lahar_shape s;
+    int rc;
+    if (dim == 2) {
+        if (pn) {
+            r->terrain_pts = read_points(r, pn, "terrain.points", 2, &r->terrain_npts);
+            if (!r->terrain_pts)
+                return;
+        } else if (lahar_profile_read_csv(full, &r->terrain_pts, &r->terrain_npts, err, sizeof err) != 0) {
+            rmap_fail(&m, "file", "%s (paths are relative to the case file's directory)", err);
+            return;
+        }
+        rc = lahar_shape_make_polyline(&s, (const double(*)[3])r->terrain_pts, r->terrain_npts, 0, radius, err,
+                                       sizeof err);
+        if (rc != 0) {
+            rd_fail(r, pn ? pn : fn, pn ? "terrain.points" : "terrain.file", "%s; fix the points", err);
+            return;
+        }
+    } else {
+        if (lahar_heightmap_read_asc(full, &r->terrain_hm, err, sizeof err) != 0) {
+            rmap_fail(&m, "file", "%s (paths are relative to the case file's directory)", err);
+            return;
+        }
+        if (lahar_heightmap_shape(&r->terrain_hm, radius, &s, err, sizeof err) != 0) {
+            rmap_fail(&m, "file", "%s: %s", full, err);
+            return;
+        }
+    }
+    lahar_body *nb = realloc(c->bodies, ((size_t)c->nbody + 1) * sizeof *nb);
+    if (!nb) {
+        lahar_shape_free(&s);
+        rd_fail(r, n, "terrain", "out of memory");
+        return;
+    }
+    c->bodies = nb;
+    lahar_body *b = &c->bodies[c->nbody++];
+    memset(b, 0, sizeof *b);
+    r->terrain_radius = radius;
+    snprintf(b->name, sizeof b->name, "%s", name);
+    b->material = mi;
+    b->motion = LAHAR_MOTION_FIXED;
+    b->shape = s;
+    b->q[0] = 1.0;
+    b->convex = 0; /* the general mesh / polyline path */
+}
+
 /* Bodies must not interpenetrate at t = 0 (walls may meet each other). */
 static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
 {
@@ -1215,8 +1320,9 @@ static void check_overlaps(reader *r, yaml_node_t *bodies, lahar_case *c)
              * coordinates written with a few digits); anything more starts with a force kick */
             if (d < halo * (1.0 - 1e-6)) {
                 char key[KEY_MAX];
-                snprintf(key, sizeof key, "bodies[%d]", j);
-                rd_fail(r, seq_item(r, bodies, j), key, "'%s' overlaps '%s' (bodies[%d]) by %.3g m at t = 0 (core "
+                int listed = j < seq_len(bodies);
+                snprintf(key, sizeof key, listed ? "bodies[%d]" : "terrain", j);
+                rd_fail(r, listed ? seq_item(r, bodies, j) : r->terrain_node, key, "'%s' overlaps '%s' (bodies[%d]) by %.3g m at t = 0 (core "
                         "distance %.6g m < sum of radii %.6g m); move the bodies apart", b->name, a->name, i,
                         halo - d, d, halo);
             }
@@ -1285,6 +1391,8 @@ static int seg2_intersect(const double *p0, const double *p1, const double *q0, 
     return 0;
 }
 
+static void check_block_polygon(reader *r, yaml_node_t *pn, const char *key, lahar_particle_block *pb);
+
 static void read_block_polygon(reader *r, yaml_node_t *pn, const char *prefix, lahar_particle_block *pb)
 {
     char key[KEY_MAX];
@@ -1300,6 +1408,14 @@ static void read_block_polygon(reader *r, yaml_node_t *pn, const char *prefix, l
     pb->kind = LAHAR_BLOCK_POLYGON;
     pb->vert = p;
     pb->nvert = np;
+    check_block_polygon(r, pn, key, pb);
+}
+
+/* A polygon block must be simple, with at least 3 vertices and an area. */
+static void check_block_polygon(reader *r, yaml_node_t *pn, const char *key, lahar_particle_block *pb)
+{
+    double(*p)[3] = pb->vert;
+    const int np = pb->nvert;
     if (np < 3) {
         rd_fail(r, pn, key, "a polygon needs at least 3 vertices (got %d)", np);
         return;
@@ -1386,6 +1502,78 @@ static void read_block_stl(reader *r, yaml_node_t *sn, const char *prefix, lahar
                   "(first: between [%g, %g, %g] and [%g, %g, %g]); a fluid region must be watertight", file, open,
                   pb->vert[ea][0], pb->vert[ea][1], pb->vert[ea][2], pb->vert[eb][0], pb->vert[eb][1], pb->vert[eb][2]);
     lahar_particle_block_bounds(pb, 3);
+}
+
+/* between: {top: ...}: the region between the terrain (terrain: section) and an upper surface,
+ * a polygon in 2D (top: [[x, y], ...] or top: profile.csv), a closed mesh in 3D (top: surface.asc
+ * on the terrain's grid); terrain.h. */
+static void read_block_between(reader *r, yaml_node_t *bn, const char *prefix, lahar_particle_block *pb)
+{
+    static const char *const keys[] = {"top", NULL};
+    char key[KEY_MAX], tkey[KEY_MAX], err[1024] = "";
+    key_join(prefix, "between", key);
+    if (!r->terrain_node) {
+        rd_fail(r, bn, key, "a region between the terrain and a surface needs a terrain: section");
+        return;
+    }
+    rmap m;
+    if (rmap_open(r, bn, key, &m) != 0)
+        return;
+    rmap_check_keys(&m, keys);
+    yaml_node_t *tn = rmap_get(&m, "top");
+    if (!tn) {
+        rmap_missing(&m, "top", r->dim == 2 ? "[[x, y], ...]  (or a CSV file of x,y)" : "surface.asc");
+        return;
+    }
+    key_join(key, "top", tkey);
+    char full[2048] = "";
+    if (tn->type == YAML_SCALAR_NODE) {
+        const char *file = scalar(tn);
+        snprintf(full, sizeof full, "%s%s", file[0] == '/' ? "" : r->dir, file);
+        if (strlen(file) < sizeof pb->source)
+            snprintf(pb->source, sizeof pb->source, "%s", file);
+    }
+    if (r->dim == 3) {
+        if (tn->type != YAML_SCALAR_NODE) {
+            rd_fail(r, tn, tkey, "in 3D the upper surface is an ESRI ASCII grid on the terrain's grid: top: surface.asc");
+            return;
+        }
+        lahar_heightmap top;
+        if (lahar_heightmap_read_asc(full, &top, err, sizeof err) != 0) {
+            rd_fail(r, tn, tkey, "%s (paths are relative to the case file's directory)", err);
+            return;
+        }
+        if (lahar_heightmap_block(&r->terrain_hm, &top, full, r->terrain_radius + 0.5 * r->dx, pb, err, sizeof err) != 0)
+            rd_fail(r, tn, tkey, "%s", err);
+        lahar_heightmap_free(&top);
+        return;
+    }
+    double(*t)[3] = NULL;
+    int nt = 0;
+    if (tn->type == YAML_SCALAR_NODE) {
+        if (lahar_profile_read_csv(full, &t, &nt, err, sizeof err) != 0) {
+            rd_fail(r, tn, tkey, "%s (paths are relative to the case file's directory)", err);
+            return;
+        }
+    } else if (!(t = read_points(r, tn, tkey, 2, &nt))) {
+        return;
+    }
+    double(*poly)[3] = NULL;
+    int np = 0;
+    /* no particle closer than the coupling's halo dx/2 to the terrain's surface (a particle
+     * starting inside it gets the penalty's kick, which grows as 1/dt) */
+    const double lift = r->terrain_radius + 0.5 * r->dx;
+    if (lahar_profile_between((const double(*)[3])r->terrain_pts, r->terrain_npts, (const double(*)[3])t, nt, lift,
+                              &poly, &np, err, sizeof err) != 0) {
+        free(t);
+        rd_fail(r, tn, tkey, "%s", err);
+        return;
+    }
+    free(t);
+    pb->kind = LAHAR_BLOCK_POLYGON;
+    pb->vert = poly;
+    pb->nvert = np;
+    check_block_polygon(r, tn, tkey, pb);
 }
 
 /* phase: water (default) | soil, and for soil the model: soil material it is made of. */
@@ -1677,14 +1865,19 @@ static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c,
             rmap_fail(bmo, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
     read_block_phase(bmo, pb, phases, c);
     yaml_node_t *bx = rmap_get(bmo, "box"), *pg = rmap_get(bmo, "polygon"), *st = rmap_get(bmo, "stl");
+    yaml_node_t *bw = rmap_get(bmo, "between");
     if (r->failed)
         return;
-    if (!!bx + !!pg + !!st != 1) {
-        if (!bx && !pg && !st)
+    if (!!bx + !!pg + !!st + !!bw != 1) {
+        if (!bx && !pg && !st && !bw)
             rmap_missing(bmo, "box", dim == 3 ? "{lo: [0, 0, 0], hi: [0.1, 0.1, 0.1]}  (or polygon: / stl:)"
                                               : "{lo: [0, 0], hi: [0.1, 0.1]}  (or polygon: [[x, y], ...])");
         else
-            rd_fail(r, n, prefix, "give exactly one of box, polygon (2D) or stl (3D) per block");
+            rd_fail(r, n, prefix, "give exactly one of box, polygon (2D), stl (3D) or between per block");
+        return;
+    }
+    if (bw) {
+        read_block_between(r, bw, prefix, pb);
         return;
     }
     if (pg) {
@@ -2075,6 +2268,7 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     rmap_section(&m, "sph");
     c->sph_dx = key_num(&m, "dx");
     c->sph_density = key_num(&m, "density");
+    r->dx = c->sph_dx;
     if (r->failed)
         return;
     const double dx = c->sph_dx;
@@ -2562,6 +2756,91 @@ static void read_probes(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
+/* trackers: [{name, position, rate}] and control_volumes: [{name, box: {lo, hi}, axis, rate}]:
+ * probes of kinds LAHAR_PROBE_TRACKER / LAHAR_PROBE_CONTROL_VOLUME appended to c->probes
+ * (sph_node/probes/sph_gauges.h). */
+static void read_gauges(reader *r, yaml_node_t *tn, yaml_node_t *vn, lahar_case *c)
+{
+    static const char *const boxkeys[] = {"lo", "hi", NULL};
+    static const char *const axes[] = {"x", "y", "z", NULL};
+    yaml_node_t *secs[2] = {tn, vn};
+    const char *secname[2] = {"trackers", "control_volumes"};
+    const int dim = r->dim;
+    for (int sct = 0; sct < 2 && !r->failed; sct++) {
+        yaml_node_t *n = secs[sct];
+        if (!n)
+            continue;
+        if (n->type != YAML_SEQUENCE_NODE) {
+            rd_fail(r, n, secname[sct], "expected a list (lines starting with `- `), got %s", node_kind(n));
+            return;
+        }
+        if (c->nblock == 0) {
+            rd_fail(r, n, secname[sct], "%s read the SPH particles, but the case has no sph: blocks", secname[sct]);
+            return;
+        }
+        int cnt = seq_len(n);
+        if (cnt == 0)
+            continue;
+        lahar_probe *np = realloc(c->probes, ((size_t)c->nprobe + cnt) * sizeof *np);
+        if (!np) {
+            rd_fail(r, n, secname[sct], "out of memory");
+            return;
+        }
+        c->probes = np;
+        for (int i = 0; i < cnt && !r->failed; i++) {
+            lahar_probe *pr = &c->probes[c->nprobe];
+            memset(pr, 0, sizeof *pr);
+            c->nprobe++;
+            char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+            snprintf(prefix, sizeof prefix, "%s[%d]", secname[sct], i);
+            snprintf(def, sizeof def, "%s%d", sct == 0 ? "tracker" : "cv", i);
+            rmap pm;
+            if (rmap_open(r, seq_item(r, n, i), prefix, &pm) != 0)
+                return;
+            rmap_section(&pm, sct == 0 ? "trackers[]" : "control_volumes[]");
+            rmap_name(&pm, "name", 0, def, pr->name);
+            for (int j = 0; j < c->nprobe - 1 && !r->failed; j++)
+                if (strcmp(c->probes[j].name, pr->name) == 0)
+                    rmap_fail(&pm, "name", "'%s' is already the name of a probe, tracker or control volume; names "
+                              "must be unique", pr->name);
+            pr->body = -1;
+            pr->rate = rmap_num(&pm, "rate", 0, 0.0, "10");
+            if (!r->failed && (!(pr->rate >= 0.0) || !isfinite(pr->rate)))
+                rmap_fail(&pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)",
+                          pr->rate);
+            if (sct == 0) {
+                pr->kind = LAHAR_PROBE_TRACKER;
+                rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[10.0, 0.0, 5.0]" : "[10.0, 5.0]");
+                continue;
+            }
+            pr->kind = LAHAR_PROBE_CONTROL_VOLUME;
+            pr->axis = rmap_enum(&pm, "axis", axes, 0, 0);
+            if (!r->failed && pr->axis >= dim) {
+                rmap_fail(&pm, "axis", "'z' is not an axis of a 2D case; use x or y");
+                return;
+            }
+            yaml_node_t *bx = rmap_get(&pm, "box");
+            if (!bx) {
+                rmap_missing(&pm, "box", dim == 3 ? "{lo: [193.1, -10, 0], hi: [193.6, 10, 50]}"
+                                                  : "{lo: [193.1, 0], hi: [193.6, 50]}");
+                return;
+            }
+            char bk[KEY_MAX];
+            key_join(prefix, "box", bk);
+            rmap xm;
+            if (rmap_open(r, bx, bk, &xm) != 0)
+                return;
+            rmap_check_keys(&xm, boxkeys);
+            rmap_vec(&xm, "lo", dim, pr->x, 1, dim == 3 ? "[0, 0, 0]" : "[0, 0]");
+            rmap_vec(&xm, "hi", dim, pr->hi, 1, dim == 3 ? "[0.5, 1, 1]" : "[0.5, 1]");
+            for (int k = 0; k < dim && !r->failed; k++)
+                if (!(pr->hi[k] > pr->x[k]))
+                    rmap_fail(&xm, "hi", "must be > lo in every component (component %d: %g <= %g)", k, pr->hi[k],
+                              pr->x[k]);
+        }
+    }
+}
+
 static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
 {
     /* bit i = field_names[i], matching LAHAR_PFIELD_* in output.h */
@@ -2980,9 +3259,9 @@ static void read_case(reader *r, lahar_case *c)
     rmap_vec(&m, "gravity", c->dim, c->gravity, 0, "");
     read_time(r, root, rmap_get(&m, "time"), c);
     yaml_node_t *mat = rmap_get(&m, "materials"), *bodies = rmap_get(&m, "bodies"), *sph = rmap_get(&m, "sph");
-    if (!r->failed && bodies && !mat)
+    if (!r->failed && (bodies || rmap_get(&m, "terrain")) && !mat)
         rmap_missing(&m, "materials", "{rock: {density: 2650, young: 1e8, restitution: 0.5, friction: 0.5}}");
-    if (!r->failed && !bodies && !sph)
+    if (!r->failed && !bodies && !sph && !rmap_get(&m, "terrain"))
         rd_fail(r, root, "bodies", "the case has neither bodies nor an sph section; add at least one");
     if (mat)
         read_materials(r, mat, c);
@@ -2999,14 +3278,16 @@ static void read_case(reader *r, lahar_case *c)
             read_bodies(r, bodies, c, &mc, line);
         mass_cache_free(&mc);
         free(line);
-        if (!r->failed)
-            check_overlaps(r, bodies, c);
     }
+    read_terrain(r, rmap_get(&m, "terrain"), c);
+    if (bodies && !r->failed)
+        check_overlaps(r, bodies, c);
     read_sph(r, sph, c);
     read_probes(r, rmap_get(&m, "probes"), c);
     read_inlets(r, rmap_get(&m, "inlets"), c);
     read_outlets(r, rmap_get(&m, "outlets"), c);
     read_domain(r, rmap_get(&m, "domain"), c);
+    read_gauges(r, rmap_get(&m, "trackers"), rmap_get(&m, "control_volumes"), c);
     read_output(r, rmap_get(&m, "output"), c);
     read_check(r, rmap_get(&m, "check"), c);
 }
@@ -3046,6 +3327,8 @@ static int case_load_bytes(const char *path, const char *base_dir, const void *d
     r.doc = &doc;
     snprintf(out->path, sizeof out->path, "%s", path);
     read_case(&r, out);
+    free(r.terrain_pts);
+    lahar_heightmap_free(&r.terrain_hm);
     yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
     if (r.failed) {

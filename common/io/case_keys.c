@@ -27,6 +27,9 @@ static const lahar_key top_keys[] = {
     {"checkpoint", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "coordinated checkpoints for lahar resume (none without it)"},
     {"output", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "what the snapshots and streams hold"},
     {"check", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the reference lahar check compares the run with"},
+    {"terrain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "a fixed DEM body from a 2D profile (points or CSV) or a 3D ESRI ASCII heightmap"},
+    {"trackers", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "material points followed through the run (OUT/gauges.h5)"},
+    {"control_volumes", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "boxes where kinetic energy, mass and mass flux are recorded (OUT/gauges.h5)"},
     {"inlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections where water enters with a hydrograph (cases/README.md)"},
     {"outlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections beyond which particles are removed and counted"},
     {"domain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: particles outside this box are removed and counted"},
@@ -187,6 +190,7 @@ static const lahar_key block_keys[] = {
     {"initial", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{file: F.h5}: per-particle vx, vy (, vz), pressure in lattice order"},
     {"phase", LAHAR_KEY_CHOICE, 0, "water", 0, 0, 0, phases, "", "water or soil"},
     {"material", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "soil blocks: a materials entry with model: soil (required for soil)"},
+    {"between", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{top: ...}: the region between the terrain and an upper surface (2D polyline, 3D grid file)"},
     END};
 
 static const char *const shapes[] = {"sphere", "disc", "box", "segment", "polyline", "polygon", "polyhedron",
@@ -212,6 +216,29 @@ static const lahar_key body_keys[] = {
     {"scale", LAHAR_KEY_NUMBER, 0, "1", LOX, 0, 0, NULL, "", "stl: factor on the file's coordinates (0.001 for mm)"},
     END};
 
+
+static const lahar_key terrain_keys[] = {
+    {"name", LAHAR_KEY_TEXT, 0, "terrain", 0, 0, 0, NULL, "", "the body's name"},
+    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "2D: a CSV of x,y; 3D: an ESRI ASCII grid (.asc); relative to the case file (or points)"},
+    {"points", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] the profile, instead of file"},
+    {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a DEM material (its friction is the bed's mu_phi against soil)"},
+    {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sweep radius of the surface (it lies radius above the points)"},
+    END};
+
+static const char *const cv_axes[] = {"x", "y", "z", NULL};
+static const lahar_key tracker_keys[] = {
+    {"name", LAHAR_KEY_TEXT, 0, "tracker<i>", 0, 0, 0, NULL, "", "unique name"},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the particle nearest this point at t = 0 is followed"},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output)"},
+    END};
+
+static const lahar_key control_volume_keys[] = {
+    {"name", LAHAR_KEY_TEXT, 0, "cv<i>", 0, 0, 0, NULL, "", "unique name"},
+    {"box", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]}: kinetic energy (Trujillo-Vela et al. 2020 eq. 39) and mass inside"},
+    {"axis", LAHAR_KEY_CHOICE, 0, "x", 0, 0, 0, cv_axes, "", "direction of the mass flux recorded through the box"},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output)"},
+    END};
+
 static const lahar_key_section sections[] = {
     {"", "the top level of a case file", top_keys},
     {"time", "duration, step bounds and output intervals (required)", time_keys},
@@ -221,6 +248,9 @@ static const lahar_key_section sections[] = {
     {"sph", "weakly compressible SPH and its coupling with the bodies (Trujillo-Vela et al. 2020 sec. 2.1, 4; Canelas et al. 2015 sec. 3)", sph_keys},
     {"sph.periodic", "periodic axes of the fluid", periodic_keys},
     {"sph.blocks[]", "a region filled with particles on the lattice lo + (i + 1/2) dx", block_keys},
+    {"terrain", "the ground as one fixed DEM body (optional)", terrain_keys},
+    {"trackers[]", "a material point followed through the run", tracker_keys},
+    {"control_volumes[]", "a box where energies, mass and mass flux are recorded", control_volume_keys},
     {"probes[]", "a pressure probe or a water-level gauge, sampled into OUT/gauges.h5", probe_keys},
     {"stability", "the instability checks (optional)", stability_keys},
     {"checkpoint", "coordinated checkpoints (optional; lahar resume)", checkpoint_keys},

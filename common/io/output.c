@@ -259,13 +259,13 @@ static int out_resume_sidecar(const char *h5path, const char *xmfpath, lahar_xdm
 /* ---------------------------------------------------------------- bodies ---------------- */
 
 typedef struct {
-    hid_t file, t, step, force, torque, ncontacts;
+    hid_t file, t, step, force, torque, ncontacts, energy;
     char path[OUT_PATH_MAX + 16];
     int failed;           /* a flush failed: nothing more is written (the rows before stay readable) */
     int nbody;
     int64_t rows;         /* rows on disk */
     int cap, nbuf;        /* buffered rows */
-    double *bt, *bforce, *btorque;
+    double *bt, *bforce, *btorque, *benergy;
     int64_t *bstep;
     int32_t *bncont;
     double last_flush;
@@ -460,11 +460,11 @@ static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_c
 static int forces_open(forces_stream *fs, const char *path, const lahar_case *c, char *err, size_t n)
 {
     memset(fs, 0, sizeof *fs);
-    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = H5I_INVALID_HID;
+    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = fs->energy = H5I_INVALID_HID;
     int nb = c->nbody;
     fs->nbody = nb;
     fs->interval = c->forces_interval > 0.0 ? c->forces_interval : 0.0;
-    size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 52 + 16;
+    size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 76 + 16;
     fs->cap = (int)(FORCES_BUFFER_BYTES / row_bytes);
     if (fs->cap < 1)
         fs->cap = 1;
@@ -475,8 +475,9 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     fs->bstep = malloc(nrow * sizeof *fs->bstep);
     fs->bforce = malloc(nrow * nb3 * sizeof *fs->bforce);
     fs->btorque = malloc(nrow * nb3 * sizeof *fs->btorque);
+    fs->benergy = malloc(nrow * nb3 * sizeof *fs->benergy);
     fs->bncont = malloc(nrow * (size_t)(nb > 0 ? nb : 1) * sizeof *fs->bncont);
-    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont) {
+    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont || !fs->benergy) {
         snprintf(err, n, "out of memory for the force stream buffer");
         return -1;
     }
@@ -493,9 +494,9 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
             snprintf(err, n, "%s: cannot reopen the force stream to continue it", path);
             return -1;
         }
-        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts};
-        const char *names[] = {"t", "step", "force", "torque", "ncontacts"};
-        for (int k = 0; k < 5; k++)
+        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts, &fs->energy};
+        const char *names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
+        for (int k = 0; k < 6; k++)
             if ((*ids[k] = H5Dopen2(fs->file, names[k], H5P_DEFAULT)) < 0) {
                 snprintf(err, n, "%s: no dataset %s to continue", path, names[k]);
                 return -1;
@@ -539,7 +540,8 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
               {&fs->step, "step", H5T_STD_I64LE, 1, ""},
               {&fs->force, "force", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N/m" : "N"},
               {&fs->torque, "torque", H5T_IEEE_F64LE, 3, c->dim == 2 ? "N m/m" : "N m"},
-              {&fs->ncontacts, "ncontacts", H5T_STD_I32LE, 2, ""}};
+              {&fs->ncontacts, "ncontacts", H5T_STD_I32LE, 2, ""},
+              {&fs->energy, "energy", H5T_IEEE_F64LE, 3, c->dim == 2 ? "J/m" : "J"}};
     int rc = 0;
     for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
         hsize_t dims[3] = {0, (hsize_t)nb, 3}, maxd[3] = {H5S_UNLIMITED, (hsize_t)nb, 3};
@@ -568,7 +570,11 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     rc |= out_attr_string(fs->file, "units", "SI");
     rc |= out_attr_string(fs->file, "description",
                           "contact + external force and torque (about the centre of mass) on each body, time "
-                          "average over the step; fixed bodies: the contact force they receive");
+                          "average over the step; fixed bodies: the contact force they receive. energy: per body "
+                          "[E_P, E_K, E_R] at the end of the step: potential energy -m g . x (m g y_B for gravity "
+                          "along -y, Trujillo-Vela et al. 2020 eq. 37; 0 at the origin), translational kinetic "
+                          "energy m |v|^2 / 2 (eq. 38) and rotational kinetic energy w . I w / 2 (0 for fixed "
+                          "bodies)");
     rc |= out_attr_string(fs->file, "lahar_version", LAHAR_VERSION);
     if (rc || H5Fstart_swmr_write(fs->file) < 0) {
         snprintf(err, n, "%s: cannot create the force datasets / start SWMR writing", path);
@@ -587,7 +593,7 @@ static int forces_flush(forces_stream *fs)
     int64_t last_step = fs->bstep[fs->nbuf - 1];
     double last_t = fs->bt[fs->nbuf - 1];
     /* the rows, plus the chunks they may open (one per dataset, FORCES_BUFFER_BYTES in all) */
-    double need = (double)fs->nbuf * (16.0 + 52.0 * fs->nbody) + FORCES_BUFFER_BYTES;
+    double need = (double)fs->nbuf * (16.0 + 76.0 * fs->nbody) + FORCES_BUFFER_BYTES;
     if (out_room(fs->path, need, "the force rows", last_step, last_t) != 0) {
         fs->failed = 1;
         return -1;
@@ -601,6 +607,7 @@ static int forces_flush(forces_stream *fs)
               {fs->force, H5T_NATIVE_DOUBLE, 3, fs->bforce},
               {fs->torque, H5T_NATIVE_DOUBLE, 3, fs->btorque},
               {fs->ncontacts, H5T_NATIVE_INT32, 2, fs->bncont},
+              {fs->energy, H5T_NATIVE_DOUBLE, 3, fs->benergy},
               {fs->t, H5T_NATIVE_DOUBLE, 1, fs->bt}};
     /* /t is extended, written and flushed last: a SWMR reader that sees n rows in /t finds
      * them in every other dataset */
@@ -637,13 +644,13 @@ static void forces_close(forces_stream *fs)
 {
     if (fs->file >= 0) { /* forces_open set every id (invalid until created) */
         forces_flush(fs);
-        hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts};
+        hid_t ids[] = {fs->t, fs->step, fs->force, fs->torque, fs->ncontacts, fs->energy};
         for (size_t k = 0; k < sizeof ids / sizeof ids[0]; k++)
             if (ids[k] >= 0)
                 H5Dclose(ids[k]);
         out_close(fs->file);
     }
-    free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont);
+    free(fs->bt), free(fs->bstep), free(fs->bforce), free(fs->btorque), free(fs->bncont), free(fs->benergy);
     memset(fs, 0, sizeof *fs);
     fs->file = H5I_INVALID_HID;
 }
@@ -842,6 +849,7 @@ int lahar_body_output_forces(lahar_body_output *o, int64_t step, double t, const
     for (int b = 0; b < nb; b++) {
         memcpy(fs->bforce + ((size_t)i * nb + b) * 3, r[b].force, 3 * sizeof(double));
         memcpy(fs->btorque + ((size_t)i * nb + b) * 3, r[b].torque, 3 * sizeof(double));
+        memcpy(fs->benergy + ((size_t)i * nb + b) * 3, r[b].energy, 3 * sizeof(double));
         fs->bncont[(size_t)i * nb + b] = r[b].ncontacts;
     }
     fs->nbuf++;
@@ -1275,27 +1283,46 @@ int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_s
         if (!rc && H5Fincrement_filesize(f, 0) < 0)
             rc = -1;
         if (!rc && i == 0) {
-            static const char *const names[] = {"t", "step", "force", "torque", "ncontacts"};
-            rc = out_trim_rows(f, names, 5, step);
+            static const char *const names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
+            rc = out_trim_rows(f, names, 6, step);
         } else if (!rc) {
-            hid_t pg = H5Gopen2(f, "probes", H5P_DEFAULT);
-            H5G_info_t info;
-            if (pg < 0 || H5Gget_info(pg, &info) < 0)
-                rc = -1;
-            for (hsize_t k = 0; !rc && k < info.nlinks; k++) {
-                char name[LAHAR_NAME_MAX + 8];
-                if (H5Lget_name_by_idx(pg, ".", H5_INDEX_NAME, H5_ITER_INC, k, name, sizeof name, H5P_DEFAULT) < 0) {
+            static const char *const groups[] = {"probes", "trackers", "control_volumes"};
+            for (int gi = 0; gi < 3 && !rc; gi++) {
+                if (H5Lexists(f, groups[gi], H5P_DEFAULT) <= 0)
+                    continue;
+                hid_t pg = H5Gopen2(f, groups[gi], H5P_DEFAULT);
+                H5G_info_t info;
+                if (pg < 0 || H5Gget_info(pg, &info) < 0)
                     rc = -1;
-                    break;
+                for (hsize_t k = 0; !rc && k < info.nlinks; k++) {
+                    char name[LAHAR_NAME_MAX + 8];
+                    if (H5Lget_name_by_idx(pg, ".", H5_INDEX_NAME, H5_ITER_INC, k, name, sizeof name, H5P_DEFAULT) < 0) {
+                        rc = -1;
+                        break;
+                    }
+                    hid_t g = H5Gopen2(pg, name, H5P_DEFAULT);
+                    /* every dataset of the gauge: t, step and its values */
+                    H5G_info_t gi2;
+                    char dn[LAHAR_PROBE_MAX_VALUES + 2][16];
+                    const char *dnames[LAHAR_PROBE_MAX_VALUES + 2];
+                    int nd = 0;
+                    if (g < 0 || H5Gget_info(g, &gi2) < 0)
+                        rc = -1;
+                    for (hsize_t d = 0; !rc && d < gi2.nlinks && nd < LAHAR_PROBE_MAX_VALUES + 2; d++) {
+                        if (H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, d, dn[nd], sizeof dn[nd],
+                                               H5P_DEFAULT) < 0)
+                            rc = -1;
+                        else
+                            dnames[nd] = dn[nd], nd++;
+                    }
+                    if (!rc)
+                        rc = out_trim_rows(g, dnames, nd, step);
+                    if (g >= 0)
+                        H5Gclose(g);
                 }
-                hid_t g = H5Gopen2(pg, name, H5P_DEFAULT);
-                static const char *const names[] = {"t", "step", "p"};
-                rc = g < 0 ? -1 : out_trim_rows(g, names, 3, step);
-                if (g >= 0)
-                    H5Gclose(g);
+                if (pg >= 0)
+                    H5Gclose(pg);
             }
-            if (pg >= 0)
-                H5Gclose(pg);
         }
         if (f >= 0 && H5Fclose(f) < 0)
             rc = -1;
@@ -1693,12 +1720,37 @@ const char *const lahar_output_run_files[] = {
 #define GAUGE_BUFFER_ROWS 1024
 
 typedef struct {
-    hid_t t, step, p;
+    hid_t t, step, v[LAHAR_PROBE_MAX_VALUES];
+    int nv;                /* values per row (lahar_probe_nvalues) */
     int64_t rows;
     int nbuf;
-    double *bt, *bp;
+    double *bt, *bp;       /* bp: value c of buffered row i at bp[c * GAUGE_BUFFER_ROWS + i] */
     int64_t *bstep;
 } gauge_stream;
+
+/* Where a gauge of this kind lives in gauges.h5, and its value datasets with their units. */
+static const char *gauge_group(int kind)
+{
+    return kind == LAHAR_PROBE_TRACKER ? "trackers" : kind == LAHAR_PROBE_CONTROL_VOLUME ? "control_volumes" : "probes";
+}
+
+static const char *gauge_value_name(int kind, int c)
+{
+    static const char *const tr[] = {"x", "y", "z", "vx", "vy", "vz", "id"};
+    static const char *const cv[] = {"ek", "ek_water", "ek_soil", "ek_bodies", "mass_water", "mass_soil",
+                                     "flux_water", "flux_soil"};
+    return kind == LAHAR_PROBE_TRACKER ? tr[c] : kind == LAHAR_PROBE_CONTROL_VOLUME ? cv[c]
+                                                 : kind == LAHAR_PROBE_LEVEL ? "h" : "p";
+}
+
+static const char *gauge_value_units(int kind, int c, int dim)
+{
+    if (kind == LAHAR_PROBE_TRACKER)
+        return c < 3 ? "m" : c < 6 ? "m/s" : "";
+    if (kind == LAHAR_PROBE_CONTROL_VOLUME)
+        return c < 4 ? (dim == 2 ? "J/m" : "J") : c < 6 ? (dim == 2 ? "kg/m" : "kg") : (dim == 2 ? "kg/(m s)" : "kg/s");
+    return kind == LAHAR_PROBE_LEVEL ? "m" : "Pa";
+}
 
 struct lahar_gauge_output {
     hid_t file;
@@ -1719,7 +1771,7 @@ static int gauge_flush(lahar_gauge_output *o)
     double last_t = 0.0;
     for (int k = 0; k < o->n; k++)
         if (o->g[k].nbuf > 0) {
-            need += 24.0 * o->g[k].nbuf + 3.0 * 8.0 * GAUGE_BUFFER_ROWS; /* rows, and the chunks they may open */
+            need += 8.0 * (2 + o->g[k].nv) * (o->g[k].nbuf + GAUGE_BUFFER_ROWS); /* rows, and the chunks they may open */
             last_step = o->g[k].bstep[o->g[k].nbuf - 1];
             last_t = o->g[k].bt[o->g[k].nbuf - 1];
         }
@@ -1735,9 +1787,14 @@ static int gauge_flush(lahar_gauge_output *o)
         struct {
             hid_t id, mtype;
             const void *buf;
-        } ds[] = {{g->step, H5T_NATIVE_INT64, g->bstep}, {g->p, H5T_NATIVE_DOUBLE, g->bp}, {g->t, H5T_NATIVE_DOUBLE, g->bt}};
-        /* t last: a SWMR reader that sees n rows of t finds them in step and p */
-        for (size_t d = 0; d < sizeof ds / sizeof ds[0]; d++) {
+        } ds[LAHAR_PROBE_MAX_VALUES + 2];
+        int nds = 0;
+        ds[nds].id = g->step, ds[nds].mtype = H5T_NATIVE_INT64, ds[nds++].buf = g->bstep;
+        for (int c = 0; c < g->nv; c++)
+            ds[nds].id = g->v[c], ds[nds].mtype = H5T_NATIVE_DOUBLE, ds[nds++].buf = g->bp + (size_t)c * GAUGE_BUFFER_ROWS;
+        ds[nds].id = g->t, ds[nds].mtype = H5T_NATIVE_DOUBLE, ds[nds++].buf = g->bt;
+        /* t last: a SWMR reader that sees n rows of t finds them in step and the values */
+        for (int d = 0; d < nds; d++) {
             hsize_t newd = start + rows;
             if (H5Dset_extent(ds[d].id, &newd) < 0) {
                 rc = -1;
@@ -1779,9 +1836,12 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
     o->file = H5I_INVALID_HID;
     for (int k = 0; k < o->n; k++) {
         gauge_stream *g = &o->g[k];
-        g->t = g->step = g->p = H5I_INVALID_HID;
+        g->t = g->step = H5I_INVALID_HID;
+        g->nv = lahar_probe_nvalues(c->probes[k].kind);
+        for (int v = 0; v < LAHAR_PROBE_MAX_VALUES; v++)
+            g->v[v] = H5I_INVALID_HID;
         g->bt = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bt);
-        g->bp = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bp);
+        g->bp = malloc((size_t)g->nv * GAUGE_BUFFER_ROWS * sizeof *g->bp);
         g->bstep = malloc(GAUGE_BUFFER_ROWS * sizeof *g->bstep);
         if (!g->bt || !g->bp || !g->bstep) {
             snprintf(err, n, "out of memory for the gauge stream");
@@ -1800,12 +1860,13 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
         int rc = o->file < 0 ? -1 : 0;
         for (int k = 0; k < o->n && !rc; k++) {
             gauge_stream *g = &o->g[k];
-            char name[LAHAR_NAME_MAX + 32];
-            hid_t *ids[] = {&g->t, &g->step, &g->p};
-            const char *dn[] = {"t", "step", "p"};
-            for (int d = 0; d < 3 && !rc; d++) {
-                snprintf(name, sizeof name, "probes/%s/%s", c->probes[k].name, dn[d]);
-                if ((*ids[d] = H5Dopen2(o->file, name, H5P_DEFAULT)) < 0)
+            char name[LAHAR_NAME_MAX + 48];
+            const int kind = c->probes[k].kind;
+            for (int d = -2; d < g->nv && !rc; d++) {
+                hid_t *id = d == -2 ? &g->t : d == -1 ? &g->step : &g->v[d];
+                snprintf(name, sizeof name, "%s/%s/%s", gauge_group(kind), c->probes[k].name,
+                         d == -2 ? "t" : d == -1 ? "step" : gauge_value_name(kind, d));
+                if ((*id = H5Dopen2(o->file, name, H5P_DEFAULT)) < 0)
                     rc = -1;
             }
             if (!rc) {
@@ -1846,44 +1907,76 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
                           "below sum V W = 0.1: 0), averaged over the sensor's segment (2D) or disc (3D) of diameter "
                           "size. Level gauges: the top of the water column on the floor along the vertical line from "
                           "position (on the floor) up to top, the first point going up where sum V W (mirrored at "
-                          "the floor) falls to 0.5, above the floor (0: dry)");
+                          "the floor) falls to 0.5, above the floor (0: dry). trackers (case section trackers:): "
+                          "per tracker /trackers/NAME/t, step, x, y, z (m), vx, vy, vz (m/s) of the particle nearest "
+                          "its position at t = 0 and that particle's id. control volumes (control_volumes:): per "
+                          "box /control_volumes/NAME/t, step, ek (sum of m |v|^2 / 2 of the particles and bodies "
+                          "inside, Trujillo-Vela et al. 2020 eq. 39), ek_water, ek_soil, ek_bodies (its parts; a "
+                          "body counts when its centre is inside), mass_water, mass_soil (particle mass inside), "
+                          "flux_water, flux_soil (sum of m v_axis inside / the box's length along axis: the mean "
+                          "mass flow rate through its cross-section). 2D: per unit thickness");
     rc |= out_attr_string(o->file, "lahar_version", LAHAR_VERSION);
-    hid_t pg = out_group(o->file, "probes");
-    if (pg < 0)
-        rc = -1;
+    hid_t pg = -1;
     const char **names = malloc((size_t)o->n * sizeof *names);
-    for (int k = 0; k < o->n && pg >= 0 && !rc; k++) {
+    int nnames = 0;
+    for (int k = 0; k < o->n && !rc; k++) {
         const lahar_probe *pr = &c->probes[k];
         gauge_stream *g = &o->g[k];
-        if (names)
-            names[k] = pr->name;
+        const int kind = pr->kind;
+        if (names && kind <= LAHAR_PROBE_LEVEL)
+            names[nnames++] = pr->name;
+        /* the kind's top group: created by its first gauge, opened by the others */
+        pg = H5Lexists(o->file, gauge_group(kind), H5P_DEFAULT) > 0 ? H5Gopen2(o->file, gauge_group(kind), H5P_DEFAULT)
+                                                                     : out_group(o->file, gauge_group(kind));
+        if (pg < 0) {
+            rc = -1;
+            break;
+        }
         hid_t gg = out_group(pg, pr->name);
+        H5Gclose(pg);
+        pg = -1;
         if (gg < 0) {
             rc = -1;
             break;
         }
         const int level = pr->kind == LAHAR_PROBE_LEVEL;
-        rc |= out_attr_string(gg, "kind", level ? "level" : "pressure");
-        rc |= out_attr(gg, "position", H5T_NATIVE_DOUBLE, 3, pr->x);
-        if (level) {
-            rc |= out_attr_double(gg, "floor", pr->x[c->dim - 1]);
-            rc |= out_attr_double(gg, "top", pr->top);
+        if (kind == LAHAR_PROBE_TRACKER || kind == LAHAR_PROBE_CONTROL_VOLUME) {
+            const int tr = kind == LAHAR_PROBE_TRACKER;
+            rc |= out_attr_string(gg, "kind", tr ? "tracker" : "control_volume");
+            rc |= out_attr(gg, tr ? "position" : "lo", H5T_NATIVE_DOUBLE, 3, pr->x);
+            if (!tr) {
+                rc |= out_attr(gg, "hi", H5T_NATIVE_DOUBLE, 3, pr->hi);
+                rc |= out_attr_string(gg, "axis", pr->axis == 0 ? "x" : pr->axis == 1 ? "y" : "z");
+            }
+            rc |= out_attr_double(gg, "rate", pr->rate);
+        } else {
+            rc |= out_attr_string(gg, "kind", level ? "level" : "pressure");
+            rc |= out_attr(gg, "position", H5T_NATIVE_DOUBLE, 3, pr->x);
+            if (level) {
+                rc |= out_attr_double(gg, "floor", pr->x[c->dim - 1]);
+                rc |= out_attr_double(gg, "top", pr->top);
+            }
+            rc |= out_attr_string(gg, "body", pr->body >= 0 ? c->bodies[pr->body].name : "");
+            if (pr->body >= 0)
+                rc |= out_attr(gg, "normal", H5T_NATIVE_DOUBLE, 3, pr->n);
+            rc |= out_attr_double(gg, "size", pr->size);
+            rc |= out_attr_double(gg, "rate", pr->rate);
+            rc |= out_attr_string(gg, "method", level ? "level: first z up from the floor with sum V W = 0.5"
+                                                : pr->body >= 0 ? "wall: Adami, Hu & Adams 2012 eq. 27"
+                                                                : "fluid: Shepard interpolation (DualSPHysics MeasureTool)");
         }
-        rc |= out_attr_string(gg, "body", pr->body >= 0 ? c->bodies[pr->body].name : "");
-        if (pr->body >= 0)
-            rc |= out_attr(gg, "normal", H5T_NATIVE_DOUBLE, 3, pr->n);
-        rc |= out_attr_double(gg, "size", pr->size);
-        rc |= out_attr_double(gg, "rate", pr->rate);
-        rc |= out_attr_string(gg, "method", level ? "level: first z up from the floor with sum V W = 0.5"
-                                            : pr->body >= 0 ? "wall: Adami, Hu & Adams 2012 eq. 27"
-                                                            : "fluid: Shepard interpolation (DualSPHysics MeasureTool)");
         struct {
             hid_t *id;
             const char *name, *units;
             hid_t type;
-        } ds[] = {{&g->t, "t", "s", H5T_IEEE_F64LE}, {&g->step, "step", "", H5T_STD_I64LE},
-                  {&g->p, level ? "h" : "p", level ? "m" : "Pa", H5T_IEEE_F64LE}};
-        for (size_t d = 0; d < sizeof ds / sizeof ds[0]; d++) {
+        } ds[LAHAR_PROBE_MAX_VALUES + 2] = {{&g->t, "t", "s", H5T_IEEE_F64LE}, {&g->step, "step", "", H5T_STD_I64LE}};
+        for (int v = 0; v < g->nv; v++) {
+            ds[2 + v].id = &g->v[v];
+            ds[2 + v].name = gauge_value_name(kind, v);
+            ds[2 + v].units = gauge_value_units(kind, v, c->dim);
+            ds[2 + v].type = H5T_IEEE_F64LE;
+        }
+        for (int d = 0; d < 2 + g->nv; d++) {
             hsize_t dim0 = 0, maxd = H5S_UNLIMITED, ch = GAUGE_BUFFER_ROWS;
             hid_t sp = H5Screate_simple(1, &dim0, &maxd), dcpl = out_dcpl();
             H5Pset_chunk(dcpl, 1, &ch);
@@ -1899,7 +1992,8 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
         H5Gclose(pg);
     if (names) {
         hid_t st = out_str_type();
-        rc |= out_attr(o->file, "probe_names", st, o->n, names);
+        if (nnames > 0)
+            rc |= out_attr(o->file, "probe_names", st, nnames, names);
         H5Tclose(st);
         free(names);
     } else {
@@ -1918,14 +2012,16 @@ int lahar_gauge_output_write(lahar_gauge_output *o, int64_t step, double t, cons
 {
     if (!o)
         return 0;
-    int full = 0;
+    int full = 0, off = 0;
     for (int k = 0; k < o->n; k++) {
+        gauge_stream *g = &o->g[k];
+        off += g->nv;
         if (!due[k])
             continue;
-        gauge_stream *g = &o->g[k];
         g->bt[g->nbuf] = t;
         g->bstep[g->nbuf] = step;
-        g->bp[g->nbuf] = p[k];
+        for (int c = 0; c < g->nv; c++)
+            g->bp[(size_t)c * GAUGE_BUFFER_ROWS + g->nbuf] = p[off - g->nv + c];
         full |= ++g->nbuf == GAUGE_BUFFER_ROWS;
     }
     if (full || out_wall_seconds() - o->last_flush >= FORCES_FLUSH_SECONDS)
@@ -1949,10 +2045,13 @@ void lahar_gauge_output_close(lahar_gauge_output *o)
         gauge_flush(o);
     for (int k = 0; k < o->n; k++) {
         gauge_stream *g = &o->g[k];
-        hid_t ids[] = {g->t, g->step, g->p};
-        for (size_t d = 0; d < 3; d++)
-            if (ids[d] >= 0)
-                H5Dclose(ids[d]);
+        if (g->t >= 0)
+            H5Dclose(g->t);
+        if (g->step >= 0)
+            H5Dclose(g->step);
+        for (int v = 0; v < g->nv; v++)
+            if (g->v[v] >= 0)
+                H5Dclose(g->v[v]);
         free(g->bt), free(g->bp), free(g->bstep);
     }
     if (o->file >= 0)

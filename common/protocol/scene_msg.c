@@ -108,6 +108,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         b->body = a->body;
         b->size = a->size;
         b->rate = a->rate;
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        b->axis = (int8_t)a->axis;
     }
     for (int i = 0; i < c->nmaterial; i++) {
         const lahar_material *from = &c->materials[i];
@@ -394,7 +396,8 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         const lahar_probe_t *a = &m->probes[i];
         lahar_probe *b = &c->probes[i];
         if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
-            (a->kind != LAHAR_PROBE_PRESSURE && a->kind != LAHAR_PROBE_LEVEL) ||
+            a->kind < LAHAR_PROBE_PRESSURE || a->kind > LAHAR_PROBE_CONTROL_VOLUME || a->axis < 0 ||
+            a->axis >= m->dim ||
             (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
             snprintf(err, errlen, "malformed scene message (probe %d)", i);
             lahar_case_free(c);
@@ -408,6 +411,8 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         b->body = a->body;
         b->size = a->size;
         b->rate = a->rate;
+        memcpy(b->hi, a->hi, sizeof b->hi);
+        b->axis = a->axis;
     }
     if (lahar_scene_msg_inflow_to_case(m, c, err, errlen) != 0) {
         lahar_case_free(c);

@@ -166,7 +166,17 @@ typedef struct {
  * body >= 0: a point on that body's swept surface (the loader projects x onto it and stores the
  * outward normal n), pressure by Adami, Hu & Adams 2012 eq. 27 at the surface point; with size > 0
  * the mean over a segment (2D) or disc (3D) of that diameter on the surface. */
-enum { LAHAR_PROBE_PRESSURE = 0, LAHAR_PROBE_LEVEL = 1 };
+enum { LAHAR_PROBE_PRESSURE = 0, LAHAR_PROBE_LEVEL = 1, LAHAR_PROBE_TRACKER = 2, LAHAR_PROBE_CONTROL_VOLUME = 3 };
+/* Trackers (case section trackers:) and control volumes (control_volumes:) travel as probes of
+ * these kinds (sph_node/probes/sph_gauges.h): a tracker follows the particle nearest to x at t = 0; a
+ * control volume is the box [x, hi) with its flux axis. Values per sample, in gauges.h5 order:
+ * pressure p; level h; tracker x, y, z, vx, vy, vz, id; control volume ek, ek_water, ek_soil,
+ * ek_bodies, mass_water, mass_soil, flux_water, flux_soil. */
+#define LAHAR_PROBE_MAX_VALUES 8
+static inline int lahar_probe_nvalues(int kind)
+{
+    return kind == LAHAR_PROBE_TRACKER ? 7 : kind == LAHAR_PROBE_CONTROL_VOLUME ? 8 : 1;
+}
 
 typedef struct {
     char name[LAHAR_NAME_MAX];
@@ -178,6 +188,8 @@ typedef struct {
     int body;              /* index into lahar_case.bodies, or -1 */
     double size;           /* sensor diameter, m (0: the point) */
     double rate;           /* samples per second (0: every step) */
+    double hi[3];          /* control volumes: the box's upper corner (x is the lower one) */
+    int axis;              /* control volumes: the flux direction (0 x, 1 y, 2 z) */
 } lahar_probe;
 
 typedef struct {
@@ -279,6 +291,7 @@ typedef struct {
     double force[3];  /* total contact + external force over the last step, N (time average over substeps) */
     double torque[3]; /* about the centre of mass, N m */
     int ncontacts;    /* active contact points at the end of the step */
+    double energy[3]; /* E_P, E_K, E_R at the end of the step (lahar_body_energy, common/geometry/energy.h) */
 } lahar_body_report;
 
 #endif

@@ -760,6 +760,8 @@ static const lahar_check_reference check_references[] = {
      lahar_check_darcy},
     {"inflow", "open boundaries: discharge through the inlets vs the hydrographs, mass balance, outflow vs inflow, "
      "steady depth vs the inlet level", "discharge_rel_error", 0.02, lahar_check_inflow},
+    {"landslide", "soil mass sliding down a terrain profile: nothing through the terrain, mass kept, deposit length "
+     "and thickness against the field's (Yangbaodi)", "escaped_particles", 0.0, lahar_check_landslide},
 };
 #define CHECK_NREF (sizeof check_references / sizeof check_references[0])
 

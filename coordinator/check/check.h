@@ -138,6 +138,8 @@ int lahar_check_granular_impact(const lahar_case *c, const lahar_check_data *d, 
 int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 /* open boundaries: discharge, mass balance, outflow, depth (coordinator/check/check_inflow.c) */
 int lahar_check_inflow(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+/* A soil mass sliding down a 2D terrain (coordinator/check/check_landslide.c; cases/README.md). */
+int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 
 /* Dimensionless drag K = F/(mu U) of a square array of cylinders at solid fraction c (Sangani &
  * Acrivos 1982 Table 1: ln K interpolated linearly in c between tabulated

@@ -1,6 +1,6 @@
 /* `lahar check` reference `inflow` (cases/README.md): open boundaries of the SPH fluid
  * (common/scene/inflow.h, sph_node/inflow/sph_inflow.h), from the counters every particle snapshot carries
- * (attributes flow_*, common/output.h) and the particles.
+ * (attributes flow_*, common/io/output.h) and the particles.
  *
  *   discharge_rel_error: the volume that entered through the inlets by each snapshot (particles
  *     entered x dx^D, each particle standing for its lattice cell) against the hydrographs'

@@ -112,7 +112,7 @@ void sph_inflow_free(sph_inflow *fl);
 int sph_inflow_case_wanted(const lahar_case *c);
 /* sph_inflow_init from the case (the kernel support of prm, the case's gravity and t_end). */
 int sph_inflow_setup_case(sph_inflow *fl, const lahar_case *c, const sph_params *prm, char *err, int errlen);
-/* The counters of a snapshot / summary (LAHAR_FLOW_NVAL values, names in common/output.h). */
+/* The counters of a snapshot / summary (LAHAR_FLOW_NVAL values, names in common/io/output.h). */
 void sph_inflow_values(const sph_inflow *fl, const sph_particles *p, double *v);
 /* Store / load the open boundaries' state: the inlet marks of the p->n particles (p->n already
  * set), the next id, the counters, each inlet's displacement, velocity, rows and particles

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "geometry.h"
+#include "sph_gauges.h"
 #include "vec.h"
 
 #define SPH_PROBE_DRY_FLUID 0.5 /* DualSPHysics MeasureTool kclimit */
@@ -83,7 +84,11 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
     pr->body = calloc((size_t)n, sizeof *pr->body);
     pr->rate = calloc((size_t)n, sizeof *pr->rate);
     pr->next_slot = calloc((size_t)n, sizeof *pr->next_slot);
-    pr->value = calloc((size_t)n, sizeof *pr->value);
+    pr->v0 = calloc((size_t)n + 1, sizeof *pr->v0);
+    pr->target = calloc((size_t)n, sizeof *pr->target);
+    for (int k = 0; k < n && pr->v0; k++)
+        pr->v0[k + 1] = pr->v0[k] + lahar_probe_nvalues(c->probes[k].kind);
+    pr->value = pr->v0 ? calloc((size_t)pr->v0[n] + 1, sizeof *pr->value) : NULL;
     pr->due = calloc((size_t)n, sizeof *pr->due);
     pr->xl = malloc((size_t)n * SPH_PROBE_MAX_POINTS * sizeof *pr->xl);
     pr->nl = malloc((size_t)n * SPH_PROBE_MAX_POINTS * sizeof *pr->nl);
@@ -103,6 +108,7 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
         pr->l0[n] = (int)nlp;
     pr->lphi = nlp < INT32_MAX ? malloc((size_t)(nlp > 0 ? nlp : 1) * sizeof *pr->lphi) : NULL;
     if (!tx || !tn || !pr->pt0 || !pr->body || !pr->rate || !pr->next_slot || !pr->value || !pr->due || !pr->xl ||
+        !pr->v0 || !pr->target ||
         !pr->nl || !pr->kind || !pr->l0 || !pr->lstep || !pr->lphi) {
         free(tx), free(tn);
         sph_probes_free(pr);
@@ -117,6 +123,7 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c)
         pr->rate[k] = p->rate;
         pr->kind[k] = p->kind;
         pr->lstep[k] = lstep;
+        pr->target[k] = -1;
         if (p->body < 0) {
             memcpy(pr->xl[m], p->x, sizeof pr->xl[m]);
             memset(pr->nl[m], 0, sizeof pr->nl[m]);
@@ -143,6 +150,7 @@ void sph_probes_free(sph_probes *pr)
 {
     free(pr->pt0), free(pr->body), free(pr->rate), free(pr->next_slot), free(pr->value), free(pr->due);
     free(pr->xl), free(pr->nl), free(pr->kind), free(pr->l0), free(pr->lphi), free(pr->lstep);
+    free(pr->v0), free(pr->target);
     memset(pr, 0, sizeof *pr);
 }
 
@@ -288,8 +296,19 @@ int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, c
         }
         pr->due[k] = 1;
         ndue++;
+        double *val = pr->value + pr->v0[k];
+        if (pr->kind[k] == LAHAR_PROBE_TRACKER) {
+            if (pr->target[k] < 0)
+                pr->target[k] = sph_gauges_nearest(f, c->probes[k].x);
+            sph_gauges_tracker(f, pr->target[k], val);
+            continue;
+        }
+        if (pr->kind[k] == LAHAR_PROBE_CONTROL_VOLUME) {
+            sph_gauges_control_volume(f, &c->probes[k], c, states, val);
+            continue;
+        }
         if (pr->kind[k] == LAHAR_PROBE_LEVEL) {
-            pr->value[k] = sph_probes_level(f, pr->xl[pr->pt0[k]], pr->l0[k + 1] - pr->l0[k], pr->lstep[k],
+            val[0] = sph_probes_level(f, pr->xl[pr->pt0[k]], pr->l0[k + 1] - pr->l0[k], pr->lstep[k],
                                             pr->lphi + pr->l0[k]);
             continue;
         }
@@ -306,7 +325,7 @@ int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, c
             }
             sum += sph_probes_point(f, xw, b >= 0);
         }
-        pr->value[k] = sum / (double)(pr->pt0[k + 1] - pr->pt0[k]);
+        val[0] = sum / (double)(pr->pt0[k + 1] - pr->pt0[k]);
     }
     return ndue;
 }

@@ -58,7 +58,10 @@ typedef struct {
     int *l0;               /* n + 1: level gauge k's line points are l0[k] .. l0[k + 1] - 1 */
     double *lphi;          /* per line point: sum_j V_j W (work space of the last sample) */
     double *lstep;         /* per probe: spacing of its line points (level gauges) */
-    double *value;         /* per probe: the last sample, Pa (pressure) or m (level) */
+    int *v0;               /* n + 1: probe k's values are value[v0[k] .. v0[k + 1]) (lahar_probe_nvalues) */
+    double *value;         /* the last sample: Pa (pressure), m (level), trackers and control
+                              volumes as sph_gauges.h */
+    int64_t *target;       /* per probe: the particle id a tracker follows (-1: not chosen yet) */
     int *due;              /* per probe: 1 if sampled by the last sph_probes_sample */
 } sph_probes;
 
@@ -68,7 +71,8 @@ int sph_probes_init(sph_probes *pr, const lahar_case *c);
 void sph_probes_free(sph_probes *pr);
 /* Sample the probes due at time t (after a step: the state of f at t) with the bodies at
  * `states` (nbody entries; NULL: the scene poses of c). Fills pr->value and pr->due; returns the
- * number of probes sampled. The particles must be sorted into f's cells (they are after a step). */
+ * number of probes sampled. Trackers and control volumes (sph_gauges.h) are sampled here too; a
+ * tracker without a target takes the particle nearest its position now (t = 0). The particles must be sorted into f's cells (they are after a step). */
 int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, const lahar_body_state *states,
                       double t);
 /* The level of the water at the vertical line from the world point foot (on the floor) upward:
