@@ -97,13 +97,17 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
         dem_test_check(0, "create %s: %s", engine, err);
         return 0.0;
     }
-    double h = 20.0 * ops->stable_dt(e), vout = 0.0;
+    double h = 20.0 * ops->stable_dt(e), vout = 0.0, jwall = 0.0;
     int touched = 0;
     for (int k = 0; k < 100000; k++) {
-        if (ops->advance(e, alt_steps && k % 3 == 2 ? 0.73 * h : h, NULL, err, sizeof err) < 0) {
+        double dt = alt_steps && k % 3 == 2 ? 0.73 * h : h;
+        if (ops->advance(e, dt, NULL, err, sizeof err) < 0) {
             dem_test_check(0, "advance: %s", err);
             break;
         }
+        lahar_body_report wr; /* the wall (body 0): the force the ball exerts on it */
+        ops->get_report(e, 0, &wr);
+        jwall += wr.force[dim - 1] * dt;
         lahar_body_state st;
         ops->get_state(e, s, &st);
         if (k < ntraj) traj_out[k] = st.x[dim - 1];
@@ -113,6 +117,12 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
             break;
         }
     }
+    /* the wall received the ball's change of momentum, and nothing once the ball has left */
+    dem_test_rel("bounce: impulse on the wall = -m (v_out - v_in)", jwall, -c.bodies[s].mass * (vout + v0), 2e-3);
+    lahar_body_report wr;
+    if (ops->advance(e, h, NULL, err, sizeof err) >= 0) ops->get_report(e, 0, &wr);
+    else wr.force[dim - 1] = NAN;
+    dem_test_abs("bounce: no force on the wall after the rebound", wr.force[dim - 1], 0.0, 0.0);
     ops->destroy(e);
     dem_test_case_free(&c);
     return vout / v0;

@@ -173,10 +173,10 @@ static int law_coeffs(const dem_pair_law *law, double mstar, char *out, size_t n
 
 /* ---- the step ----------------------------------------------------------------------------------- */
 
-/* fix external's callback, at post_force of every substep (and once in the setup of a `run pre yes`):
- * contact forces (pairs and walls) are complete in f and torque, gravity not yet added. */
 static void accumulate_wall_forces(lahar_dem_engine *e, int nlocal);
 
+/* fix external's callback, at post_force of every substep (and once in the setup of a `run pre yes`):
+ * contact forces (pairs and walls) are complete in f and torque, gravity not yet added. */
 static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double **x, double **fext)
 {
     (void)x;
