@@ -44,3 +44,14 @@ endif()
 add_executable(bench_dem_lammps EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
 target_include_directories(bench_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
 target_link_libraries(bench_dem_lammps PRIVATE lahar_dem)
+
+# The same coupled scene with both engines (cases/boulders_barrier_2d.yaml to 0.7 s, three runs
+# in-process): the engines agree within 3x the spread of spheropoly between two SPH steps
+# (dem_engines_compare.sh says why; numbers in docs/bench/dem_engines.md). ~2 min on 2 idle cores.
+# Without the lammps engine it prints SKIP (exit 77).
+lahar_test(dem_engines_compare
+  COMMAND sh ${LAHAR_TEST_DIR}/dem_engines_compare.sh $<TARGET_FILE_DIR:lahar> ${CMAKE_SOURCE_DIR}/tools
+          ${CMAKE_SOURCE_DIR}/cases/boulders_barrier_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/dem_engines_compare
+          ${LAHAR_TEST_PYTHON}
+  LABELS slow lammps coupling TIMEOUT 1200
+  PROPERTIES SKIP_RETURN_CODE 77 REQUIRED_FILES "$<TARGET_FILE:lahar-dem>;$<TARGET_FILE:lahar-sph>")

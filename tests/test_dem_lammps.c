@@ -97,13 +97,17 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
         dem_test_check(0, "create %s: %s", engine, err);
         return 0.0;
     }
-    double h = 20.0 * ops->stable_dt(e), vout = 0.0;
+    double h = 20.0 * ops->stable_dt(e), vout = 0.0, jwall = 0.0;
     int touched = 0;
     for (int k = 0; k < 100000; k++) {
-        if (ops->advance(e, alt_steps && k % 3 == 2 ? 0.73 * h : h, NULL, err, sizeof err) < 0) {
+        double dt = alt_steps && k % 3 == 2 ? 0.73 * h : h;
+        if (ops->advance(e, dt, NULL, err, sizeof err) < 0) {
             dem_test_check(0, "advance: %s", err);
             break;
         }
+        lahar_body_report wr; /* the wall (body 0): the force the ball exerts on it */
+        ops->get_report(e, 0, &wr);
+        jwall += wr.force[dim - 1] * dt;
         lahar_body_state st;
         ops->get_state(e, s, &st);
         if (k < ntraj) traj_out[k] = st.x[dim - 1];
@@ -113,6 +117,12 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
             break;
         }
     }
+    /* the wall received the ball's change of momentum, and nothing once the ball has left */
+    dem_test_rel("bounce: impulse on the wall = -m (v_out - v_in)", jwall, -c.bodies[s].mass * (vout + v0), 2e-3);
+    lahar_body_report wr;
+    if (ops->advance(e, h, NULL, err, sizeof err) >= 0) ops->get_report(e, 0, &wr);
+    else wr.force[dim - 1] = NAN;
+    dem_test_abs("bounce: no force on the wall after the rebound", wr.force[dim - 1], 0.0, 0.0);
     ops->destroy(e);
     dem_test_case_free(&c);
     return vout / v0;
@@ -284,7 +294,9 @@ static void constant_load(void)
     dem_test_case_free(&c);
 }
 
-/* a resting sphere on a plane under gravity: the report is the contact force m g (time average) */
+/* a resting sphere on a plane under gravity: the report is the contact force m g (time average);
+ * the plane's report is the force the sphere exerts on it, -m g, with its torque about the plane's
+ * centre (the sphere rests 0.3 m off it), plus the SPH load handed to the plane */
 static void resting(void)
 {
     const double g[3] = {0, 0, -9.81};
@@ -293,7 +305,7 @@ static void resting(void)
     int m = dem_test_material(&c, "rock", LAHAR_CONTACT_LINEAR, 2500.0, 1e6, 0, 0, 0.3, 0.5);
     const double centre[3] = {0, 0, 0}, n[3] = {0, 0, 1}, size[2] = {10, 10};
     dem_test_plane(&c, "floor", m, centre, n, size, 0.01);
-    const double x[3] = {0, 0, 0.11};
+    const double x[3] = {0.3, 0, 0.11};
     int s = dem_test_sphere(&c, "ball", m, 0.1, x, LAHAR_MOTION_FREE);
     const lahar_dem_engine_ops *ops;
     lahar_dem_engine *e = make(&c, &ops);
@@ -308,6 +320,17 @@ static void resting(void)
     ops->get_state(e, s, &st);
     dem_test_rel("resting sphere: overlap = m g / kn", 0.11 - st.x[2], w / 1e6, 1e-3);
     dem_test_check(rep.ncontacts == 1 && ops->ncontacts(e) == 1, "resting sphere: one contact");
+    lahar_body_report wrep;
+    ops->get_report(e, 0, &wrep);
+    dem_test_rel("resting sphere: the plane receives -m g", -wrep.force[2], w, 1e-3);
+    dem_test_abs("resting sphere: the plane's force is normal", fabs(wrep.force[0]) + fabs(wrep.force[1]), 0.0, 1e-9 * w);
+    dem_test_rel("resting sphere: the plane's torque about its centre = 0.3 m x m g", wrep.torque[1], 0.3 * w, 1e-3);
+    lahar_body_load loads[2] = {{{5.0, 0.0, -7.0}, {0.0, 0.0, 0.5}}, {{0, 0, 0}, {0, 0, 0}}};
+    dem_test_check(ops->advance(e, 0.01, loads, err, sizeof err) >= 1, "advance");
+    ops->get_report(e, 0, &wrep);
+    dem_test_abs("resting sphere: the plane's report adds its load", wrep.force[0], 5.0, 1e-12);
+    dem_test_rel("resting sphere: the plane's report adds its load (z)", -wrep.force[2], w + 7.0, 1e-3);
+    dem_test_abs("resting sphere: the plane's report adds its torque load", wrep.torque[2], 0.5, 1e-12);
     ops->destroy(e);
     dem_test_case_free(&c);
 }

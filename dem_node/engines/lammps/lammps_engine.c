@@ -38,6 +38,7 @@ typedef struct {
     int body;        /* index in the scene */
     double p[3], n[3]; /* the contact surface: a point (the face moved out by the sweep radius) and the normal */
     double radius;   /* sweep radius of the wall */
+    double c[3];     /* the body's reference point (torques of its report are about it) */
     int material;
 } lmp_wall;
 
@@ -54,6 +55,13 @@ struct lahar_dem_engine {
     double (*acc_f)[3], (*acc_t)[3];   /* contact + external, summed over the substeps */
     double (*rep_f)[3], (*rep_t)[3];   /* the report of the last step (time average) */
     double (*last_f)[3], (*last_t)[3]; /* contact force and torque of the last substep */
+    /* walls (per body, 0 for free bodies): the contact force the free bodies exert on them, summed
+     * over the substeps, the SPH load of the step and the report (time average + load), as
+     * spheropoly reports its fixed bodies */
+    double (*wacc_f)[3], (*wacc_t)[3], (*wload_f)[3], (*wload_t)[3], (*wrep_f)[3], (*wrep_t)[3];
+    int nwfix;            /* wall fixes (one per wall and atom type), made with `contacts` */
+    char (*wfix_id)[32];  /* their IDs, for lammps_extract_fix */
+    int *wfix_wall;       /* their wall */
     int have_last;
     /* fixes made again before every init after the first (see lmp_advance): the Hertz walls
      * and, after them, the stateless fixes that must follow the walls in post_force order */
@@ -165,6 +173,8 @@ static int law_coeffs(const dem_pair_law *law, double mstar, char *out, size_t n
 
 /* ---- the step ----------------------------------------------------------------------------------- */
 
+static void accumulate_wall_forces(lahar_dem_engine *e, int nlocal);
+
 /* fix external's callback, at post_force of every substep (and once in the setup of a `run pre yes`):
  * contact forces (pairs and walls) are complete in f and torque, gravity not yet added. */
 static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double **x, double **fext)
@@ -176,6 +186,7 @@ static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double *
     double **om = lammps_extract_atom(e->lmp, "omega");
     const int setup = step == e->step_start;
     const double h = e->h_last;
+    if (!setup) accumulate_wall_forces(e, nlocal);
     for (int i = 0; i < nlocal; i++) {
         int k = ids[i] - 1;
         if (setup && e->have_last) {
@@ -210,6 +221,28 @@ static void lmp_callback(void *ptr, int64_t step, int nlocal, int *ids, double *
         if (wn > 0.0) {
             quat r = q_axis_angle(v3_scale(w, 1.0 / wn), wn * h);
             q_store(q_normalize(q_mul(r, q_load(s->q))), s->q);
+        }
+    }
+}
+
+/* The force each wall receives at this substep: minus the force of its fix on every atom in
+ * contact (the per-atom array of `contacts`: flag, force on the atom, contact point, radius), with
+ * the torque about the wall body's reference point. Called from the callback (the wall fixes have
+ * run: they come before fix external). */
+static void accumulate_wall_forces(lahar_dem_engine *e, int nlocal)
+{
+    for (int q = 0; q < e->nwfix; q++) {
+        double **arr = lammps_extract_fix(e->lmp, e->wfix_id[q], LMP_STYLE_ATOM, LMP_TYPE_ARRAY, 0, 0);
+        if (!arr) continue;
+        const lmp_wall *wl = &e->walls[e->wfix_wall[q]];
+        double *af = e->wacc_f[wl->body], *at = e->wacc_t[wl->body];
+        for (int i = 0; i < nlocal; i++) {
+            if (arr[i][0] == 0.0) continue;
+            vec3 f = v3(-arr[i][1], -arr[i][2], -arr[i][3]);
+            vec3 r = v3(arr[i][4] - wl->c[0], arr[i][5] - wl->c[1], arr[i][6] - wl->c[2]);
+            vec3 t = v3_cross(r, f);
+            af[0] += f.x, af[1] += f.y, af[2] += f.z;
+            at[0] += t.x, at[1] += t.y, at[2] += t.z;
         }
     }
 }
@@ -386,6 +419,14 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
             e->acc_f[k][a] = e->acc_t[k][a] = 0.0;
         }
     }
+    for (int w = 0; w < e->nwall; w++) {
+        int b = e->walls[w].body;
+        for (int a = 0; a < 3; a++) {
+            e->wload_f[b][a] = loads ? loads[b].force[a] : 0.0;
+            e->wload_t[b][a] = loads ? loads[b].torque[a] : 0.0;
+            e->wacc_f[b][a] = e->wacc_t[b][a] = 0.0;
+        }
+    }
     if (h != e->h_last) lmp_cmd(e, "timestep %.17g", h);
     e->h_last = h;
     e->step_start = *(int64_t *)lammps_extract_global(e->lmp, "ntimestep");
@@ -397,6 +438,13 @@ static int lmp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *lo
             e->rep_f[k][a] = e->acc_f[k][a] / (double)n;
             e->rep_t[k][a] = e->acc_t[k][a] / (double)n;
         }
+    for (int w = 0; w < e->nwall; w++) {
+        int b = e->walls[w].body;
+        for (int a = 0; a < 3; a++) {
+            e->wrep_f[b][a] = e->wacc_f[b][a] / (double)n + e->wload_f[b][a];
+            e->wrep_t[b][a] = e->wacc_t[b][a] / (double)n + e->wload_t[b][a];
+        }
+    }
     refresh_state(e);
     if (count_and_check(e, err, errlen) != 0) return -1;
     e->contacts_evaluated += (long long)e->ncontacts * n; /* approximate: the end-of-step count per substep */
@@ -458,6 +506,14 @@ static void lmp_destroy(lahar_dem_engine *e)
     free(e->rep_t);
     free(e->last_f);
     free(e->last_t);
+    free(e->wacc_f);
+    free(e->wacc_t);
+    free(e->wload_f);
+    free(e->wload_t);
+    free(e->wrep_f);
+    free(e->wrep_t);
+    free(e->wfix_id);
+    free(e->wfix_wall);
     free(e->refix_id);
     free(e->refix_cmd);
     free(e->ncontact_body);
@@ -517,6 +573,7 @@ static int make_wall(const lahar_case *c, int i, lmp_wall *w, char *err, size_t 
     w->body = i;
     w->material = b->material;
     w->radius = s->radius;
+    for (int a = 0; a < 3; a++) w->c[a] = b->x[a];
     v3_store(v3_axpy(s->radius, n, p0), w->p);
     v3_store(n, w->n);
     return 0;
@@ -560,12 +617,19 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
     e->rep_f = calloc(nb, sizeof *e->rep_f);
     e->rep_t = calloc(nb, sizeof *e->rep_t);
     e->last_f = calloc(nb, sizeof *e->last_f);
+    e->wacc_f = calloc(nb, sizeof *e->wacc_f);
+    e->wacc_t = calloc(nb, sizeof *e->wacc_t);
+    e->wload_f = calloc(nb, sizeof *e->wload_f);
+    e->wload_t = calloc(nb, sizeof *e->wload_t);
+    e->wrep_f = calloc(nb, sizeof *e->wrep_f);
+    e->wrep_t = calloc(nb, sizeof *e->wrep_t);
     e->last_t = calloc(nb, sizeof *e->last_t);
     e->ncontact_body = calloc(nb, sizeof(int));
     int nm = c->nmaterial > 0 ? c->nmaterial : 1;
     laws = calloc((size_t)nm * (size_t)nm, sizeof *laws);
     if (!e->free_of_body || !e->body_of_free || !e->type_of_free || !e->mass || !e->radius || !e->inertia ||
         !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t || !e->last_f || !e->last_t ||
+        !e->wacc_f || !e->wacc_t || !e->wload_f || !e->wload_t || !e->wrep_f || !e->wrep_t ||
         !e->ncontact_body || !laws)
         goto oom;
     for (int a = 0; a < c->nmaterial; a++)
@@ -681,8 +745,10 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
     /* room for the kept fixes: every wall x type (the Hertz ones are kept) and four more */
     e->caprefix = e->nwall * e->ntype + 4;
     e->refix_id = calloc((size_t)e->caprefix, sizeof *e->refix_id);
+    e->wfix_id = calloc((size_t)(e->nwall * e->ntype + 1), sizeof *e->wfix_id);
+    e->wfix_wall = calloc((size_t)(e->nwall * e->ntype + 1), sizeof *e->wfix_wall);
     e->refix_cmd = calloc((size_t)e->caprefix, sizeof *e->refix_cmd);
-    if (!e->refix_id || !e->refix_cmd) {
+    if (!e->refix_id || !e->refix_cmd || !e->wfix_id || !e->wfix_wall) {
         free(tmat);
         free(tmass);
         goto oom;
@@ -795,8 +861,10 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
             const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + wl->material];
             law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
             if (law->model == LAHAR_CONTACT_HERTZ) continue; /* after the linear ones, below */
-            lmp_cmd(e, "fix lahar_w%d_%d lahar_t%d wall/gran/region granular %s region lahar_w%d", w, t + 1, t + 1,
-                    coeff, w);
+            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "lahar_w%d_%d", w, t + 1);
+            e->wfix_wall[e->nwfix++] = w;
+            lmp_cmd(e, "fix lahar_w%d_%d lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", w, t + 1,
+                    t + 1, coeff, w);
         }
     }
     for (int w = 0; w < e->nwall; w++) {
@@ -807,7 +875,10 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
             law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
             char id[32];
             snprintf(id, sizeof id, "lahar_w%d_%d", w, t + 1);
-            lmp_keep_fix(e, id, "fix %s lahar_t%d wall/gran/region granular %s region lahar_w%d", id, t + 1, coeff, w);
+            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "%s", id);
+            e->wfix_wall[e->nwfix++] = w;
+            lmp_keep_fix(e, id, "fix %s lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", id, t + 1,
+                         coeff, w);
         }
     }
     free(tmat);
@@ -857,8 +928,8 @@ static void lmp_get_report(const lahar_dem_engine *e, int i, lahar_body_report *
 {
     int k = e->free_of_body[i];
     for (int a = 0; a < 3; a++) {
-        out->force[a] = k >= 0 ? e->rep_f[k][a] : 0.0;
-        out->torque[a] = k >= 0 ? e->rep_t[k][a] : 0.0;
+        out->force[a] = k >= 0 ? e->rep_f[k][a] : e->wrep_f[i][a];
+        out->torque[a] = k >= 0 ? e->rep_t[k][a] : e->wrep_t[i][a];
     }
     out->ncontacts = e->ncontact_body[i];
 }
