@@ -495,13 +495,19 @@ static void check_restitution(conf *cf)
     if (rc == 0) {
         lahar_link_heartbeat_stop(s.co);
         lahar_link_heartbeat_stop(s.sph);
+        /* LAHAR_CONFORMANCE_EXIT_SLACK (s, default 0): time the engine's own exit may add after it
+         * gave up, for builds whose exit is slow (the sanitizer build's leak check with full stack
+         * unwinding, which OpenMPI's suppressions need, takes seconds); detection itself is not
+         * loosened: the lower bound stays */
+        const char *slack_env = getenv("LAHAR_CONFORMANCE_EXIT_SLACK");
+        const double slack = slack_env ? fmax(0.0, atof(slack_env)) : 0.0, hi = SILENCE_HI + slack;
         double t0 = lahar_now();
-        int exited = conf_session_wait_exit(&s, SILENCE_HI + 5.0) == 0;
+        int exited = conf_session_wait_exit(&s, hi + 5.0) == 0;
         double dt = exited ? s.exit_time - t0 : -1.0;
-        int ok = exited && s.exit_status == 3 && dt >= SILENCE_LO && dt <= SILENCE_HI;
+        int ok = exited && s.exit_status == 3 && dt >= SILENCE_LO && dt <= hi;
         report(cf, ok, "silence",
                "harness silent: engine exit status %d (3) after %.2f s (documented %.0f s; accepted %.2f .. %.2f s)",
-               exited ? s.exit_status : -1, dt, SILENCE_DOC, SILENCE_LO, SILENCE_HI);
+               exited ? s.exit_status : -1, dt, SILENCE_DOC, SILENCE_LO, hi);
     } else {
         report(cf, 0, "silence", "not run: the restitution run failed");
     }
