@@ -18,6 +18,9 @@ RUN is the output folder of the run (its case: the header's case_path). Asserts:
   - boulders' potential energy (forces.h5 /energy E_P, eq. 37): for a boulder whose centre stays
     on the flat (x > 193.1 m + 2 R) over the last 2 s of the run, E_P constant within 1 % of m g R
     (the paper's Fig. 26a); a boulder not there yet is reported, not asserted.
+Also printed (information, cases/README.md "Debris flow"): the front (99 % quantile of the soil's and
+the water's x) per snapshot, its largest speed between snapshots and where it ends; the trackers'
+peak speeds; the control volumes' peak E_K (total and the bodies' part) and when.
 Exit 0 when all hold, 1 otherwise."""
 import argparse
 import os
@@ -77,6 +80,16 @@ def main():
         print("debris_flow_check: mass balance worst |dM - (in - out)| / M = %.3g (bound 1e-12)" % worst)
         if worst > 1e-12:
             fails.append("mass balance %.3g > 1e-12" % worst)
+        fronts = []
+        for k in keys:
+            g = snaps[k]
+            dom = g["inlet"][:] < 0
+            fronts.append((g.attrs["time"], float(np.quantile(g["x"][:][dom], 0.99))))
+        fr = np.array(fronts)
+        vf = np.diff(fr[:, 1]) / np.diff(fr[:, 0])
+        kmax = int(np.argmax(vf))
+        print("debris_flow_check: front (99 %% of x) %.1f -> %.1f m (run-out %.1f m), fastest %.1f m/s at t = %.1f-%.1f s"
+              % (fr[0, 1], fr[-1, 1], fr[-1, 1] - fr[0, 1], vf[kmax], fr[kmax, 0], fr[kmax + 1, 0]))
         g = snaps[keys[-1]]
         if g.attrs["flow_entered"] <= 0:
             fails.append("the inlet delivered no water")
@@ -129,6 +142,18 @@ def main():
         print("debris_flow_check: %s on the flat: E_P spread over the last 2 s = %.3g m g R (bound 0.01)" % (n, spread))
         if spread > 0.01:
             fails.append("%s E_P varies by %.3g m g R on the flat" % (n, spread))
+    with h5py.File(os.path.join(a.run, "gauges.h5"), "r") as f:
+        for n in sorted(f.get("trackers", {}).keys()):
+            tr = f["trackers"][n]
+            sp = np.hypot(tr["vx"][:], tr["vy"][:])
+            i = int(np.argmax(sp))
+            print("debris_flow_check: tracker %s: peak speed %.1f m/s at %.1f s" % (n, sp[i], tr["t"][i]))
+        for n in sorted(f.get("control_volumes", {}).keys()):
+            cv = f["control_volumes"][n]
+            ek, eb, tc = cv["ek"][:], cv["ek_bodies"][:], cv["t"][:]
+            i, j = int(np.argmax(ek)), int(np.argmax(eb))
+            print("debris_flow_check: control volume %s: peak E_K %.3g J/m at %.2f s; bodies' part peak %.3g J/m at %.2f s"
+                  % (n, ek[i], tc[i], eb[j], tc[j]))
     for msg in fails:
         print("debris_flow_check: FAIL " + msg)
     print("debris_flow_check: %s" % ("PASS" if not fails else "FAIL"))
