@@ -146,7 +146,7 @@ def main():
         for n in sorted(f.get("trackers", {}).keys()):
             tr = f["trackers"][n]
             sp = np.hypot(tr["vx"][:], tr["vy"][:])
-            i = int(np.argmax(sp))
+            i = int(np.nanargmax(sp))  # NaN once the tracked particle has left the domain
             print("debris_flow_check: tracker %s: peak speed %.1f m/s at %.1f s" % (n, sp[i], tr["t"][i]))
         for n in sorted(f.get("control_volumes", {}).keys()):
             cv = f["control_volumes"][n]
