@@ -2989,11 +2989,10 @@ static int read_section(rmap *m, int dim, double x0[3], double e1[3], double e2[
 /* the solver features the open boundaries do not handle yet; 0 or -1 (message at n) */
 static int open_boundary_support(reader *r, yaml_node_t *n, const char *key, const lahar_case *c)
 {
+    /* soil blocks are allowed: a removal carries the stress arrays (sph_particles_remove) and the
+     * soil-DEM friction springs are kept by unique particle id (sph_coupling_enable_soil) */
     const char *why = NULL;
-    for (int b = 0; b < c->nblock && !why; b++)
-        if (c->blocks[b].phase == 1)
-            why = "soil blocks (their stress history is not carried through removals yet)";
-    if (!why && c->sph.shifting > 0.0)
+    if (c->sph.shifting > 0.0)
         why = "sph.shifting (it would move the buffer particles)";
     if (!why && c->sph.transport_velocity)
         why = "sph.transport_velocity (fully periodic flows only)";
