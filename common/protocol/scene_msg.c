@@ -5,6 +5,7 @@
 #include <string.h>
 #include "case.h"
 #include "msg_check.h"
+#include "scene_msg_fields.h"
 
 static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 {
@@ -12,9 +13,8 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 }
 
 /* The fields a message carries under the same name as the in-memory case, listed once and copied
- * both ways by the same macros: NUM fields have the same type on both sides, FLAG fields are
- * booleans sent as int8, CODE fields small integers (enums, counts) sent as int8. A field added to
- * a .lcm type and to scene.h is added here once. */
+ * both ways by the macros of scene_msg_fields.h. A field added to a .lcm type and to scene.h is
+ * added here once. */
 #define SPH_NUM_FIELDS(X) X(h_over_dx) X(c0) X(gamma) X(mu) X(alpha) X(delta) X(cfl) X(cfl_force) X(cfl_visc) \
     X(shepard_interval) X(shifting) X(background_pressure) X(sps_cs) X(halo) X(kappa) X(riemann_limiter)
 #define SPH_FLAG_FIELDS(X) X(shifting_density) X(transport_velocity) X(sps)
@@ -25,12 +25,6 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
     X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
 #define MATERIAL_CODE_FIELDS(X) X(model)
 
-#define TO_MSG_NUM(f) to->f = from->f;
-#define TO_MSG_FLAG(f) to->f = (int8_t)(from->f != 0);
-#define TO_MSG_CODE(f) to->f = (int8_t)from->f;
-#define FROM_MSG_FLAG(f) to->f = from->f != 0;
-#define FROM_MSG_CODE(f) to->f = from->f;
-#define COPY_ARRAY(f) memcpy(to->f, from->f, sizeof to->f);
 
 /* The kernel string points into from (keep it alive while to is used). */
 static void scene_sph_to_msg(const lahar_sph_options *from, lahar_sph_options_t *to)

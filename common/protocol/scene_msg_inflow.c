@@ -6,6 +6,12 @@
 #include <string.h>
 
 #include "scene_msg.h"
+#include "scene_msg_fields.h"
+
+/* the fields of an inlet and an outlet, listed once (scene_msg_fields.h) */
+#define SECTION_ARRAY_FIELDS(X) X(x0) X(e1) X(e2) X(n)
+#define INLET_NUM_FIELDS(X) X(level) X(layers) X(velocity) X(t_start) X(t_end) X(max_particles)
+#define INLET_ARRAY_FIELDS(X) X(gumbel)
 
 int lahar_scene_msg_inflow_from_case(const lahar_case *c, lahar_scene_t *m)
 {
@@ -16,21 +22,13 @@ int lahar_scene_msg_inflow_from_case(const lahar_case *c, lahar_scene_t *m)
     if (!m->inlets || !m->outlets)
         return -1;
     for (int i = 0; i < c->ninlet; i++) {
-        const lahar_inlet *a = &c->inlets[i];
-        lahar_inlet_t *b = &m->inlets[i];
+        const lahar_inlet *a = &c->inlets[i], *from = a;
+        lahar_inlet_t *b = &m->inlets[i], *to = b;
         b->name = (char *)a->name;
-        memcpy(b->x0, a->x0, sizeof b->x0);
-        memcpy(b->e1, a->e1, sizeof b->e1);
-        memcpy(b->e2, a->e2, sizeof b->e2);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->level = a->level;
-        b->layers = a->layers;
+        SECTION_ARRAY_FIELDS(COPY_ARRAY)
+        INLET_NUM_FIELDS(TO_MSG_NUM)
+        INLET_ARRAY_FIELDS(COPY_ARRAY)
         b->kind = (int8_t)a->kind;
-        b->velocity = a->velocity;
-        memcpy(b->gumbel, a->gumbel, sizeof b->gumbel);
-        b->t_start = a->t_start;
-        b->t_end = a->t_end;
-        b->max_particles = a->max_particles;
         b->ntable = a->ntable;
         b->table_t = a->table_t;
         b->table_v = a->table_v;
@@ -39,14 +37,11 @@ int lahar_scene_msg_inflow_from_case(const lahar_case *c, lahar_scene_t *m)
         b->level_h = a->level_h;
     }
     for (int i = 0; i < c->noutlet; i++) {
-        const lahar_outlet *a = &c->outlets[i];
-        lahar_outlet_t *b = &m->outlets[i];
-        b->name = (char *)a->name;
-        memcpy(b->x0, a->x0, sizeof b->x0);
-        memcpy(b->e1, a->e1, sizeof b->e1);
-        memcpy(b->e2, a->e2, sizeof b->e2);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->depth = a->depth;
+        const lahar_outlet *from = &c->outlets[i];
+        lahar_outlet_t *to = &m->outlets[i];
+        to->name = (char *)from->name;
+        SECTION_ARRAY_FIELDS(COPY_ARRAY)
+        to->depth = from->depth;
     }
     m->has_domain = (int8_t)(c->has_domain != 0);
     memcpy(m->domain_lo, c->domain_lo, sizeof m->domain_lo);
@@ -80,19 +75,13 @@ int lahar_scene_msg_inflow_to_case(const lahar_scene_t *m, lahar_case *c, char *
             snprintf(err, errlen, "malformed scene message (inlet %d)", i);
             return -1;
         }
+        const lahar_inlet_t *from = a;
+        lahar_inlet *to = b;
         snprintf(b->name, sizeof b->name, "%s", a->name ? a->name : "");
-        memcpy(b->x0, a->x0, sizeof b->x0);
-        memcpy(b->e1, a->e1, sizeof b->e1);
-        memcpy(b->e2, a->e2, sizeof b->e2);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->level = a->level;
-        b->layers = a->layers;
+        SECTION_ARRAY_FIELDS(COPY_ARRAY)
+        INLET_NUM_FIELDS(TO_MSG_NUM)
+        INLET_ARRAY_FIELDS(COPY_ARRAY)
         b->kind = a->kind;
-        b->velocity = a->velocity;
-        memcpy(b->gumbel, a->gumbel, sizeof b->gumbel);
-        b->t_start = a->t_start;
-        b->t_end = a->t_end;
-        b->max_particles = a->max_particles;
         if (a->ntable > 0) {
             b->table_t = malloc((size_t)a->ntable * sizeof *b->table_t);
             b->table_v = malloc((size_t)a->ntable * sizeof *b->table_v);
@@ -115,15 +104,12 @@ int lahar_scene_msg_inflow_to_case(const lahar_scene_t *m, lahar_case *c, char *
     if (m->noutlet > 0 && !(c->outlets = calloc((size_t)m->noutlet, sizeof *c->outlets)))
         goto oom;
     for (int i = 0; i < m->noutlet; i++) {
-        const lahar_outlet_t *a = &m->outlets[i];
-        lahar_outlet *b = &c->outlets[i];
+        const lahar_outlet_t *from = &m->outlets[i];
+        lahar_outlet *to = &c->outlets[i];
         c->noutlet = i + 1;
-        snprintf(b->name, sizeof b->name, "%s", a->name ? a->name : "");
-        memcpy(b->x0, a->x0, sizeof b->x0);
-        memcpy(b->e1, a->e1, sizeof b->e1);
-        memcpy(b->e2, a->e2, sizeof b->e2);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->depth = a->depth;
+        snprintf(to->name, sizeof to->name, "%s", from->name ? from->name : "");
+        SECTION_ARRAY_FIELDS(COPY_ARRAY)
+        to->depth = from->depth;
     }
     c->has_domain = m->has_domain != 0;
     memcpy(c->domain_lo, m->domain_lo, sizeof c->domain_lo);
