@@ -164,39 +164,12 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
 {
     const lahar_sph_options *o = &c->sph;
     memset(prm, 0, sizeof *prm);
+    prm->opt = *o; /* every default already filled by the loader */
     prm->dim = c->dim;
-    prm->kernel = o->kernel[0] ? o->kernel : NULL;
     prm->dx = c->sph_dx;
-    prm->h_over_dx = o->h_over_dx;
     prm->rho0 = c->sph_density;
-    prm->c0 = o->c0;
-    prm->eos = o->eos;
-    prm->gamma = o->gamma;
-    prm->mu = o->mu;
-    prm->alpha = o->alpha;
-    prm->delta = o->delta;
-    for (int a = 0; a < 3; a++) {
+    for (int a = 0; a < 3; a++)
         prm->body_force[a] = c->gravity[a] + o->body_force[a];
-        prm->periodic[a] = o->periodic[a];
-        prm->lo[a] = o->lo[a];
-        prm->hi[a] = o->hi[a];
-    }
-    prm->cfl = o->cfl;
-    prm->cfl_force = o->cfl_force;
-    prm->cfl_visc = o->cfl_visc;
-    prm->wall_viscous = o->wall_viscous;
-    prm->wall_pressure = o->wall_pressure;
-    prm->penalty_acoustic = o->penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC;
-    prm->soil_wall_stress = o->soil_wall_stress;
-    prm->shepard_every = o->shepard_interval;
-    prm->riemann = o->scheme == LAHAR_SPH_SCHEME_RIEMANN;
-    prm->riemann_eta = o->riemann_limiter;
-    prm->shifting = o->shifting;
-    prm->shifting_density = o->shifting_density;
-    prm->background_pressure = o->background_pressure;
-    prm->transport_velocity = o->transport_velocity;
-    prm->sps = o->sps;
-    prm->sps_cs = o->sps_cs;
     for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */
         if (c->blocks[b].phase == SPH_SOIL_PHASE && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial) {
             const lahar_material *mt = &c->materials[c->blocks[b].material];
@@ -217,7 +190,7 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
                  0.5 * c->sph_dx, o->halo);
         return -1;
     }
-    const kernel_def *kd = kernel_find(prm->kernel ? prm->kernel : "cubic");
+    const kernel_def *kd = kernel_find(o->kernel);
     if (o->kappa > 0.0 && kd && fabs(o->kappa - kd->kappa) > 1e-12) {
         snprintf(err, errlen, "sph.kappa: the coupling range is the kernel's support (%g h); %g h is not implemented yet",
                  kd->kappa, o->kappa);
@@ -414,9 +387,9 @@ static void sph_node_reach(const sph_node *s, double lo[3], double hi[3])
         lo[2] = z < lo[2] ? z : lo[2], hi[2] = z > hi[2] ? z : hi[2];
     }
     for (int a = 0; a < 3; a++) {
-        if (s->f.prm.periodic[a]) { /* particles wrap: the whole period, and beyond by the margin */
-            lo[a] = fmin(lo[a], s->f.prm.lo[a]);
-            hi[a] = fmax(hi[a], s->f.prm.hi[a]);
+        if (s->f.prm.opt.periodic[a]) { /* particles wrap: the whole period, and beyond by the margin */
+            lo[a] = fmin(lo[a], s->f.prm.opt.lo[a]);
+            hi[a] = fmax(hi[a], s->f.prm.opt.hi[a]);
         }
         lo[a] -= margin;
         hi[a] += margin;
@@ -1167,7 +1140,7 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
     }
     /* rates at t_0 for the first dt proposal (with K_n of a CFL step; step 0 re-evaluates them
      * with the granted dt) */
-    double dt_guess = prm.cfl > 0 ? prm.cfl * s->f.k.h / prm.c0 : 0.25 * s->f.k.h / prm.c0;
+    double dt_guess = prm.opt.cfl * s->f.k.h / prm.opt.c0;
     if (sph_fluid_rates(&s->f, s->nbody > 0 ? s->states : NULL, dt_guess) < 0) {
         snprintf(err, errlen, "out of memory in the SPH rates");
         return -1;
@@ -1254,8 +1227,8 @@ int lahar_sph_node_run(const lahar_sph_node_options *o)
     char desc[256];
     if (s.fluid_ready)
         snprintf(desc, sizeof desc, "WCSPH, %lld particles, kernel %s, h = %g m, c0 = %g m/s, %d bodies coupled%s%s",
-                 (long long)s.f.p.n, s.f.prm.kernel, s.f.k.h, s.f.prm.c0, s.nbody,
-                 s.f.prm.sps ? ", SPS turbulence" : "", s.f.has_soil ? ", Drucker-Prager soil" : "");
+                 (long long)s.f.p.n, s.f.prm.opt.kernel, s.f.k.h, s.f.prm.opt.c0, s.nbody,
+                 s.f.prm.opt.sps ? ", SPS turbulence" : "", s.f.has_soil ? ", Drucker-Prager soil" : "");
     st.error = err[0] != '\0';
     st.dt_proposed = st.error ? 0.0 : sph_fluid_dt(&s.f);
     st.dt_stable = st.dt_proposed;

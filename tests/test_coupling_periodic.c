@@ -59,16 +59,18 @@ static int keep(int dim, const double x[3], const lahar_body *b, const double c[
 static void evaluate(int dim, const int periodic[3], int images, const lahar_body *body, const lahar_body_state *state,
                      const double c0[3], const double shift[3], int nx, int ny, int nz, result *r)
 {
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.delta = 0.0;
     prm.dim = dim;
     prm.dx = DX;
     prm.rho0 = RHO;
-    prm.c0 = 10;
-    prm.mu = MU;
+    prm.opt.c0 = 10;
+    prm.opt.mu = MU;
     for (int a = 0; a < 3; a++) {
-        prm.periodic[a] = periodic ? periodic[a] : 0;
-        prm.lo[a] = 0.0;
-        prm.hi[a] = L;
+        prm.opt.periodic[a] = periodic ? periodic[a] : 0;
+        prm.opt.lo[a] = 0.0;
+        prm.opt.hi[a] = L;
     }
     int64_t cap = (int64_t)nx * ny * nz;
     sph_fluid f;
@@ -118,7 +120,7 @@ static void evaluate(int dim, const int periodic[3], int images, const lahar_bod
     if (sph_fluid_attach_bodies(&f, 1, &moved) != 0)
         abort();
     if (!images)
-        sph_coupling_set_periodic(&f.cpl, NULL, prm.lo, prm.hi);
+        sph_coupling_set_periodic(&f.cpl, NULL, prm.opt.lo, prm.opt.hi);
     for (int64_t i = 0; i < f.p.n; i++)
         f.p.ax[i] = f.p.ay[i] = f.p.az[i] = 0.0;
     if (sph_coupling_apply(&f.cpl, &f.p, state ? &st : NULL, DT) != 0)

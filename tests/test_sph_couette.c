@@ -53,14 +53,16 @@ int main(void)
 {
     const int nrow = 20;
     const double dx = H / nrow;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = dx;
     prm.rho0 = RHO;
-    prm.c0 = 0.05;
-    prm.mu = MU;
-    prm.periodic[0] = 1;
-    prm.hi[0] = PERIOD;
+    prm.opt.c0 = 0.05;
+    prm.opt.mu = MU;
+    prm.opt.periodic[0] = 1;
+    prm.opt.hi[0] = PERIOD;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, (int64_t)lround(PERIOD / dx) * nrow, err, sizeof err) != 0) {

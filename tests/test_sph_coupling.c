@@ -47,12 +47,14 @@ static void disc2d(lahar_body *b, double R)
 
 static void one_particle(sph_fluid *f, int dim, const double x[3], const double v[3], int nbody, const lahar_body *b)
 {
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.delta = 0.0;
     prm.dim = dim;
     prm.dx = DX;
     prm.rho0 = RHO;
-    prm.c0 = 10;
-    prm.mu = MU;
+    prm.opt.c0 = 10;
+    prm.opt.mu = MU;
     char err[256];
     if (sph_fluid_init(f, &prm, 4, err, sizeof err) != 0)
         abort();
@@ -126,9 +128,11 @@ int main(void)
         walls[1].motion = LAHAR_MOTION_FIXED;
         walls[1].convex = 1;
         walls[1].q[0] = 1.0;
-        sph_params prm = {0};
-        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.c0 = 10, prm.mu = MU;
-        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
+        sph_params prm;
+        sph_params_default(&prm);
+        prm.opt.delta = 0.0;
+        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.opt.c0 = 10, prm.opt.mu = MU;
+        prm.opt.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
         char err[256];
         if (sph_fluid_init(&f, &prm, 4, err, sizeof err) != 0)
             abort();
@@ -191,8 +195,10 @@ int main(void)
      * has neighbours only above it, so -A h^2 grad C points into the plate. That part is dropped:
      * the row may shift along the plate, never towards it. */
     {
-        sph_params prm = {0};
-        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.c0 = 10, prm.mu = MU, prm.shifting = 0.05;
+        sph_params prm;
+        sph_params_default(&prm);
+        prm.opt.delta = 0.0;
+        prm.dim = 2, prm.dx = DX, prm.rho0 = RHO, prm.opt.c0 = 10, prm.opt.mu = MU, prm.opt.shifting = 0.05;
         char err[256];
         if (sph_fluid_init(&f, &prm, 200, err, sizeof err) != 0)
             abort();
@@ -312,12 +318,14 @@ int main(void)
         double res[2][2][3];
         for (int th = 1; th <= 2; th++) {
             omp_set_num_threads(th);
-            sph_params prm = {0};
+            sph_params prm;
+            sph_params_default(&prm);
+            prm.opt.delta = 0.0;
             prm.dim = 2;
             prm.dx = DX;
             prm.rho0 = RHO;
-            prm.c0 = 10;
-            prm.mu = MU;
+            prm.opt.c0 = 10;
+            prm.opt.mu = MU;
             char err[256];
             sph_fluid_init(&f, &prm, 3600, err, sizeof err);
             unsigned long long s = 12345;

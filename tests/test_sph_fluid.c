@@ -77,8 +77,8 @@ static int64_t brute_rates(const sph_fluid *f, int64_t i, double out[4])
             continue;
         double r[3] = {p->x[i] - p->x[j], p->y[i] - p->y[j], p->z[i] - p->z[j]};
         for (int d = 0; d < 3; d++)
-            if (prm->periodic[d]) {
-                double L = prm->hi[d] - prm->lo[d];
+            if (prm->opt.periodic[d]) {
+                double L = prm->opt.hi[d] - prm->opt.lo[d];
                 r[d] -= L * round(r[d] / L);
             }
         double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -92,16 +92,16 @@ static int64_t brute_rates(const sph_fluid *f, int64_t i, double out[4])
         double hyd = 0.0; /* hydrostatic density difference along non-periodic axes */
         double b[3] = {prm->body_force[0], prm->body_force[1], prm->body_force[2]};
         for (int d = 0; d < 3; d++)
-            if (!prm->periodic[d])
-                hyd += prm->rho0 * b[d] / (prm->c0 * prm->c0) * r[d];
+            if (!prm->opt.periodic[d])
+                hyd += prm->rho0 * b[d] / (prm->opt.c0 * prm->opt.c0) * r[d];
         drho += p->rho[i] * Vj * vr * F +
-                2.0 * prm->delta * h * prm->c0 * Vj * ((p->rho[i] - p->rho[j]) - hyd) * F * r2 / (r2 + eta2);
+                2.0 * prm->opt.delta * h * prm->opt.c0 * Vj * ((p->rho[i] - p->rho[j]) - hyd) * F * r2 / (r2 + eta2);
         double pi_ = sph_fluid_pressure(prm, p->rho[i]), pj = sph_fluid_pressure(prm, p->rho[j]);
         double P = pi_ / (p->rho[i] * p->rho[i]) + pj / (p->rho[j] * p->rho[j]);
-        if (prm->alpha > 0 && vr < 0)
-            P += -prm->alpha * prm->c0 * (h * vr / (r2 + eta2)) / (0.5 * (p->rho[i] + p->rho[j]));
+        if (prm->opt.alpha > 0 && vr < 0)
+            P += -prm->opt.alpha * prm->opt.c0 * (h * vr / (r2 + eta2)) / (0.5 * (p->rho[i] + p->rho[j]));
         for (int d = 0; d < 3; d++)
-            a[d] += -p->m[j] * P * F * r[d] + p->m[j] * 2.0 * prm->mu / (p->rho[i] * p->rho[j]) * F * r2 / (r2 + eta2) * v[d];
+            a[d] += -p->m[j] * P * F * r[d] + p->m[j] * 2.0 * prm->opt.mu / (p->rho[i] * p->rho[j]) * F * r2 / (r2 + eta2) * v[d];
     }
     out[0] = drho;
     for (int d = 0; d < 3; d++)
@@ -122,22 +122,23 @@ static void check_rates_brute(int dim, const char *kern, lahar_sph_eos eos, int 
     const int side[3] = {big ? (dim == 2 ? 55 : 14) : 12, big ? (dim == 2 ? 55 : 14) : dim == 2 ? 12 : 6,
                          dim == 2 ? 1 : big ? 14 : 6};
     omp_set_num_threads(big ? 2 : 1);
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
     prm.dim = dim;
-    prm.kernel = kern;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", kern);
     prm.dx = 0.01;
     prm.rho0 = 1000;
-    prm.c0 = 20;
-    prm.eos = eos;
-    prm.mu = 0.05;
-    prm.alpha = 0.1;
-    prm.delta = 0.1;
+    prm.opt.c0 = 20;
+    prm.opt.eos = eos;
+    prm.opt.mu = 0.05;
+    prm.opt.alpha = 0.1;
+    prm.opt.delta = 0.1;
     prm.body_force[1] = -9.81;
-    prm.periodic[0] = 1;
-    prm.periodic[1] = dim == 2 || big;
-    prm.periodic[2] = big;
+    prm.opt.periodic[0] = 1;
+    prm.opt.periodic[1] = dim == 2 || big;
+    prm.opt.periodic[2] = big;
     for (int a = 0; a < 3; a++)
-        prm.hi[a] = side[a] * prm.dx;
+        prm.opt.hi[a] = side[a] * prm.dx;
     sph_fluid f;
     char err[256];
     int64_t cap = (int64_t)side[0] * side[1] * side[2];
@@ -146,7 +147,7 @@ static void check_rates_brute(int dim, const char *kern, lahar_sph_eos eos, int 
         failures++;
         return;
     }
-    double lo[3] = {0, 0, 0}, hi[3] = {prm.hi[0], prm.hi[1], prm.hi[2]}, v0[3] = {0, 0, 0};
+    double lo[3] = {0, 0, 0}, hi[3] = {prm.opt.hi[0], prm.opt.hi[1], prm.opt.hi[2]}, v0[3] = {0, 0, 0};
     sph_particles_add_box(&f.p, dim, prm.dx, prm.rho0, lo, hi, v0);
     sph_particles *p = &f.p;
     for (int64_t i = 0; i < p->n; i++) { /* disorder, motion, density noise; some cross the period */
@@ -263,14 +264,16 @@ static void check_delta_sph(void)
 {
     const int N = 48;
     const double dx = 0.01, L = N * dx, A = 1e-3, rho0 = 1000, c0 = 10, delta = 0.1;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
     prm.dim = 2;
     prm.dx = dx;
     prm.rho0 = rho0;
-    prm.c0 = c0;
-    prm.delta = delta;
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = prm.hi[1] = L;
+    prm.opt.c0 = c0;
+    prm.opt.delta = delta;
+    prm.opt.periodic[0] = prm.opt.periodic[1] = 1;
+    prm.opt.hi[0] = prm.opt.hi[1] = L;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, N * N, err, sizeof err) != 0) {
@@ -301,13 +304,14 @@ static void check_delta_sph(void)
 
 static void check_eos(void)
 {
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
     prm.rho0 = 1000;
-    prm.c0 = 30;
-    prm.gamma = 7;
-    prm.eos = LAHAR_SPH_EOS_LINEAR;
+    prm.opt.c0 = 30;
+    prm.opt.gamma = 7;
+    prm.opt.eos = LAHAR_SPH_EOS_LINEAR;
     CHECK(fabs(sph_fluid_pressure(&prm, 1010) - 900 * 10) < 1e-9, "linear EOS");
-    prm.eos = LAHAR_SPH_EOS_TAIT;
+    prm.opt.eos = LAHAR_SPH_EOS_TAIT;
     double pt = sph_fluid_pressure(&prm, 1010), expect = 1000 * 900 / 7.0 * (pow(1.01, 7) - 1);
     CHECK(fabs(pt - expect) < 1e-9 * expect, "Tait EOS %.12g vs %.12g", pt, expect);
     double e = 1e-3, slope = (sph_fluid_pressure(&prm, 1000 + e) - sph_fluid_pressure(&prm, 1000 - e)) / (2 * e);
@@ -323,14 +327,15 @@ typedef struct {
 static void run_fall(int threads, fall_state *out)
 {
     omp_set_num_threads(threads);
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = 0.01;
     prm.rho0 = 1000;
-    prm.c0 = 20;
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = 20;
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.body_force[1] = -9.81;
     sph_fluid f;
     char err[256];
@@ -367,14 +372,17 @@ static void run_fall(int threads, fall_state *out)
  * moved by up to +-jitter/2 dx; `shifting` as sph_params.shifting. Returns 0, or -1 (counted). */
 static int disordered_periodic_lattice(sph_fluid *f, double shifting, double jitter)
 {
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = 0.01;
     prm.rho0 = 1000;
-    prm.c0 = 20;
-    prm.shifting = shifting;
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = prm.hi[1] = 0.12;
+    prm.opt.c0 = 20;
+    prm.opt.shifting = shifting;
+    prm.opt.periodic[0] = prm.opt.periodic[1] = 1;
+    prm.opt.hi[0] = prm.opt.hi[1] = 0.12;
     char err[256];
     if (sph_fluid_init(f, &prm, 144, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);
@@ -488,7 +496,7 @@ static void check_shifting(void)
         id0[i] = p->id[i];
     }
     sph_fluid_step(&f, dt, NULL);
-    const double a = -prm.shifting * f.k.h * f.k.h;
+    const double a = -prm.opt.shifting * f.k.h * f.k.h;
     double worst = 0.0, big = 0.0;
     for (int64_t i = 0; i < n; i++) {
         const double *q = x0 + 4 * p->id[i];
@@ -542,7 +550,7 @@ static void check_shifting_density(void)
     sph_fluid f;
     if (disordered_periodic_lattice(&f, 0.05, 0.4) != 0)
         return;
-    f.prm.shifting_density = 1;
+    f.prm.opt.shifting_density = 1;
     sph_particles *p = &f.p;
     const int64_t n = p->n;
     double *s0 = malloc((size_t)n * sizeof *s0);

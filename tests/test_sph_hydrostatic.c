@@ -42,24 +42,25 @@ int main(int argc, char **argv)
 {
     const int NX = 20, NY = argc > 1 ? atoi(argv[1]) : 20;
     const double dx = 0.01, W = NX * dx, H = NY * dx, g = 9.81, rho0 = 1000, T = argc > 2 ? atof(argv[2]) : 2.0;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = dx;
     prm.rho0 = rho0;
-    prm.c0 = 20.0 * sqrt(g * H);
-    prm.alpha = 0.1;
-    prm.delta = getenv("SPH_DELTA") ? atof(getenv("SPH_DELTA")) : 0.0;
-    prm.shepard_every = getenv("SPH_SHEPARD") ? atoi(getenv("SPH_SHEPARD")) : 0;
-    prm.mu = 1e-3;
+    prm.opt.c0 = 20.0 * sqrt(g * H);
+    prm.opt.alpha = 0.1;
+    prm.opt.delta = getenv("SPH_DELTA") ? atof(getenv("SPH_DELTA")) : 0.0;
+    prm.opt.shepard_interval = getenv("SPH_SHEPARD") ? atoi(getenv("SPH_SHEPARD")) : 0;
+    prm.opt.mu = 1e-3;
     prm.body_force[1] = -g;
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
     if (argc > 4 && strcmp(argv[4], "riemann") == 0) { /* the Riemann scheme (sph_riemann.h): its own dissipation */
-        prm.riemann = 1;
-        prm.riemann_eta = 3.0;
-        prm.alpha = 0.0;
+        prm.opt.scheme = LAHAR_SPH_SCHEME_RIEMANN;
+        prm.opt.riemann_limiter = 3.0;
+        prm.opt.alpha = 0.0;
     }
     if (ghost)
-        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
+        prm.opt.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, NX * NY, err, sizeof err) != 0) {
@@ -69,7 +70,7 @@ int main(int argc, char **argv)
     double lo[3] = {0, 0, 0}, hi[3] = {W, H, 0}, v0[3] = {0, 0, 0};
     sph_particles_add_box(&f.p, 2, dx, rho0, lo, hi, v0);
     for (int64_t i = 0; i < f.p.n; i++) { /* hydrostatic start: p = rho0 g (H - y), mass rho dx^2 */
-        f.p.rho[i] = rho0 + rho0 * g * (H - f.p.y[i]) / (prm.c0 * prm.c0);
+        f.p.rho[i] = rho0 + rho0 * g * (H - f.p.y[i]) / (prm.opt.c0 * prm.opt.c0);
         f.p.m[i] = f.p.rho[i] * dx * dx;
     }
     lahar_body walls[3];

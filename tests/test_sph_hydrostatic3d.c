@@ -39,21 +39,23 @@ int main(int argc, char **argv)
 {
     const int NB = 8, NZ = argc > 1 ? atoi(argv[1]) : 10;
     const double dx = 0.01, W = NB * dx, H = NZ * dx, g = 9.81, rho0 = 1000, T = argc > 2 ? atof(argv[2]) : 3.0;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.delta = 0.0;
     prm.dim = 3;
     prm.dx = dx;
     prm.rho0 = rho0;
-    prm.c0 = 20.0 * sqrt(g * H);
-    prm.alpha = 0.1;
-    prm.mu = 1e-3;
+    prm.opt.c0 = 20.0 * sqrt(g * H);
+    prm.opt.alpha = 0.1;
+    prm.opt.mu = 1e-3;
     prm.body_force[2] = -g;
     /* "ghost": the walls carry the ghost-layer pressure (sph.wall_pressure: ghost, Adami et al.
      * 2012 eq. 27) on the quintic kernel at h = dx, the settings of cases/hydrostatic_3d.yaml */
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
     if (ghost) {
-        prm.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
-        prm.kernel = "quintic";
-        prm.h_over_dx = 1.0;
+        prm.opt.wall_pressure = LAHAR_SPH_WALL_PRESSURE_GHOST;
+        snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "quintic");
+        prm.opt.h_over_dx = 1.0;
     }
     sph_fluid f;
     char err[256];
@@ -64,7 +66,7 @@ int main(int argc, char **argv)
     double lo[3] = {0, 0, 0}, hi[3] = {W, W, H}, v0[3] = {0, 0, 0};
     sph_particles_add_box(&f.p, 3, dx, rho0, lo, hi, v0);
     for (int64_t i = 0; i < f.p.n; i++) {
-        f.p.rho[i] = rho0 + rho0 * g * (H - f.p.z[i]) / (prm.c0 * prm.c0);
+        f.p.rho[i] = rho0 + rho0 * g * (H - f.p.z[i]) / (prm.opt.c0 * prm.opt.c0);
         f.p.m[i] = f.p.rho[i] * dx * dx * dx;
     }
     const double t = 0.05, e = 0.1; /* wall thickness, extension past the tank */

@@ -71,16 +71,16 @@ static int channel_open(channel *ch, double dx, double h, double L, double c0, l
     memset(ch, 0, sizeof *ch);
     ch->dx = dx, ch->h = h;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = dx;
-    prm.kernel = "wendland2";
-    prm.h_over_dx = 1.41;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
+    prm.opt.h_over_dx = 1.41;
     prm.rho0 = 1000.0;
-    prm.c0 = c0;
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = c0;
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.body_force[1] = -G;
     const double g[3] = {0.0, -G, 0.0};
     in->x0[0] = 0.0, in->x0[1] = 0.0, in->x0[2] = 0.0;
@@ -447,16 +447,16 @@ static void test_3d(void)
     in.level = h;
     in.layers = 3;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = 3;
     prm.dx = dx;
-    prm.kernel = "wendland2";
-    prm.h_over_dx = 1.41;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
+    prm.opt.h_over_dx = 1.41;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = 10.0;
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.body_force[2] = -G;
     const double g[3] = {0.0, 0.0, -G};
     sph_inflow fl;
@@ -482,7 +482,7 @@ static void test_3d(void)
     floor.convex = 1;
     floor.q[0] = 1.0;
     if (sph_fluid_attach_bodies(&f, 1, &floor) != 0 || sph_inflow_start(&fl, &f, 0.0, err, sizeof err) != 0 ||
-        sph_cells_sort(&f.cells, &f.p) != 0 || sph_fluid_rates(&f, NULL, 0.25 * f.k.h / prm.c0) < 0) {
+        sph_cells_sort(&f.cells, &f.p) != 0 || sph_fluid_rates(&f, NULL, 0.25 * f.k.h / prm.opt.c0) < 0) {
         CHECK(0, "3d: start: %s", err);
     } else {
         int ok = 1;

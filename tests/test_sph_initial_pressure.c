@@ -97,11 +97,11 @@ static void test_linear_2d(const char *dir)
     CHECK(back.sph.initial_pressure == LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC, "initial_pressure lost in the message");
     CHECK(c.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && back.sph.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST,
           "wall_pressure not read or lost in the message");
-    CHECK(prm.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
+    CHECK(prm.opt.wall_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST, "wall_pressure not passed to the solver");
     CHECK(c.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST &&
               back.sph.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST,
           "soil_wall_stress not read or lost in the message");
-    CHECK(prm.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST, "soil_wall_stress not passed to the solver");
+    CHECK(prm.opt.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST, "soil_wall_stress not passed to the solver");
     lahar_scene_msg_release(&msg);
     lahar_case_free(&back);
     sph_particles_free(&p);

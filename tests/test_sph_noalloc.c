@@ -105,21 +105,21 @@ static void scene(const char *name, int dim, double dx, const double water[3], c
                   lahar_sph_eos eos, int nwarm, int ncount)
 {
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = dim;
     prm.dx = dx;
-    prm.kernel = "wendland2";
-    prm.h_over_dx = 1.41;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
+    prm.opt.h_over_dx = 1.41;
     prm.rho0 = 1000.0;
     const double H = water[dim - 1];
-    prm.c0 = 10.0 * sqrt(9.81 * H);
-    prm.eos = eos;
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = 10.0 * sqrt(9.81 * H);
+    prm.opt.eos = eos;
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.body_force[dim - 1] = -9.81;
-    prm.sps = sps;
-    prm.shepard_every = sps ? 5 : 0;
+    prm.opt.sps = sps;
+    prm.opt.shepard_interval = sps ? 5 : 0;
     int64_t cap = 1;
     for (int a = 0; a < dim; a++)
         cap *= (int64_t)floor(water[a] / dx + 1e-9);
@@ -172,7 +172,7 @@ static void scene(const char *name, int dim, double dx, const double water[3], c
         states[b].q[0] = 1.0;
     }
     if (sph_fluid_attach_bodies(&f, nb, bodies) != 0 || sph_cells_sort(&f.cells, &f.p) != 0 ||
-        sph_fluid_rates(&f, states, 0.25 * f.k.h / prm.c0) < 0) {
+        sph_fluid_rates(&f, states, 0.25 * f.k.h / prm.opt.c0) < 0) {
         CHECK(0, "%s: set-up", name);
     } else {
         long warm = steps(&f, nwarm, states, moving, 1);

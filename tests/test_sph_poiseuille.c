@@ -77,18 +77,20 @@ static void run(int nrow, const char *kern, lahar_sph_wall_viscous wv, int threa
     omp_set_num_threads(threads);
     memset(res, 0, sizeof *res);
     double dx = H / nrow;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
+    prm.opt.delta = 0.0;
     prm.dim = 2;
-    prm.kernel = kern;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", kern);
     prm.dx = dx;
     prm.rho0 = RHO;
-    prm.c0 = 0.0125 * 4; /* 40 u_max: density variations ~ (u/c)^2 stay tiny */
-    prm.mu = MU;
+    prm.opt.c0 = 0.0125 * 4; /* 40 u_max: density variations ~ (u/c)^2 stay tiny */
+    prm.opt.mu = MU;
     prm.body_force[0] = A;
-    prm.periodic[0] = 1;
-    prm.lo[0] = 0.0;
-    prm.hi[0] = PERIOD;
-    prm.wall_viscous = wv;
+    prm.opt.periodic[0] = 1;
+    prm.opt.lo[0] = 0.0;
+    prm.opt.hi[0] = PERIOD;
+    prm.opt.wall_viscous = wv;
     sph_fluid f;
     char err[256];
     int ncol = (int)lround(PERIOD / dx);

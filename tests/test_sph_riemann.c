@@ -70,22 +70,23 @@ static double hammer(int riemann, double *mom)
 {
     const int NX = 100, NY = 8;
     const double dx = 0.01, L = NX * dx, rho0 = 1000, c0 = 20, U = 0.5, tend = 0.01;
-    sph_params prm = {0};
+    sph_params prm;
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = dx;
     prm.rho0 = rho0;
-    prm.c0 = c0;
-    prm.mu = 1e-3;
+    prm.opt.c0 = c0;
+    prm.opt.mu = 1e-3;
     if (riemann) {
-        prm.riemann = 1;
-        prm.riemann_eta = 3.0;
+        prm.opt.scheme = LAHAR_SPH_SCHEME_RIEMANN;
+        prm.opt.riemann_limiter = 3.0;
     } else {
-        prm.alpha = 0.02;
-        prm.delta = 0.1;
+        prm.opt.alpha = 0.02;
+        prm.opt.delta = 0.1;
     }
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = L;
-    prm.hi[1] = NY * dx;
+    prm.opt.periodic[0] = prm.opt.periodic[1] = 1;
+    prm.opt.hi[0] = L;
+    prm.opt.hi[1] = NY * dx;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, NX * NY, err, sizeof err) != 0) {

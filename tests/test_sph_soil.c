@@ -94,13 +94,15 @@ static void test_return(void)
 static int64_t soil_lattice(sph_fluid *f, int n, const double L[2][2], const double sig0[6])
 {
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
-    prm.kernel = "quintic";
-    prm.h_over_dx = 1.0;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "quintic");
+    prm.opt.h_over_dx = 1.0;
     prm.dx = DX;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
+    prm.opt.c0 = 10.0;
     prm.body_force[1] = -9.81;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 0.0);
@@ -181,11 +183,13 @@ static void test_jaumann_and_uniform(void)
 static void test_water_only(void)
 {
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = DX;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
+    prm.opt.c0 = 10.0;
     sph_fluid f;
     char err[256];
     CHECK(sph_fluid_init(&f, &prm, 100, err, sizeof err) == 0, "init");
@@ -198,13 +202,15 @@ static void test_seepage(void)
     const int n = 10;
     const double kh = 0.01, g = 9.81, u = 2e-3;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = DX;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = prm.hi[1] = n * DX;
+    prm.opt.c0 = 10.0;
+    prm.opt.periodic[0] = prm.opt.periodic[1] = 1;
+    prm.opt.hi[0] = prm.opt.hi[1] = n * DX;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 1e4);
     prm.soil_mat.kh = kh;
@@ -267,11 +273,13 @@ static void test_friction(void)
     plate.convex = 1;
     plate.q[0] = 1.0;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = DX;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
+    prm.opt.c0 = 10.0;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 0.0);
     prm.soil_mat.mu_phi = mu;
@@ -388,14 +396,16 @@ static int64_t soil_on_plate(sph_fluid *f, lahar_body *plate, int nx, int ny, do
     plate->convex = 1;
     plate->q[0] = 1.0;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
+    prm.opt.mu = 0.0;
+    prm.opt.delta = 0.0;
     prm.dim = 2;
     prm.dx = DX;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0;
+    prm.opt.c0 = 10.0;
     prm.soil = 1;
     prm.soil_mat = sand(30.0, 0.0);
-    prm.soil_wall_stress = LAHAR_SPH_WALL_PRESSURE_GHOST;
+    prm.opt.soil_wall_stress = LAHAR_SPH_WALL_PRESSURE_GHOST;
     char err[256];
     if (sph_fluid_init(f, &prm, (int64_t)nx * ny, err, sizeof err) != 0) {
         CHECK(0, "init: %s", err);

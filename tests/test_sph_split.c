@@ -37,17 +37,17 @@ static int setup(sph_fluid *f, int sps, lahar_body *bodies)
 {
     const double dx = 0.005, W = 0.3, H = 0.2, g = 9.81;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = dx;
     prm.rho0 = 1000.0;
-    prm.c0 = 10.0 * sqrt(g * H);
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = 10.0 * sqrt(g * H);
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.body_force[1] = -g;
-    prm.sps = sps;
-    prm.penalty_acoustic = 1; /* K_n from the acoustic step, not from dt: the same model at every dt */
+    prm.opt.sps = sps;
+    prm.opt.penalty_stiffness = LAHAR_SPH_PENALTY_ACOUSTIC; /* K_n from the acoustic step, not from dt: the same model at every dt */
     char err[256];
     if (sph_fluid_init(f, &prm, NP, err, sizeof err) != 0) {
         fprintf(stderr, "%s\n", err);

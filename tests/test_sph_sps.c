@@ -27,13 +27,15 @@ static const double DX = 0.01, RHO0 = 1000.0, CS = 0.12;
 
 static void shear_params(sph_params *prm, int dim)
 {
-    memset(prm, 0, sizeof *prm);
+    sph_params_default(prm);
+    prm->opt.mu = 0.0;
+    prm->opt.delta = 0.0;
     prm->dim = dim;
     prm->dx = DX;
     prm->rho0 = RHO0;
-    prm->c0 = 10.0;
-    prm->sps = 1;
-    prm->sps_cs = CS;
+    prm->opt.c0 = 10.0;
+    prm->opt.sps = 1;
+    prm->opt.sps_cs = CS;
 }
 
 /* The SPH velocity gradient on an unbounded lattice: dv_x/dy = gamma G with
@@ -62,12 +64,12 @@ static void check_linear_shear(int dim, const char *kname, int exact_bound)
     const double gamma = 5.0;
     sph_params prm;
     shear_params(&prm, dim);
-    prm.kernel = kname;
-    prm.periodic[0] = 1;
-    prm.hi[0] = NX * DX;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", kname);
+    prm.opt.periodic[0] = 1;
+    prm.opt.hi[0] = NX * DX;
     if (dim == 3) {
-        prm.periodic[2] = 1;
-        prm.hi[2] = NZ * DX;
+        prm.opt.periodic[2] = 1;
+        prm.opt.hi[2] = NZ * DX;
     }
     sph_fluid f;
     char err[256];
@@ -119,9 +121,9 @@ static void check_shear_wave(void)
     const double A = 0.2, L = NY * DX, k = 2.0 * M_PI / L;
     sph_params prm;
     shear_params(&prm, 2);
-    prm.periodic[0] = prm.periodic[1] = 1;
-    prm.hi[0] = NX * DX;
-    prm.hi[1] = L;
+    prm.opt.periodic[0] = prm.opt.periodic[1] = 1;
+    prm.opt.hi[0] = NX * DX;
+    prm.opt.hi[1] = L;
     sph_fluid f;
     char err[256];
     if (sph_fluid_init(&f, &prm, (int64_t)NX * NY, err, sizeof err) != 0) {
@@ -172,16 +174,16 @@ static void check_dam_break(void)
 {
     const double W = 0.2, H = 0.4, TANK = 0.8, g = 9.81;
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = DX;
     prm.rho0 = RHO0;
-    prm.c0 = 10.0 * sqrt(2.0 * g * H);
-    prm.mu = 1e-3;
-    prm.alpha = 0.01;
-    prm.delta = 0.1;
+    prm.opt.c0 = 10.0 * sqrt(2.0 * g * H);
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.01;
+    prm.opt.delta = 0.1;
     prm.body_force[1] = -g;
-    prm.sps = 1;
+    prm.opt.sps = 1;
     sph_fluid f;
     char err[256];
     const int64_t n = (int64_t)(W / DX + 0.5) * (int64_t)(H / DX + 0.5);

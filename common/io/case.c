@@ -2248,7 +2248,10 @@ static void check_blocks_placement(reader *r, yaml_node_t *bl, lahar_case *c)
     }
 }
 
-static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
+/* The option keys of sph: (everything but dx, density, periodic and blocks) with the key table's
+ * defaults; checks that tie keys together are read_sph's. dx = 0: no spacing known (the halo's
+ * default dx/2 stays 0). */
+static void read_sph_options(rmap *m, lahar_sph_options *o, int dim, double dx)
 {
     static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
     static const char *const eos_names[] = {"linear", "tait", NULL};
@@ -2257,6 +2260,73 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
     static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
     static const char *const scheme_names[] = {"delta", "riemann", NULL}; /* LAHAR_SPH_SCHEME_* */
+    int kind = rmap_enum(m, "kernel", kernels, 0, 0);
+    snprintf(o->kernel, sizeof o->kernel, "%s", kernels[kind]);
+    const kernel_def *kd = kernel_find(o->kernel);
+    o->h_over_dx = key_num(m, "h_over_dx");
+    o->eos = (lahar_sph_eos)rmap_enum(m, "eos", eos_names, 0, LAHAR_SPH_EOS_LINEAR);
+    o->gamma = key_num(m, "gamma");
+    o->mu = key_num(m, "viscosity");
+    o->alpha = key_num(m, "alpha");
+    o->delta = key_num(m, "delta");
+    o->cfl = key_num(m, "cfl");
+    o->cfl_force = key_num(m, "cfl_force");
+    o->cfl_visc = key_num(m, "cfl_visc");
+    rmap_vec(m, "body_force", dim, o->body_force, 0, "");
+    o->shepard_interval = (int)key_num(m, "shepard_interval");
+    o->shifting = key_num(m, "shifting");
+    o->sps = rmap_bool(m, "sps", 0);
+    o->shifting_density = rmap_bool(m, "shifting_density", 0);
+    o->transport_velocity = rmap_bool(m, "transport_velocity", 0);
+    o->body_layers = (int)key_num(m, "body_layers");
+    o->sps_cs = key_num(m, "sps_cs");
+    o->halo = rmap_num(m, "halo", 0, 0.5 * dx, "0.005");
+    o->kappa = rmap_num(m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
+    o->wall_viscous = (lahar_sph_wall_viscous)rmap_enum(m, "wall_viscous", wall_names, 0, LAHAR_SPH_WALL_HALFSPACE);
+    o->initial_pressure = (lahar_sph_initial_pressure)rmap_enum(m, "initial_pressure", initial_pressure_names, 0,
+                                                                LAHAR_SPH_INITIAL_PRESSURE_NONE);
+    o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(m, "wall_pressure", wall_pressure_names, 0,
+                                                          LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->penalty_stiffness = (lahar_sph_penalty_stiffness)rmap_enum(m, "penalty_stiffness", penalty_stiffness_names, 0,
+                                                                  LAHAR_SPH_PENALTY_STEP);
+    o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(m, "soil_wall_stress", wall_pressure_names, 0,
+                                                             LAHAR_SPH_WALL_PRESSURE_PENALTY);
+    o->scheme = (lahar_sph_scheme)rmap_enum(m, "scheme", scheme_names, 0, LAHAR_SPH_SCHEME_DELTA);
+    o->riemann_limiter = key_num(m, "riemann_limiter");
+    if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN) { /* its own dissipation replaces delta-SPH and Monaghan's */
+        if (!rmap_get(m, "delta"))
+            o->delta = 0.0;
+        if (!rmap_get(m, "alpha"))
+            o->alpha = 0.0;
+    }
+}
+
+/* lahar_sph_options_default (case.h): read_sph_options on an empty mapping. */
+void lahar_sph_options_default(lahar_sph_options *o)
+{
+    memset(o, 0, sizeof *o);
+    yaml_document_t doc;
+    char err[256];
+    reader r;
+    memset(&r, 0, sizeof r);
+    r.path = "(defaults)";
+    r.err = err;
+    r.errlen = sizeof err;
+    r.dim = 3;
+    if (!yaml_document_initialize(&doc, NULL, NULL, NULL, 1, 1))
+        return;
+    int id = yaml_document_add_mapping(&doc, NULL, YAML_ANY_MAPPING_STYLE);
+    r.doc = &doc;
+    rmap m;
+    if (id && rmap_open(&r, rd_node(&r, id), "sph", &m) == 0) {
+        rmap_section(&m, "sph");
+        read_sph_options(&m, o, 3, 0.0);
+    }
+    yaml_document_delete(&doc);
+}
+
+static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
+{
     lahar_sph_options *o = &c->sph;
     c->sph_density = 1000.0;
     if (!n)
@@ -2272,45 +2342,8 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     if (r->failed)
         return;
     const double dx = c->sph_dx;
-    int kind = rmap_enum(&m, "kernel", kernels, 0, 0);
-    snprintf(o->kernel, sizeof o->kernel, "%s", kernels[kind]);
+    read_sph_options(&m, o, dim, dx);
     const kernel_def *kd = kernel_find(o->kernel);
-    o->h_over_dx = key_num(&m, "h_over_dx");
-    o->eos = (lahar_sph_eos)rmap_enum(&m, "eos", eos_names, 0, LAHAR_SPH_EOS_LINEAR);
-    o->gamma = key_num(&m, "gamma");
-    o->mu = key_num(&m, "viscosity");
-    o->alpha = key_num(&m, "alpha");
-    o->delta = key_num(&m, "delta");
-    o->cfl = key_num(&m, "cfl");
-    o->cfl_force = key_num(&m, "cfl_force");
-    o->cfl_visc = key_num(&m, "cfl_visc");
-    rmap_vec(&m, "body_force", dim, o->body_force, 0, "");
-    double shep = key_num(&m, "shepard_interval");
-    o->shifting = key_num(&m, "shifting");
-    o->sps = rmap_bool(&m, "sps", 0);
-    o->shifting_density = rmap_bool(&m, "shifting_density", 0);
-    o->transport_velocity = rmap_bool(&m, "transport_velocity", 0);
-    double layers = key_num(&m, "body_layers");
-    o->sps_cs = key_num(&m, "sps_cs");
-    o->halo = rmap_num(&m, "halo", 0, 0.5 * dx, "0.005");
-    o->kappa = rmap_num(&m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
-    o->wall_viscous = (lahar_sph_wall_viscous)rmap_enum(&m, "wall_viscous", wall_names, 0, LAHAR_SPH_WALL_HALFSPACE);
-    o->initial_pressure = (lahar_sph_initial_pressure)rmap_enum(&m, "initial_pressure", initial_pressure_names, 0,
-                                                                LAHAR_SPH_INITIAL_PRESSURE_NONE);
-    o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(&m, "wall_pressure", wall_pressure_names, 0,
-                                                          LAHAR_SPH_WALL_PRESSURE_PENALTY);
-    o->penalty_stiffness = (lahar_sph_penalty_stiffness)rmap_enum(&m, "penalty_stiffness", penalty_stiffness_names, 0,
-                                                                  LAHAR_SPH_PENALTY_STEP);
-    o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(&m, "soil_wall_stress", wall_pressure_names, 0,
-                                                             LAHAR_SPH_WALL_PRESSURE_PENALTY);
-    o->scheme = (lahar_sph_scheme)rmap_enum(&m, "scheme", scheme_names, 0, LAHAR_SPH_SCHEME_DELTA);
-    o->riemann_limiter = key_num(&m, "riemann_limiter");
-    if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN) { /* its own dissipation replaces delta-SPH and Monaghan's */
-        if (!rmap_get(&m, "delta"))
-            o->delta = 0.0;
-        if (!rmap_get(&m, "alpha"))
-            o->alpha = 0.0;
-    }
     yaml_node_t *pn = rmap_get(&m, "periodic");
     if (pn)
         read_periodic(r, pn, o);
@@ -2331,11 +2364,11 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
     else if (rmap_get(&m, "riemann_limiter") && o->scheme != LAHAR_SPH_SCHEME_RIEMANN)
         rmap_fail(&m, "riemann_limiter", "is the limiter of scheme: riemann, but the case uses scheme: delta; remove it "
                   "or set scheme: riemann");
-    else if (shep > 0 && !LAHAR_SPH_HAVE_SHEPARD)
+    else if (o->shepard_interval > 0 && !LAHAR_SPH_HAVE_SHEPARD)
         rmap_fail(&m, "shepard_interval", "the Shepard filter is not implemented yet; remove the key or set 0");
     else if (o->sps && !LAHAR_SPH_HAVE_SPS)
         rmap_fail(&m, "sps", "SPS turbulence is not implemented yet; remove the key or set false");
-    else if (layers > 0 && case_first_round_body(c) < 0)
+    else if (o->body_layers > 0 && case_first_round_body(c) < 0)
         rmap_fail(&m, "body_layers", "places particles on layers around sphere (3D) or disc (2D) bodies, but the case "
                   "has none; remove the key");
     else if (o->shifting_density && !(o->shifting > 0.0))
@@ -2367,8 +2400,6 @@ static void read_sph(reader *r, yaml_node_t *n, lahar_case *c)
                       "outwards); remove shifting or drive the flow along periodic axes only", "xyz"[a]);
             return;
         }
-    o->shepard_interval = (int)shep;
-    o->body_layers = (int)layers;
     if (o->body_layers > 0)
         case_check_body_layers(&m, c);
     if (r->failed)

@@ -29,6 +29,10 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
  * relative paths in it (STL meshes, initial files) start from. lahar_case_load_err reads the file
  * and calls this. */
 int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen);
+/* Every sph: option at the default the loader gives it (the key table, case_keys.c), for programs
+ * that build a solver without a case file; c0 and the halo, whose defaults depend on the case,
+ * are 0. */
+void lahar_sph_options_default(lahar_sph_options *o);
 
 /* Release everything a loaded (or scene-message-built) case owns; the case is zeroed. Safe on a
  * zeroed case. */

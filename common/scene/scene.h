@@ -102,8 +102,10 @@ typedef struct {
 
 /* Weakly compressible SPH and the SPH-DEM coupling (section sph: of a case; every key is
  * documented in cases/dem_drop_3d.yaml). Together with lahar_case.sph_dx (particle spacing) and
- * lahar_case.sph_density (rest density) this is everything the SPH node needs (sph_params of
- * sph_node/fluid/sph_fluid.h). The loader fills every default, so a loaded case has final values. */
+ * lahar_case.sph_density (rest density) this is everything the SPH node needs: the solver's
+ * sph_params (sph_node/fluid/sph_fluid.h) holds this struct as it is. The loader fills every
+ * default from the key table (common/io/case_keys.c), so a loaded case has final values;
+ * lahar_sph_options_default gives the same defaults without a case. */
 typedef enum { LAHAR_SPH_EOS_LINEAR = 0, LAHAR_SPH_EOS_TAIT = 1 } lahar_sph_eos;
 typedef enum { LAHAR_SPH_WALL_HALFSPACE = 0, LAHAR_SPH_WALL_PAPER = 1 } lahar_sph_wall_viscous;
 typedef enum { LAHAR_SPH_INITIAL_PRESSURE_NONE = 0, LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC = 1 } lahar_sph_initial_pressure;

@@ -2,48 +2,44 @@
 #include "sph_fluid.h"
 #include "sph_eos.h"
 #include "sph_riemann.h"
+#include "case.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void fluid_defaults(sph_params *p)
+void sph_params_default(sph_params *prm)
 {
-    if (!p->kernel)
-        p->kernel = "cubic";
-    if (p->h_over_dx <= 0.0)
-        p->h_over_dx = 1.3;
-    if (p->gamma <= 0.0)
-        p->gamma = 7.0;
-    if (p->cfl <= 0.0)
-        p->cfl = 0.25;
-    if (p->cfl_force <= 0.0)
-        p->cfl_force = 0.25;
-    if (p->cfl_visc <= 0.0)
-        p->cfl_visc = 0.125;
-    if (p->sps_cs <= 0.0)
-        p->sps_cs = 0.12;
+    memset(prm, 0, sizeof *prm);
+    lahar_sph_options_default(&prm->opt);
 }
 
 int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, int errlen)
 {
     memset(f, 0, sizeof *f);
     f->prm = *prm;
-    fluid_defaults(&f->prm);
-    sph_params *p = &f->prm;
-    if (!(p->dx > 0.0) || !(p->rho0 > 0.0) || !(p->c0 > 0.0) || p->mu < 0.0 || (p->dim != 2 && p->dim != 3)) {
+    const sph_params *p = &f->prm;
+    const lahar_sph_options *o = &p->opt;
+    if (!(p->dx > 0.0) || !(p->rho0 > 0.0) || !(o->c0 > 0.0) || o->mu < 0.0 || (p->dim != 2 && p->dim != 3)) {
         snprintf(err, (size_t)errlen, "SPH parameters: need dim 2 or 3, dx > 0, rho0 > 0, c0 > 0, mu >= 0");
         return -1;
     }
-    if (kernel_init(&f->k, p->kernel, p->dim, p->h_over_dx * p->dx) != 0) {
-        snprintf(err, (size_t)errlen, "unknown kernel '%s' (cubic, quintic, wendland2)", p->kernel);
+    /* the options come from the loader or sph_params_default, never zero */
+    if (!(o->h_over_dx > 0.0) || !(o->cfl > 0.0) || !(o->cfl_force > 0.0) || !(o->cfl_visc > 0.0) ||
+        (o->eos == LAHAR_SPH_EOS_TAIT && !(o->gamma > 0.0)) || (o->sps && !(o->sps_cs > 0.0))) {
+        snprintf(err, (size_t)errlen, "SPH parameters: h_over_dx, cfl, cfl_force, cfl_visc (and gamma, sps_cs when "
+                 "used) must be > 0; start from sph_params_default");
+        return -1;
+    }
+    if (kernel_init(&f->k, o->kernel, p->dim, o->h_over_dx * p->dx) != 0) {
+        snprintf(err, (size_t)errlen, "unknown kernel '%s' (cubic, quintic, wendland2)", o->kernel);
         return -1;
     }
     if (sph_particles_init(&f->p, cap) != 0) {
         snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)cap);
         return -1;
     }
-    if (sph_cells_init(&f->cells, p->dim, f->k.support, p->periodic, p->lo, p->hi, f->p.cap, err, errlen) != 0) {
+    if (sph_cells_init(&f->cells, p->dim, f->k.support, o->periodic, o->lo, o->hi, f->p.cap, err, errlen) != 0) {
         sph_particles_free(&f->p);
         return -1;
     }
@@ -57,7 +53,7 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)cap);
         return -1;
     }
-    if (p->sps) {
+    if (o->sps) {
         /* nu_t and the six stress components in one block, only when SPS is on */
         double *buf = calloc((size_t)f->p.cap * 7, sizeof(double));
         if (!buf) {
@@ -72,7 +68,7 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         for (int a = 0; a < 6; a++)
             f->sps_tau[a] = buf + (size_t)f->p.cap * (size_t)(a + 1);
     }
-    if (p->transport_velocity) { /* v~ - v per particle, and the background-pressure acceleration */
+    if (o->transport_velocity) { /* v~ - v per particle, and the background-pressure acceleration */
         double *buf = calloc((size_t)f->p.cap * 3, sizeof(double));
         if (!buf || sph_particles_alloc_transport(&f->p) != 0) {
             free(buf);
@@ -114,10 +110,10 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
     f->has_bodies = 0;
-    if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.mu,
-                          f->prm.wall_viscous, f->p.cap) != 0)
+    if (sph_coupling_init(&f->cpl, f->prm.dim, nbody, bodies, &f->k, f->prm.dx, m_min, f->prm.opt.mu,
+                          f->prm.opt.wall_viscous, f->p.cap) != 0)
         return -1;
-    sph_coupling_set_periodic(&f->cpl, f->prm.periodic, f->prm.lo, f->prm.hi); /* bodies act across them */
+    sph_coupling_set_periodic(&f->cpl, f->prm.opt.periodic, f->prm.opt.lo, f->prm.opt.hi); /* bodies act across them */
     if (f->has_soil && sph_coupling_enable_soil(&f->cpl, f->prm.soil_mat.mu_phi) != 0) { /* Trujillo-Vela et al. 2020, section 4.2 */
         sph_coupling_free(&f->cpl);
         return -1;
@@ -127,25 +123,25 @@ int sph_fluid_attach_bodies(sph_fluid *f, int nbody, const lahar_body *bodies)
      * pressure gradient) */
     double bh[3];
     for (int a = 0; a < 3; a++)
-        bh[a] = f->prm.periodic[a] ? 0.0 : f->prm.body_force[a];
+        bh[a] = f->prm.opt.periodic[a] ? 0.0 : f->prm.body_force[a];
     f->cpl.cells = &f->cells;
     /* K_n with the acoustic step (sph_coupling.kn_dt): the CFL step at rest, cfl h / c (the
      * larger of c0 and the soil's sound speed) */
-    if (f->prm.penalty_acoustic)
-        f->cpl.kn_dt = f->prm.cfl * f->k.h / fmax(f->prm.c0, f->has_soil ? f->soil.cs : 0.0);
-    f->cpl.riemann = f->prm.riemann;
-    f->cpl.riemann_c0 = f->prm.c0;
-    f->cpl.riemann_eta = f->prm.riemann_eta;
-    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.wall_pressure, bh, f->prm.dx) != 0) {
+    if (f->prm.opt.penalty_stiffness == LAHAR_SPH_PENALTY_ACOUSTIC)
+        f->cpl.kn_dt = f->prm.opt.cfl * f->k.h / fmax(f->prm.opt.c0, f->has_soil ? f->soil.cs : 0.0);
+    f->cpl.riemann = f->prm.opt.scheme == LAHAR_SPH_SCHEME_RIEMANN;
+    f->cpl.riemann_c0 = f->prm.opt.c0;
+    f->cpl.riemann_eta = f->prm.opt.riemann_limiter;
+    if (sph_coupling_set_wall_pressure(&f->cpl, f->prm.opt.wall_pressure, bh, f->prm.dx) != 0) {
         sph_coupling_free(&f->cpl);
         return -1;
     }
     if (f->has_soil) { /* the soil's ghost stress extrapolates with its gravity (the case's) */
         double gs[3];
         for (int a = 0; a < 3; a++)
-            gs[a] = f->prm.periodic[a] ? 0.0 : f->prm.soil_mat.gravity[a];
-        if (sph_coupling_set_soil_wall(&f->cpl, f->prm.soil_wall_stress, gs, f->prm.dx) != 0 ||
-            (f->prm.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST && sph_soil_keep_gradient(&f->soil) != 0)) {
+            gs[a] = f->prm.opt.periodic[a] ? 0.0 : f->prm.soil_mat.gravity[a];
+        if (sph_coupling_set_soil_wall(&f->cpl, f->prm.opt.soil_wall_stress, gs, f->prm.dx) != 0 ||
+            (f->prm.opt.soil_wall_stress == LAHAR_SPH_WALL_PRESSURE_GHOST && sph_soil_keep_gradient(&f->soil) != 0)) {
             sph_coupling_free(&f->cpl);
             return -1;
         }
@@ -172,15 +168,15 @@ void sph_fluid_free(sph_fluid *f)
 
 double sph_fluid_pressure(const sph_params *prm, double rho)
 {
-    return sph_eos_get(prm->eos)->pressure(rho, prm->rho0, prm->c0, prm->gamma);
+    return sph_eos_get(prm->opt.eos)->pressure(rho, prm->rho0, prm->opt.c0, prm->opt.gamma);
 }
 
 double sph_fluid_density_of_pressure(const sph_params *prm, double p)
 {
-    return sph_eos_get(prm->eos)->density(p, prm->rho0, prm->c0, prm->gamma);
+    return sph_eos_get(prm->opt.eos)->density(p, prm->rho0, prm->opt.c0, prm->opt.gamma);
 }
 
-static inline int prm_tvf(const sph_fluid *f) { return f->prm.transport_velocity != 0; }
+static inline int prm_tvf(const sph_fluid *f) { return f->prm.opt.transport_velocity != 0; }
 
 /* The pairs (i, j) of water particle i with the water particles j after it in the forward half
  * stencil (SPH_HALF_NEIGHBOUR_CHUNKS_D), each evaluated once and added to both particles: the
@@ -205,7 +201,7 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     const int tvf = prm_tvf(f);
     double *const bxa = f->tv_bx, *const bya = f->tv_by, *const bza = f->tv_bz;
     const double *const tvxa = p->tvx, *const tvya = p->tvy, *const tvza = p->tvz;
-    const double pb = f->prm.background_pressure;
+    const double pb = f->prm.opt.background_pressure;
     double bxi = 0.0, byi = 0.0, bzi = 0.0;
     const sph_cells *c = &f->cells;
     const sph_params *prm = &f->prm;
@@ -218,18 +214,18 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     const double vxi = p->vx[i], vyi = p->vy[i], vzi = dim == 2 ? 0.0 : p->vz[i];
     const double rhoi = p->rho[i], pri = pra[i], mi = ma[i], voli = vola[i];
     /* Morris: m_i m_j (mu_i + mu_j)/(rho_i rho_j) = 2 mu V_i V_j */
-    const double visci = 2.0 * prm->mu * voli;
-    const double c0 = prm->c0, alpha = prm->alpha, ddelta = 2.0 * prm->delta * h * c0;
+    const double visci = 2.0 * prm->opt.mu * voli;
+    const double c0 = prm->opt.c0, alpha = prm->opt.alpha, ddelta = 2.0 * prm->opt.delta * h * c0;
     /* Monaghan: Pi_ij = -alpha c0 h v_ij.x_ij/(r^2 + eta^2) / rho_ij, rho_ij = (rho_i + rho_j)/2 */
     const double av = 2.0 * alpha * c0 * h;
     /* hydrostatic density difference per unit x_ij, rho0 b / c0^2, from the body force along the
      * non-periodic axes (Fourtakas et al. 2019): delta-SPH diffuses only the deviation from it */
-    const double hx = prm->periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
-                 hy = prm->periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
-                 hz = prm->periodic[2] || dim == 2 ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
+    const double hx = prm->opt.periodic[0] ? 0.0 : prm->rho0 * prm->body_force[0] / (c0 * c0),
+                 hy = prm->opt.periodic[1] ? 0.0 : prm->rho0 * prm->body_force[1] / (c0 * c0),
+                 hz = prm->opt.periodic[2] || dim == 2 ? 0.0 : prm->rho0 * prm->body_force[2] / (c0 * c0);
     /* Riemann scheme (sph_riemann.h): p_i itself (with p_b) and the limiter */
-    const int riem = prm->riemann;
-    const double pi_full = pri * rhoi * rhoi, reta = prm->riemann_eta;
+    const int riem = prm->opt.scheme == LAHAR_SPH_SCHEME_RIEMANN;
+    const double pi_full = pri * rhoi * rhoi, reta = prm->opt.riemann_limiter;
     /* SPS stress of i over rho_i^2 (Canelas et al. 2015, eq. 10); unused when sps is 0 */
     double ti[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     double *const *tau = f->sps_tau;
@@ -350,7 +346,7 @@ static inline void fluid_sps_particle(sph_fluid *f, const kernel_kind kind, int6
     double sxx = g[0][0], syy = g[1][1], szz = g[2][2];
     double sxy = 0.5 * (g[0][1] + g[1][0]), sxz = 0.5 * (g[0][2] + g[2][0]), syz = 0.5 * (g[1][2] + g[2][1]);
     double ss = sxx * sxx + syy * syy + szz * szz + 2.0 * (sxy * sxy + sxz * sxz + syz * syz); /* S:S */
-    double smag = sqrt(2.0 * ss), delta = f->prm.dx, csd = f->prm.sps_cs * delta;
+    double smag = sqrt(2.0 * ss), delta = f->prm.dx, csd = f->prm.opt.sps_cs * delta;
     double nut = csd * csd * smag;
     double tr3 = (sxx + syy + szz) / 3.0;
     double iso = 2.0 / 3.0 * SPH_SPS_CI * delta * delta * smag * smag;
@@ -413,7 +409,7 @@ static void fluid_pass(sph_fluid *f)
     const sph_cells *c = &f->cells;
     const int64_t n = p->n;
     const kernel_kind kind = f->k.kind;
-    const int sps = f->prm.sps != 0, d3 = f->prm.dim == 3;
+    const int sps = f->prm.opt.sps != 0, d3 = f->prm.dim == 3;
     const int soil = f->has_soil;
     const int tvf = prm_tvf(f);
     double *const drho = p->drho, *const fx = p->ax, *const fy = p->ay, *const fz = p->az;
@@ -498,7 +494,7 @@ static void fluid_shift(sph_fluid *f)
     const sph_coupling *cpl = &f->cpl;
     const int64_t n = p->n;
     const kernel *k = &f->k;
-    const double s2 = k->support * k->support, coef = -f->prm.shifting * k->h * k->h, cap = 0.1 * f->prm.dx;
+    const double s2 = k->support * k->support, coef = -f->prm.opt.shifting * k->h * k->h, cap = 0.1 * f->prm.dx;
     const int d3 = f->prm.dim == 3;
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
     for (int64_t i = 0; i < n; i++) {
@@ -531,7 +527,7 @@ static void fluid_shift(sph_fluid *f)
             d = v3_scale(d, cap / dl);
         p->vhx[i] = d.x, p->vhy[i] = d.y, p->vhz[i] = d.z;
     }
-    if (f->prm.shifting_density) {
+    if (f->prm.opt.shifting_density) {
         /* shifting_density: the shift is a displacement the continuity equation (Trujillo-Vela et al. 2020, eq. 1)
          * never saw, so the density takes the change that operator gives a particle moved by dr,
          * drho_i = rho_i sum_j V_j (dr_i - dr_j).grad_i W_ij (the arbitrary-Lagrangian-Eulerian
@@ -615,12 +611,12 @@ static void fluid_rates_particles(sph_fluid *f)
     sph_particles *p = &f->p;
     const int64_t n = p->n;
     const sph_params prm = f->prm;
-    if (prm.transport_velocity)
+    if (prm.opt.transport_velocity)
         fluid_summation_density(f);
     double *const prho2 = f->prho2, *const vol = f->vol;
     /* background pressure in the momentum equation (p = p_EOS + p_b), unless the transport
      * velocity takes it (sph_fluid.h); p.p keeps the EOS pressure */
-    const double pbm = prm.transport_velocity ? 0.0 : prm.background_pressure;
+    const double pbm = prm.opt.transport_velocity ? 0.0 : prm.opt.background_pressure;
 #pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
     for (int64_t i = 0; i < n; i++) {
         const double rho = p->rho[i], pr = sph_fluid_pressure(&prm, rho);
@@ -628,12 +624,12 @@ static void fluid_rates_particles(sph_fluid *f)
         prho2[i] = (pbm > 0.0 ? pr + pbm : pr) / (rho * rho);
         vol[i] = p->m[i] / rho;
     }
-    if (prm.sps)
+    if (prm.opt.sps)
         fluid_sps_pass(f);
     if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
         sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k, f->vol);
     fluid_pass(f);
-    if (prm.transport_velocity) /* the density is the summation of the positions, not integrated */
+    if (prm.opt.transport_velocity) /* the density is the summation of the positions, not integrated */
         memset(p->drho, 0, (size_t)n * sizeof *p->drho);
     if (f->has_soil) {
         int64_t soil_water = 0;
@@ -688,7 +684,7 @@ static int64_t fluid_rates_bodies(sph_fluid *f, const lahar_body_state *states, 
     }
     f->vmax = sqrt(vmax2);
     f->amax = sqrt(amax2);
-    if (f->prm.sps) { /* the eddy viscosity joins the viscous step limit */
+    if (f->prm.opt.sps) { /* the eddy viscosity joins the viscous step limit */
         double nutmax = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : nutmax) if (n >= SPH_OMP_MIN_LIGHT)
         for (int64_t i = 0; i < n; i++)
@@ -722,7 +718,7 @@ int sph_fluid_step_begin(sph_fluid *f, double dt)
     const double *restrict ax = p->ax, *restrict ay = p->ay, *restrict az = p->az, *restrict drho = p->drho;
     /* kick (half), drift, predict; one loop per dimension so that neither tests d3 per particle
      * (both vectorise); 2D: z, vz and vhz are not touched (they stay 0) */
-    if (f->prm.transport_velocity) {
+    if (f->prm.opt.transport_velocity) {
         /* Adami et al. 2013: the particles move with the transport velocity
          * v~ = v(t + dt/2) + dt/2 b(t), b the background-pressure acceleration of the last
          * evaluation; tv = v~ - v is kept for the extra stress A of the next evaluation */
@@ -797,9 +793,9 @@ int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *stat
         fluid_soil_kick(f, hdt, 0);
     f->t += dt;
     f->step++;
-    if (f->prm.shepard_every > 0 && f->step % f->prm.shepard_every == 0)
+    if (f->prm.opt.shepard_interval > 0 && f->step % f->prm.opt.shepard_interval == 0)
         sph_fluid_shepard(f);
-    if (f->prm.shifting > 0.0)
+    if (f->prm.opt.shifting > 0.0)
         fluid_shift(f);
     f->crossings = cross;
     return cross;
@@ -822,16 +818,16 @@ double sph_fluid_dt(const sph_fluid *f)
 {
     const sph_params *prm = &f->prm;
     double h = f->k.h;
-    double dt = prm->cfl * h / (prm->c0 + f->vmax);
+    double dt = prm->opt.cfl * h / (prm->opt.c0 + f->vmax);
     if (f->has_soil) /* the soil's P-wave speed (sph_soil.h) */
-        dt = fmin(dt, prm->cfl * h / (f->soil.cs + f->vmax));
+        dt = fmin(dt, prm->opt.cfl * h / (f->soil.cs + f->vmax));
     if (f->has_soil && f->soil.seep > 0.0) /* the seepage drag rate g / k_h (sph_soil.h) */
         dt = fmin(dt, 0.25 * f->soil.mat.kh / f->soil.mat.g_ref);
     if (f->amax > 0.0)
-        dt = fmin(dt, prm->cfl_force * sqrt(h / f->amax));
+        dt = fmin(dt, prm->opt.cfl_force * sqrt(h / f->amax));
     if (f->nut_max > 0.0) /* SPS: the eddy viscosity adds to the laminar one */
-        dt = fmin(dt, prm->cfl_visc * h * h / (prm->mu / prm->rho0 + f->nut_max));
-    else if (prm->mu > 0.0)
-        dt = fmin(dt, prm->cfl_visc * h * h * prm->rho0 / prm->mu);
+        dt = fmin(dt, prm->opt.cfl_visc * h * h / (prm->opt.mu / prm->rho0 + f->nut_max));
+    else if (prm->opt.mu > 0.0)
+        dt = fmin(dt, prm->opt.cfl_visc * h * h * prm->rho0 / prm->opt.mu);
     return dt;
 }

@@ -25,10 +25,10 @@
  *   EOS: linear p = c0^2 (rho - rho0) (Trujillo-Vela et al. 2020, eq. 3) or Tait p = rho0 c0^2/gamma ((rho/rho0)^gamma - 1)
  *     (Canelas et al. 2015, eq. 19). c0 is the constant numerical speed of sound.
  *
- *   Background pressure p_b (prm.background_pressure, default 0): without the transport velocity
+ *   Background pressure p_b (prm.opt.background_pressure, default 0): without the transport velocity
  *     the momentum equation uses p_i + p_b (p.p and the snapshots keep the EOS pressure); with it,
  *     p_b enters the transport velocity only (Adami et al. 2013, below).
- *   Transport velocity (prm.transport_velocity; Adami, Hu & Adams 2013, J. Comput. Phys.
+ *   Transport velocity (prm.opt.transport_velocity; Adami, Hu & Adams 2013, J. Comput. Phys.
  *     241:292-307, section 2; fully periodic water-only flows, the loader rejects the rest):
  *       b_i = -p_b sum_j m_j (1/rho_i^2 + 1/rho_j^2) grad_i W_ij   (the uniform p_b, same symmetric form)
  *       drift x += dt v~, v~ = v(t + dt/2) + dt/2 b (b of the last evaluation); tv = v~ - v kept
@@ -42,7 +42,7 @@
  *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
  *     hydrostatic bias that delta-SPH has (Canelas et al. 2015, section 3.3; test_sph_hydrostatic.c).
  *
- * Riemann scheme (prm.riemann, case key sph.scheme: riemann; Zhang, Hu & Adams 2017, J. Comput. Phys.
+ * Riemann scheme (case key sph.scheme: riemann; Zhang, Hu & Adams 2017, J. Comput. Phys.
  *   335:605-620, section 3), instead of delta-SPH and Monaghan's viscosity (both must be 0): with
  *   the pair's interface state U*, P* of sph_riemann.h (e_ij = -x_ij/r, U_L - U_R = -v_ij.x_ij/r),
  *     drho_i/dt = 2 rho_i sum_j V_j (v_i - v*_ij) . grad_i W_ij,  v*_ij = v-bar_ij + (U* - U-bar) e_ij
@@ -83,38 +83,17 @@
 #include "sph_soil.h"
 
 
+/* The solver's parameters: the case's sph: section as the loader filled it (every default set from
+ * the key table, common/io/case_keys.c) and what the solver derives from the rest of the case.
+ * Programs without a case file start from sph_params_default. */
 typedef struct {
+    lahar_sph_options opt;  /* the sph: keys (common/scene/scene.h documents each) */
     int dim;
-    const char *kernel;     /* "cubic" (default when NULL), "quintic", "wendland2" */
-    double dx;              /* initial particle spacing */
-    double h_over_dx;       /* smoothing length h = h_over_dx dx (default 1.3 when 0) */
-    double rho0;            /* rest density */
-    double c0;              /* numerical speed of sound */
-    lahar_sph_eos eos;
-    double gamma;           /* Tait exponent (default 7 when 0) */
-    double mu;              /* dynamic viscosity, Pa s */
-    double alpha;           /* Monaghan artificial viscosity, 0 = off */
-    double delta;           /* delta-SPH coefficient, 0 = off (0.1 typical) */
-    double body_force[3];   /* m/s^2 (gravity plus any driving acceleration) */
-    double cfl, cfl_force, cfl_visc; /* defaults 0.25, 0.25, 0.125 when 0 */
-    int periodic[3];        /* 1: axis periodic with period [lo, hi) */
-    double lo[3], hi[3];
-    lahar_sph_wall_viscous wall_viscous;
-    lahar_sph_wall_pressure wall_pressure; /* default penalty only (Trujillo-Vela et al. 2020 eq. 15); sph_coupling.h */
-    int penalty_acoustic;   /* 1: K_n of eq. 15 with the acoustic step cfl h / c0, not the step's dt
-                               (sph_coupling.kn_dt); 0 (default): the step's dt as printed */
-    lahar_sph_wall_pressure soil_wall_stress; /* the soil's: default penalty + friction spring; sph_coupling.h */
-    int shepard_every;      /* Shepard density filter every N steps (Canelas et al. 2015, eq. 5), 0 = off */
-    double shifting;        /* particle shifting A (dr = -A h^2 grad C each step, sph_fluid.c), 0 = off */
-    int shifting_density;    /* 1: the shift changes the density as the continuity equation would (sph_fluid.c) */
-    double background_pressure; /* p_b, Pa (see "Background pressure" above), 0 = off */
-    int transport_velocity; /* 1: Adami et al. 2013 transport velocity (see above), 0 = off */
-    int sps;                /* SPS (Smagorinsky) turbulence (Canelas et al. 2015, eq. 10-11), 0 = off */
-    double sps_cs;          /* Smagorinsky constant C_s (default 0.12 when 0) */
+    double dx;              /* initial particle spacing (sph.dx) */
+    double rho0;            /* rest density (sph.density) */
+    double body_force[3];   /* m/s^2 acting on the water: gravity + sph.body_force */
     int soil;               /* 1: the particles include soil (phase 1, sph_soil.h) of material soil_mat */
     sph_soil_material soil_mat;
-    int riemann;            /* 1: Riemann scheme (see "Riemann scheme" above; sph_riemann.h), 0: delta-SPH */
-    double riemann_eta;     /* its limiter eta (Zhang et al. 2017: 3), 0 = the full acoustic dissipation */
 } sph_params;
 
 typedef struct {
@@ -130,7 +109,7 @@ typedef struct {
     double vmax, amax;      /* of the last evaluation */
     int64_t crossings;      /* of the last step */
     int begun;              /* sph_fluid_step_begin done, sph_fluid_step_end due */
-    /* SPS only (NULL when prm.sps is off): per particle, in the sorted order of the last
+    /* SPS only (NULL when prm.opt.sps is off): per particle, in the sorted order of the last
      * evaluation, the eddy viscosity nu_t and the SPS stress tau (Canelas et al. 2015, eq. 11, with density:
      * xx, xy, xz, yy, yz, zz) */
     double *sps_nut;
@@ -157,6 +136,9 @@ typedef struct {
     int64_t work_neighbours_fluid_soil; /* seepage: water neighbours of soil + soil neighbours of water */
 } sph_fluid;
 
+/* prm with every sph: key at the key table's default (lahar_sph_options_default), body_force
+ * zero, no soil. */
+void sph_params_default(sph_params *prm);
 /* Set up for up to cap particles (add them with sph_particles_add / _add_box on f->p before the
  * first step). Returns 0, or -1 with a one-line reason in err. */
 int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, int errlen);
@@ -170,7 +152,7 @@ double sph_fluid_pressure(const sph_params *prm, double rho);
 /* The density whose EOS pressure is p (the inverse of sph_fluid_pressure). */
 double sph_fluid_density_of_pressure(const sph_params *prm, double p);
 
-/* SPS turbulence (Canelas et al. 2015, eq. 10-11, Dalrymple & Rogers 2006), when prm.sps is on. Before the
+/* SPS turbulence (Canelas et al. 2015, eq. 10-11, Dalrymple & Rogers 2006), when prm.opt.sps is on. Before the
  * particle-particle sums, one gather pass takes the velocity gradient
  *   (grad v)_ab,i = sum_j V_j (v_j - v_i)_a (grad_i W_ij)_b,
  * the strain rate S = (grad v + grad v^T)/2, |S| = sqrt(2 S:S), the eddy viscosity

@@ -13,9 +13,9 @@ int sph_inflow_case_wanted(const lahar_case *c) { return c->ninlet > 0 || c->nou
 
 int sph_inflow_setup_case(sph_inflow *fl, const lahar_case *c, const sph_params *prm, char *err, int errlen)
 {
-    /* the kernel support with the solver's defaults (sph_fluid_init: cubic, h = 1.3 dx) */
-    const kernel_def *kd = kernel_find(prm->kernel ? prm->kernel : "cubic");
-    const double h_over_dx = prm->h_over_dx > 0.0 ? prm->h_over_dx : 1.3;
+    /* the kernel support of the case's kernel and h */
+    const kernel_def *kd = kernel_find(prm->opt.kernel);
+    const double h_over_dx = prm->opt.h_over_dx;
     const double support = (kd ? kd->kappa : 2.0) * h_over_dx * c->sph_dx;
     return sph_inflow_init(fl, c->dim, c->sph_dx, support, c->gravity, c->ninlet, c->inlets, c->noutlet, c->outlets,
                            c->has_domain, c->domain_lo, c->domain_hi, c->t_end, err, errlen);

@@ -108,16 +108,16 @@ static void case_walls(bench_case *c)
 
 static void params(const bench_case *c, sph_params *prm)
 {
-    memset(prm, 0, sizeof *prm);
+    sph_params_default(prm);
     prm->dim = c->dim;
-    prm->kernel = "wendland2";
+    prm->opt.kernel = "wendland2";
     prm->dx = c->dx;
-    prm->h_over_dx = 1.41;
+    prm->opt.h_over_dx = 1.41;
     prm->rho0 = 1000.0;
-    prm->c0 = c->c0;
-    prm->mu = 1e-3;
-    prm->alpha = 0.02;
-    prm->delta = 0.1;
+    prm->opt.c0 = c->c0;
+    prm->opt.mu = 1e-3;
+    prm->opt.alpha = 0.02;
+    prm->opt.delta = 0.1;
     prm->body_force[c->dim == 2 ? 1 : 2] = -9.81;
 }
 
@@ -146,7 +146,7 @@ static void setup(bench_case *c, sph_fluid *f)
 static __attribute__((noinline)) int bench_measure(sph_fluid *f, int nsteps)
 {
     for (int k = 0; k < nsteps; k++) {
-        double dt = f->primed ? sph_fluid_dt(f) : 0.25 * f->k.h / f->prm.c0;
+        double dt = f->primed ? sph_fluid_dt(f) : 0.25 * f->k.h / f->prm.opt.c0;
         if (sph_fluid_step(f, dt, NULL) != 0)
             return -1;
     }
