@@ -2,6 +2,8 @@
 #include "sph_fluid.h"
 #include "sph_eos.h"
 #include "sph_riemann.h"
+#include "sph_pair_terms.h"
+#include "sph_fluid_units.h"
 #include "case.h"
 #include <math.h>
 #include <stdio.h>
@@ -265,27 +267,20 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
                 const double ps = sph_riemann_pstar(pi_full, pj, rhobar, c0, du, reta);
                 gp = -mi * mj * 2.0 * ps / (rhoi * rhoj) * fij;
             } else {
-                const double dev = ddelta * ((rhoi - rhoj) - (hx * rx + hy * ry + hz * rz)) * rsoft;
+                const double dev = sph_delta_diffusion(ddelta, rhoi, rhoj, hx * rx + hy * ry + hz * rz, rsoft);
                 drhoi += volj * fij * (rhoi * vdotr + dev);
                 drho[j] += voli * fij * (rhoj * vdotr - dev);
                 /* pressure, symmetric (Trujillo-Vela et al. 2020, eq. 2), with Monaghan's Pi_ij > 0 when approaching
                  * (av = 0 without artificial viscosity): -m_i m_j (...) F_ij x_ij */
-                const double pav = vdotr < 0.0 ? av * vdotr * ieta / (rhoi + rhoj) : 0.0;
+                const double pav = sph_monaghan_viscosity(av, vdotr, ieta, rhoi, rhoj);
                 gp = -mi * mj * (pri + pra[j] - pav) * fij;
             }
             /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij */
-            const double gv = visci * volj * fij * rsoft;
+            const double gv = sph_morris_viscosity(visci, volj, fij, rsoft);
             double Fx = gp * rx + gv * vx, Fy = gp * ry + gv * vy, Fz = dim == 3 ? gp * rz + gv * vz : 0.0;
             if (sps) { /* Canelas et al. 2015, eq. 10, third term: m_i m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
-                const double irj2 = 1.0 / (rhoj * rhoj), mf = mi * mj * fij;
-                const double txx = ti[0] + tau[0][j] * irj2, txy = ti[1] + tau[1][j] * irj2,
-                             txz = ti[2] + tau[2][j] * irj2;
-                const double tyy = ti[3] + tau[3][j] * irj2, tyz = ti[4] + tau[4][j] * irj2,
-                             tzz = ti[5] + tau[5][j] * irj2;
-                Fx += mf * (txx * rx + txy * ry + txz * rz);
-                Fy += mf * (txy * rx + tyy * ry + tyz * rz);
-                if (dim == 3)
-                    Fz += mf * (txz * rx + tyz * ry + tzz * rz);
+                const double tj[6] = {tau[0][j], tau[1][j], tau[2][j], tau[3][j], tau[4][j], tau[5][j]};
+                sph_sps_pair(ti, tj, 1.0 / (rhoj * rhoj), mi * mj * fij, rx, ry, rz, dim, &Fx, &Fy, &Fz);
             }
             if (tvf) {
                 /* 1/rho div A, symmetric: m_i m_j (A_i/rho_i^2 + A_j/rho_j^2) . grad_i W_ij, with
@@ -293,12 +288,9 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
                 const double mf = mi * mj * fij;
                 const double si = (tvxa[i] * rx + tvya[i] * ry + (dim == 3 ? tvza[i] * rz : 0.0)) / rhoi;
                 const double sj = (tvxa[j] * rx + tvya[j] * ry + (dim == 3 ? tvza[j] * rz : 0.0)) / rhoj;
-                Fx += mf * (vxi * si + vxa[j] * sj);
-                Fy += mf * (vyi * si + vya[j] * sj);
-                if (dim == 3)
-                    Fz += mf * (vzi * si + vza[j] * sj);
+                sph_transport_pair(mf, si, sj, vxi, vyi, vzi, vxa[j], vya[j], dim == 3 ? vza[j] : 0.0, dim, &Fx, &Fy, &Fz);
                 /* background pressure: -m_i m_j p_b (1/rho_i^2 + 1/rho_j^2) grad_i W_ij */
-                const double gb = -mi * mj * pb * (1.0 / (rhoi * rhoi) + 1.0 / (rhoj * rhoj)) * fij;
+                const double gb = sph_background_pair(mi, mj, pb, rhoi, rhoj, fij);
                 bxi += gb * rx, byi += gb * ry;
                 bxa[j] -= gb * rx, bya[j] -= gb * ry;
                 if (dim == 3)
@@ -322,56 +314,6 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
     if (dim == 3)
         fz[i] += fzi;
     return npair;
-}
-
-/* Velocity gradient, strain rate, nu_t and the SPS stress of particle i (sph_fluid.h, Canelas et al. 2015, eq. 11). */
-static inline void fluid_sps_particle(sph_fluid *f, const kernel_kind kind, int64_t i)
-{
-    const sph_particles *p = &f->p;
-    const sph_cells *c = &f->cells;
-    const double inv_h = f->k.inv_h, dnorm = f->k.dnorm, s2 = f->k.support * f->k.support;
-    const double xi = p->x[i], yi = p->y[i], zi = p->z[i];
-    const double vxi = p->vx[i], vyi = p->vy[i], vzi = p->vz[i];
-    double g[3][3] = {{0.0}}; /* g[a][b] = d v_a / d x_b */
-    SPH_FOR_EACH_NEIGHBOUR(c, p, i, xi, yi, zi, s2, {
-        double r = sqrt(r2);
-        double fij = r > 0.0 ? dnorm * kernel_dshape(kind, r * inv_h) / r : 0.0;
-        double w = p->m[j] / p->rho[j] * fij; /* V_j F_ij; grad_i W_ij = F_ij x_ij */
-        double dv[3] = {p->vx[j] - vxi, p->vy[j] - vyi, p->vz[j] - vzi};
-        double xr[3] = {rx, ry, rz};
-        for (int a = 0; a < 3; a++)
-            for (int b = 0; b < 3; b++)
-                g[a][b] += w * dv[a] * xr[b];
-    });
-    double sxx = g[0][0], syy = g[1][1], szz = g[2][2];
-    double sxy = 0.5 * (g[0][1] + g[1][0]), sxz = 0.5 * (g[0][2] + g[2][0]), syz = 0.5 * (g[1][2] + g[2][1]);
-    double ss = sxx * sxx + syy * syy + szz * szz + 2.0 * (sxy * sxy + sxz * sxz + syz * syz); /* S:S */
-    double smag = sqrt(2.0 * ss), delta = f->prm.dx, csd = f->prm.opt.sps_cs * delta;
-    double nut = csd * csd * smag;
-    double tr3 = (sxx + syy + szz) / 3.0;
-    double iso = 2.0 / 3.0 * SPH_SPS_CI * delta * delta * smag * smag;
-    double rho = p->rho[i];
-    f->sps_nut[i] = nut;
-    f->sps_tau[0][i] = rho * (2.0 * nut * (sxx - tr3) - iso);
-    f->sps_tau[1][i] = rho * 2.0 * nut * sxy;
-    f->sps_tau[2][i] = rho * 2.0 * nut * sxz;
-    f->sps_tau[3][i] = rho * (2.0 * nut * (syy - tr3) - iso);
-    f->sps_tau[4][i] = rho * 2.0 * nut * syz;
-    f->sps_tau[5][i] = rho * (2.0 * nut * (szz - tr3) - iso);
-}
-
-static void fluid_sps_pass(sph_fluid *f)
-{
-    const int64_t n = f->p.n;
-    const kernel_kind kind = f->k.kind;
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        switch (kind) {
-        case KERNEL_QUINTIC: fluid_sps_particle(f, KERNEL_QUINTIC, i); break;
-        case KERNEL_WENDLAND2: fluid_sps_particle(f, KERNEL_WENDLAND2, i); break;
-        default: fluid_sps_particle(f, KERNEL_CUBIC, i); break;
-        }
-    }
 }
 
 /* The pairs of the water particles of block k (sph_cells_blocks), particle by particle in the
@@ -479,132 +421,6 @@ static void fluid_pass(sph_fluid *f)
     f->work_neighbours_fluid += 2 * pairs; /* (i, j) and (j, i); integer sum: exact in any order */
 }
 
-/* Particle shifting (Lind et al. 2012, J. Comput. Phys. 231:1499, eq. 17-18 with D = A h^2):
- * dr_i = -A h^2 grad C_i, grad C_i = sum_j V_j grad_i W_ij, moves water particles from where they
- * crowd to where they are sparse, against the pairing and clustering that disorder a slow flow.
- * A body's surface has no particles behind it, so grad C points away from it: within the coupling
- * range of a body the part of the shift towards the body (along x_i - x_s of each contact of the
- * last evaluation) is dropped, the particle shifts along the surface only. Lahar detects no free
- * surface: for confined (periodic, closed) flows. The shift is at most 0.1 dx per step. vhx, vhy,
- * vhz (free between steps) hold the shifts: no allocation. */
-static void fluid_shift(sph_fluid *f)
-{
-    sph_particles *p = &f->p;
-    const sph_cells *c = &f->cells;
-    const sph_coupling *cpl = &f->cpl;
-    const int64_t n = p->n;
-    const kernel *k = &f->k;
-    const double s2 = k->support * k->support, coef = -f->prm.opt.shifting * k->h * k->h, cap = 0.1 * f->prm.dx;
-    const int d3 = f->prm.dim == 3;
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        double gx = 0.0, gy = 0.0, gz = 0.0;
-        if (p->phase[i] == 0) {
-            SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
-                if (p->phase[j] != 0 || !(r2 > 0.0)) /* coincident: no direction (and W'(0)/0) */
-                    continue;
-                const double r = sqrt(r2), fv = f->vol[j] * kernel_dwdr(k, r) / r;
-                gx += fv * rx, gy += fv * ry, gz += fv * rz;
-            });
-        }
-        vec3 d = v3(coef * gx, coef * gy, d3 ? coef * gz : 0.0);
-        const int ncontact = cpl->slot_n ? cpl->slot_n[i] : 0; /* no bodies attached: none */
-        for (int s = 0; s < ncontact; s++) {
-            const sph_contact *ct = &cpl->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s];
-            vec3 nrm = v3(p->x[i] - ct->xs[0], p->y[i] - ct->xs[1], d3 ? p->z[i] - ct->xs[2] : 0.0);
-            for (int a = 0; a < 3; a++) /* the particle may be a periodic image away from x_s */
-                if (cpl->periodic[a]) {
-                    double P = cpl->period[a], u = v3_get(nrm, a);
-                    u -= P * floor(u / P + 0.5);
-                    if (a == 0) nrm.x = u; else if (a == 1) nrm.y = u; else nrm.z = u;
-                }
-            double len = v3_norm(nrm), dn = len > 0.0 ? v3_dot(d, nrm) / len : 0.0;
-            if (dn < 0.0) /* towards the body */
-                d = v3_axpy(-dn / len, nrm, d);
-        }
-        double dl = v3_norm(d);
-        if (dl > cap)
-            d = v3_scale(d, cap / dl);
-        p->vhx[i] = d.x, p->vhy[i] = d.y, p->vhz[i] = d.z;
-    }
-    if (f->prm.opt.shifting_density) {
-        /* shifting_density: the shift is a displacement the continuity equation (Trujillo-Vela et al. 2020, eq. 1)
-         * never saw, so the density takes the change that operator gives a particle moved by dr,
-         * drho_i = rho_i sum_j V_j (dr_i - dr_j).grad_i W_ij (the arbitrary-Lagrangian-Eulerian
-         * reading of the shift; Lind et al. 2012 correct the fields after the shift as well).
-         * It follows the summation density of the moved particles to first order (test_sph_fluid).
-         * Without it the densities keep the history of a particle arrangement the shift has
-         * undone: in a closed box the total volume sum m/rho fell by 9.6 % in 30 s of the
-         * lid-driven cavity (cases/README.md), with it by < 0.1 %. rhoh is free between steps. */
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-        for (int64_t i = 0; i < n; i++) {
-            double s = 0.0;
-            if (p->phase[i] == 0) {
-                const double dxi = p->vhx[i], dyi = p->vhy[i], dzi = d3 ? p->vhz[i] : 0.0;
-                SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
-                    if (p->phase[j] != 0 || !(r2 > 0.0))
-                        continue;
-                    const double fv = f->vol[j] * kernel_dwdr(k, sqrt(r2)) / sqrt(r2);
-                    s += fv * ((dxi - p->vhx[j]) * rx + (dyi - p->vhy[j]) * ry +
-                               (d3 ? (dzi - p->vhz[j]) * rz : 0.0));
-                });
-            }
-            p->rhoh[i] = p->rho[i] * (1.0 + s);
-        }
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
-        for (int64_t i = 0; i < n; i++)
-            p->rho[i] = p->rhoh[i];
-    }
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
-    for (int64_t i = 0; i < n; i++) {
-        p->x[i] += p->vhx[i];
-        p->y[i] += p->vhy[i];
-        if (d3)
-            p->z[i] += p->vhz[i];
-    }
-}
-
-void sph_fluid_shepard(sph_fluid *f)
-{
-    sph_particles *p = &f->p;
-    const sph_cells *c = &f->cells;
-    const int64_t n = p->n;
-    const kernel *k = &f->k;
-    const double s2 = k->support * k->support, w0 = kernel_w(k, 0.0);
-    /* new densities into rhoh (free outside a step), then copied: gather, no races */
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        double num = p->m[i] * w0, den = p->m[i] / p->rho[i] * w0;
-        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, {
-            double w = kernel_w(k, sqrt(r2));
-            num += p->m[j] * w;
-            den += p->m[j] / p->rho[j] * w;
-        });
-        p->rhoh[i] = num / den;
-    }
-#pragma omp parallel for schedule(static) if (n >= SPH_OMP_MIN_LIGHT)
-    for (int64_t i = 0; i < n; i++)
-        p->rho[i] = p->rhoh[i];
-}
-
-/* Summation density of the transport-velocity formulation (Adami et al. 2013, sph_fluid.h):
- * rho_i = m_i sum_j W_ij (j includes i), into rho and rhoh (the integrator's half-step density;
- * drho is zeroed after the pass, so the density stays this value through the step). Gather. */
-static void fluid_summation_density(sph_fluid *f)
-{
-    sph_particles *p = &f->p;
-    const sph_cells *c = &f->cells;
-    const int64_t n = p->n;
-    const kernel *k = &f->k;
-    const double s2 = k->support * k->support, w0 = kernel_w(k, 0.0);
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        double sw = w0;
-        SPH_FOR_EACH_NEIGHBOUR(c, p, i, p->x[i], p->y[i], p->z[i], s2, { sw += kernel_w(k, sqrt(r2)); });
-        p->rho[i] = p->rhoh[i] = p->m[i] * sw;
-    }
-}
-
 /* EOS, SPS and the particle-particle sums: everything of the rates that does not need the bodies. */
 static void fluid_rates_particles(sph_fluid *f)
 {
@@ -612,7 +428,7 @@ static void fluid_rates_particles(sph_fluid *f)
     const int64_t n = p->n;
     const sph_params prm = f->prm;
     if (prm.opt.transport_velocity)
-        fluid_summation_density(f);
+        sph_fluid_summation_density(f);
     double *const prho2 = f->prho2, *const vol = f->vol;
     /* background pressure in the momentum equation (p = p_EOS + p_b), unless the transport
      * velocity takes it (sph_fluid.h); p.p keeps the EOS pressure */
@@ -625,7 +441,7 @@ static void fluid_rates_particles(sph_fluid *f)
         vol[i] = p->m[i] / rho;
     }
     if (prm.opt.sps)
-        fluid_sps_pass(f);
+        sph_fluid_sps_pass(f);
     if (f->has_soil) /* stress rates, artificial stress and p = -tr(sigma)/3 of the soil */
         sph_soil_stress_rates(&f->soil, p, &f->cells, &f->k, f->vol);
     fluid_pass(f);
@@ -796,7 +612,7 @@ int64_t sph_fluid_step_end(sph_fluid *f, double dt, const lahar_body_state *stat
     if (f->prm.opt.shepard_interval > 0 && f->step % f->prm.opt.shepard_interval == 0)
         sph_fluid_shepard(f);
     if (f->prm.opt.shifting > 0.0)
-        fluid_shift(f);
+        sph_fluid_shift(f);
     f->crossings = cross;
     return cross;
 }
