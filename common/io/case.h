@@ -42,9 +42,9 @@ void lahar_case_free(lahar_case *c);
  * (shape_build.h) that lie outside every body, so water poured around a cylinder or under a
  * floating box leaves the bodies' room empty; a point within the coupling halo dx/2 of a free
  * body's surface is moved out to it, so no particle starts overlapping a body that it would kick
- * (case.c, case_lattice_cut). With sph.body_layers = N the lattice points within N dx of a sphere's
+ * (case_lattice.c, case_lattice_cut). With sph.body_layers = N the lattice points within N dx of a sphere's
  * (disc's) surface are replaced by N layers concentric with it, appended after the lattice points
- * (case.c, case_block_layers). Writes the first `cap` points to out (NULL to
+ * (case_lattice.c, case_block_layers). Writes the first `cap` points to out (NULL to
  * count) and returns how many there are, or -1 when out of memory. The SPH node fills its
  * particles with this (mass rho0 dx^D each, the block's velocity). */
 int64_t lahar_case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap);
