@@ -1,4 +1,5 @@
 /* Building sphero-polyhedra and their mass properties (see shape_build.h for the conventions). */
+#include "errmsg.h"
 #include "shape_build.h"
 
 #include <errno.h>
@@ -14,16 +15,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static void shape_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
 
 void lahar_shape_free(lahar_shape *s)
 {
@@ -252,14 +243,14 @@ int lahar_shape_make_polyline(lahar_shape *s, const double (*p)[3], int n, int c
 {
     memset(s, 0, sizeof *s);
     if (n < 2) {
-        shape_err(err, errlen, "a polyline needs at least 2 points (got %d)", n);
+        lahar_errf(err, errlen, "a polyline needs at least 2 points (got %d)", n);
         return -1;
     }
     double scale = points_scale(p, n);
     for (int i = 0; i + 1 < n + (closed ? 1 : 0); i++) {
         int j = (i + 1) % n;
         if (hypot(p[j][0] - p[i][0], p[j][1] - p[i][1]) <= 1e-12 * scale) {
-            shape_err(err, errlen, "points %d and %d coincide (zero-length segment)", i, j);
+            lahar_errf(err, errlen, "points %d and %d coincide (zero-length segment)", i, j);
             return -1;
         }
     }
@@ -318,7 +309,7 @@ int lahar_shape_make_polygon_hull(lahar_shape *s, const double (*p)[3], int n, d
 {
     memset(s, 0, sizeof *s);
     if (n < 3) {
-        shape_err(err, errlen, "a polygon needs at least 3 points (got %d)", n);
+        lahar_errf(err, errlen, "a polygon needs at least 3 points (got %d)", n);
         return -1;
     }
     pt2 *pts = malloc((size_t)n * sizeof *pts), *h = malloc(((size_t)n + 1) * sizeof *h);
@@ -334,7 +325,7 @@ int lahar_shape_make_polygon_hull(lahar_shape *s, const double (*p)[3], int n, d
     double L = points_scale(p, n);
     int m = hull2d(pts, n, 1e-12 * L * L, h);
     if (m < 3) {
-        shape_err(err, errlen, "the points are collinear (degenerate polygon)");
+        lahar_errf(err, errlen, "the points are collinear (degenerate polygon)");
         goto done;
     }
     for (int i = 0; i < m; i++) {
@@ -357,11 +348,11 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
 {
     memset(s, 0, sizeof *s);
     if (n < 4) {
-        shape_err(err, errlen, "a polyhedron needs at least 4 vertices (got %d)", n);
+        lahar_errf(err, errlen, "a polyhedron needs at least 4 vertices (got %d)", n);
         return -1;
     }
     if (n > 512) { /* O(n^3): 400 points take about a second */
-        shape_err(err, errlen, "too many points for the convex hull (%d > 512); give faces", n);
+        lahar_errf(err, errlen, "too many points for the convex hull (%d > 512); give faces", n);
         return -1;
     }
     double L = points_scale(p, n), eps = 1e-9 * L;
@@ -393,7 +384,7 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
                 if (pos && neg)
                     continue;
                 if (!pos && !neg) {
-                    shape_err(err, errlen, "all %d vertices are coplanar (degenerate polyhedron)", n);
+                    lahar_errf(err, errlen, "all %d vertices are coplanar (degenerate polyhedron)", n);
                     goto done;
                 }
                 int known = 0; /* a face already found through another triple of its points */
@@ -446,7 +437,7 @@ int lahar_shape_make_hull(lahar_shape *s, const double (*p)[3], int n, double ra
                 fstart[++nfc] = nfv;
             }
     if (nfc < 4) {
-        shape_err(err, errlen, "the vertices span no volume (degenerate polyhedron)");
+        lahar_errf(err, errlen, "the vertices span no volume (degenerate polyhedron)");
         goto done;
     }
     /* keep the points that are corners of some face, in input order */
@@ -489,29 +480,29 @@ int lahar_shape_make_polyhedron(lahar_shape *s, const double (*v)[3], int nv, co
 {
     memset(s, 0, sizeof *s);
     if (nv < 4) {
-        shape_err(err, errlen, "a polyhedron needs at least 4 vertices (got %d)", nv);
+        lahar_errf(err, errlen, "a polyhedron needs at least 4 vertices (got %d)", nv);
         return -1;
     }
     if (nf < 4) {
-        shape_err(err, errlen, "a closed polyhedron needs at least 4 faces (got %d)", nf);
+        lahar_errf(err, errlen, "a closed polyhedron needs at least 4 faces (got %d)", nf);
         return -1;
     }
     double L = points_scale(v, nv);
     for (int f = 0; f < nf; f++) {
         int cnt = face_start[f + 1] - face_start[f];
         if (cnt < 3) {
-            shape_err(err, errlen, "face %d has %d vertices; a face needs at least 3", f, cnt);
+            lahar_errf(err, errlen, "face %d has %d vertices; a face needs at least 3", f, cnt);
             return -1;
         }
         for (int k = 0; k < cnt; k++) {
             int id = face_v[face_start[f] + k];
             if (id < 0 || id >= nv) {
-                shape_err(err, errlen, "face %d refers to vertex %d; vertices are numbered 0..%d", f, id, nv - 1);
+                lahar_errf(err, errlen, "face %d refers to vertex %d; vertices are numbered 0..%d", f, id, nv - 1);
                 return -1;
             }
             for (int l = 0; l < k; l++)
                 if (face_v[face_start[f] + l] == id) {
-                    shape_err(err, errlen, "face %d uses vertex %d twice", f, id);
+                    lahar_errf(err, errlen, "face %d uses vertex %d twice", f, id);
                     return -1;
                 }
         }
@@ -525,7 +516,7 @@ int lahar_shape_make_polyhedron(lahar_shape *s, const double (*v)[3], int nv, co
     for (int f = 0; f < nf; f++) {
         vec3 nn = face_newell(s, f);
         if (v3_norm(nn) <= 1e-12 * L * L) {
-            shape_err(err, errlen, "face %d has zero area (degenerate polyhedron)", f);
+            lahar_errf(err, errlen, "face %d has zero area (degenerate polyhedron)", f);
             lahar_shape_free(s);
             return -1;
         }
@@ -533,7 +524,7 @@ int lahar_shape_make_polyhedron(lahar_shape *s, const double (*v)[3], int nv, co
         vec3 a = shape_vertex(s, s->face_v[s->face_start[f]]);
         for (int k = s->face_start[f]; k < s->face_start[f + 1]; k++)
             if (fabs(v3_dot(nn, v3_sub(shape_vertex(s, s->face_v[k]), a))) > 1e-6 * L) {
-                shape_err(err, errlen, "face %d is not planar (vertex %d is off its plane)", f, s->face_v[k]);
+                lahar_errf(err, errlen, "face %d is not planar (vertex %d is off its plane)", f, s->face_v[k]);
                 lahar_shape_free(s);
                 return -1;
             }
@@ -547,7 +538,7 @@ int lahar_shape_make_polyhedron(lahar_shape *s, const double (*v)[3], int nv, co
         used[face_v[t]] = 1;
     for (int i = 0; i < nv; i++)
         if (!used[i]) {
-            shape_err(err, errlen, "vertex %d is not used by any face", i);
+            lahar_errf(err, errlen, "vertex %d is not used by any face", i);
             free(used);
             lahar_shape_free(s);
             return -1;
@@ -589,7 +580,7 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
 {
     FILE *fp = fopen(path, "rb");
     if (!fp) {
-        shape_err(err, errlen, "cannot open STL file '%s': %s", path, strerror(errno));
+        lahar_errf(err, errlen, "cannot open STL file '%s': %s", path, strerror(errno));
         return -1;
     }
     long size = -1;
@@ -611,7 +602,7 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
             for (uint32_t t = 0; t < ntri; t++) {
                 unsigned char rec[50];
                 if (fread(rec, 1, sizeof rec, fp) != sizeof rec) {
-                    shape_err(err, errlen, "STL file '%s' is truncated", path);
+                    lahar_errf(err, errlen, "STL file '%s' is truncated", path);
                     free(v);
                     fclose(fp);
                     return -1;
@@ -636,7 +627,7 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
             continue;
         double x, y, z;
         if (fscanf(fp, "%lf %lf %lf", &x, &y, &z) != 3) {
-            shape_err(err, errlen, "STL file '%s': 'vertex' not followed by three numbers", path);
+            lahar_errf(err, errlen, "STL file '%s': 'vertex' not followed by three numbers", path);
             free(v);
             fclose(fp);
             return -1;
@@ -659,7 +650,7 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
     }
     fclose(fp);
     if (n == 0 || n % 3 != 0) {
-        shape_err(err, errlen, "STL file '%s' holds %d vertices, not a positive multiple of 3 (neither valid "
+        lahar_errf(err, errlen, "STL file '%s' holds %d vertices, not a positive multiple of 3 (neither valid "
                   "ASCII nor binary STL)", path, n);
         free(v);
         return -1;
@@ -709,7 +700,7 @@ int lahar_shape_read_stl(lahar_shape *s, const char *path, double radius, char *
         nt++;
     }
     if (nt == 0) {
-        shape_err(err, errlen, "STL file '%s' has no non-degenerate triangle", path);
+        lahar_errf(err, errlen, "STL file '%s' has no non-degenerate triangle", path);
         goto done;
     }
     if (shape_alloc(s, nv, 0, nt, 3 * nt, radius) != 0)
@@ -851,7 +842,7 @@ static int moments_3d(const lahar_shape *s, moments *m, char *err, size_t errlen
     if (s->nf == 0 && s->nv == 2) {
         ne = 1;
     } else if (s->nf < 4) {
-        shape_err(err, errlen, "mass properties need a closed core (sphere, segment or polyhedron)");
+        lahar_errf(err, errlen, "mass properties need a closed core (sphere, segment or polyhedron)");
         return -1;
     }
     theta = calloc((size_t)ne, sizeof *theta);
@@ -998,7 +989,7 @@ static int moments_3d(const lahar_shape *s, moments *m, char *err, size_t errlen
     rc = 0;
     goto done;
 open:
-    shape_err(err, errlen, "mass properties need a closed polyhedron (every edge shared by two faces walking it "
+    lahar_errf(err, errlen, "mass properties need a closed polyhedron (every edge shared by two faces walking it "
               "in opposite directions)");
 done:
     free(theta);
@@ -1020,7 +1011,7 @@ static int moments_2d(const lahar_shape *s, moments *m, char *err, size_t errlen
     int n = s->nv;
     memset(m, 0, sizeof *m);
     if (n > 2 && s->ne != n) {
-        shape_err(err, errlen, "mass properties need a closed 2D polygon");
+        lahar_errf(err, errlen, "mass properties need a closed 2D polygon");
         return -1;
     }
     /* all vertex sectors together: R^4/4 int_0^{2pi} u u^T = (pi/4) R^4 I_2 */
@@ -1136,7 +1127,7 @@ int lahar_shape_mass_properties(const lahar_shape *s, int dim, lahar_mass_props 
     if ((dim == 2 ? moments_2d(s, &m, err, errlen) : moments_3d(s, &m, err, errlen)) != 0)
         return -1;
     if (!(m.vol > 0.0)) {
-        shape_err(err, errlen, "the shape has no volume");
+        lahar_errf(err, errlen, "the shape has no volume");
         return -1;
     }
     mp->volume = m.vol;

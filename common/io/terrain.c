@@ -1,5 +1,6 @@
 /* Terrain input: ESRI ASCII grids, CSV profiles, and the shapes and blocks built from them
  * (terrain.h). */
+#include "errmsg.h"
 #include "terrain.h"
 
 #include <ctype.h>
@@ -12,16 +13,6 @@
 #include <strings.h>
 
 #include "shape_build.h"
-
-static void terr_err(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
 
 /* --- ESRI ASCII grid -------------------------------------------------------------------------- */
 
@@ -84,7 +75,7 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
     memset(h, 0, sizeof *h);
     FILE *fp = fopen(path, "r");
     if (!fp) {
-        terr_err(err, errlen, "%s: cannot open the grid file: %s; check the path", path, strerror(errno));
+        lahar_errf(err, errlen, "%s: cannot open the grid file: %s; check the path", path, strerror(errno));
         return -1;
     }
     tokens t = {fp, 1, "", 1};
@@ -95,7 +86,7 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
     for (;;) {
         rc = tok_next(&t);
         if (rc != 0) {
-            terr_err(err, errlen, "%s:%d: %s; an ESRI ASCII grid starts with ncols, nrows, xllcorner, yllcorner, "
+            lahar_errf(err, errlen, "%s:%d: %s; an ESRI ASCII grid starts with ncols, nrows, xllcorner, yllcorner, "
                      "cellsize (and NODATA_value) followed by the values", path, t.line,
                      rc > 0 ? "the file ends in the header" : "a word longer than 127 characters");
             goto fail;
@@ -113,19 +104,19 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
         if (strcasecmp(t.tok, "yllcenter") == 0)
             k = YLL, ycenter = 1;
         if (k < 0) {
-            terr_err(err, errlen, "%s:%d: unknown header key '%s'; the header keys are ncols, nrows, xllcorner (or "
+            lahar_errf(err, errlen, "%s:%d: unknown header key '%s'; the header keys are ncols, nrows, xllcorner (or "
                      "xllcenter), yllcorner (or yllcenter), cellsize, NODATA_value", path, t.tok_line, t.tok);
             goto fail;
         }
         if (have[k]) {
-            terr_err(err, errlen, "%s:%d: header key '%s' given twice; keep one", path, t.tok_line, t.tok);
+            lahar_errf(err, errlen, "%s:%d: header key '%s' given twice; keep one", path, t.tok_line, t.tok);
             goto fail;
         }
         int kl = t.tok_line;
         char key[128];
         snprintf(key, sizeof key, "%s", t.tok);
         if (tok_next(&t) != 0 || parse_double(t.tok, &val[k]) != 0 || t.tok_line != kl) {
-            terr_err(err, errlen, "%s:%d: header key '%s' needs a number after it on the same line", path, kl, key);
+            lahar_errf(err, errlen, "%s:%d: header key '%s' needs a number after it on the same line", path, kl, key);
             goto fail;
         }
         have[k] = 1;
@@ -133,18 +124,18 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
     static const char *const need[] = {"ncols", "nrows", "xllcorner", "yllcorner", "cellsize"};
     for (int k = 0; k < CELL + 1; k++)
         if (!have[k]) {
-            terr_err(err, errlen, "%s:%d: the header has no '%s'; add a line `%s VALUE` before the values", path,
+            lahar_errf(err, errlen, "%s:%d: the header has no '%s'; add a line `%s VALUE` before the values", path,
                      t.tok_line, need[k], need[k]);
             goto fail;
         }
     if (!(val[NCOLS] >= 2 && val[NCOLS] == floor(val[NCOLS]) && val[NROWS] >= 2 && val[NROWS] == floor(val[NROWS]) &&
           val[NCOLS] * val[NROWS] <= 1e8)) {
-        terr_err(err, errlen, "%s: ncols and nrows must be whole numbers >= 2 (got %g and %g, at most 1e8 values)",
+        lahar_errf(err, errlen, "%s: ncols and nrows must be whole numbers >= 2 (got %g and %g, at most 1e8 values)",
                  path, val[NCOLS], val[NROWS]);
         goto fail;
     }
     if (!(val[CELL] > 0)) {
-        terr_err(err, errlen, "%s: cellsize must be > 0 m (got %g)", path, val[CELL]);
+        lahar_errf(err, errlen, "%s: cellsize must be > 0 m (got %g)", path, val[CELL]);
         goto fail;
     }
     h->ncols = (int)val[NCOLS];
@@ -155,13 +146,13 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
     h->nodata = have[NODATA] ? val[NODATA] : -9999.0;
     h->z = malloc((size_t)h->ncols * h->nrows * sizeof *h->z);
     if (!h->z) {
-        terr_err(err, errlen, "%s: out of memory for a %d x %d grid", path, h->ncols, h->nrows);
+        lahar_errf(err, errlen, "%s: out of memory for a %d x %d grid", path, h->ncols, h->nrows);
         goto fail;
     }
     const size_t total = (size_t)h->ncols * h->nrows;
     for (size_t k = 0; k < total; k++) {
         if (k > 0 && (rc = tok_next(&t)) != 0) {
-            terr_err(err, errlen, "%s:%d: %s after %zu of the %d x %d = %zu values (row %zu from the north); "
+            lahar_errf(err, errlen, "%s:%d: %s after %zu of the %d x %d = %zu values (row %zu from the north); "
                      "each of the nrows rows needs ncols values", path, rc > 0 ? t.tok_line : t.line,
                      rc > 0 ? "the file ends" : "a word longer than 127 characters", k, h->nrows, h->ncols, total,
                      k / (size_t)h->ncols + 1);
@@ -169,7 +160,7 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
         }
         double z;
         if (parse_double(t.tok, &z) != 0) {
-            terr_err(err, errlen, "%s:%d: '%s' is not a number (value %zu: row %zu from the north, column %zu); "
+            lahar_errf(err, errlen, "%s:%d: '%s' is not a number (value %zu: row %zu from the north, column %zu); "
                      "the values are elevations in m, NODATA_value where there is none", path, t.tok_line, t.tok,
                      k + 1, k / (size_t)h->ncols + 1, k % (size_t)h->ncols + 1);
             goto fail;
@@ -178,7 +169,7 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
         h->z[(size_t)(h->nrows - 1 - row) * h->ncols + col] = z;
     }
     if ((rc = tok_next(&t)) == 0) {
-        terr_err(err, errlen, "%s:%d: more values than nrows x ncols = %zu ('%s'); check ncols and nrows", path,
+        lahar_errf(err, errlen, "%s:%d: more values than nrows x ncols = %zu ('%s'); check ncols and nrows", path,
                  t.tok_line, total, t.tok);
         goto fail;
     }
@@ -197,7 +188,7 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
     int *vid = malloc((size_t)nc * nr * sizeof *vid);
     int ncell = 0;
     if (!vid) {
-        terr_err(err, errlen, "out of memory for the terrain");
+        lahar_errf(err, errlen, "out of memory for the terrain");
         return -1;
     }
     for (size_t k = 0; k < (size_t)nc * nr; k++)
@@ -212,7 +203,7 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
             }
     if (ncell < 2) {
         free(vid);
-        terr_err(err, errlen, "the grid has %d cell(s) whose four corners all have data; a terrain needs at least 2",
+        lahar_errf(err, errlen, "the grid has %d cell(s) whose four corners all have data; a terrain needs at least 2",
                  ncell);
         return -1;
     }
@@ -253,7 +244,7 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
         fs[nf] = 3 * nf;
         rc = lahar_shape_make_polyhedron(s, (const double(*)[3])v, nv, fs, fv, nf, radius, err, errlen);
     } else {
-        terr_err(err, errlen, "out of memory for the terrain");
+        lahar_errf(err, errlen, "out of memory for the terrain");
     }
     free(v), free(fs), free(fv), free(vid);
     return rc;
@@ -275,7 +266,7 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     const double tol = 1e-9 * (bot->cellsize + fabs(bot->x0) + fabs(bot->y0));
     if (top->ncols != bot->ncols || top->nrows != bot->nrows || fabs(top->cellsize - bot->cellsize) > tol ||
         fabs(top->x0 - bot->x0) > tol || fabs(top->y0 - bot->y0) > tol) {
-        terr_err(err, errlen, "%s: the grid (ncols %d, nrows %d, cellsize %g, first node at %g, %g) is not the "
+        lahar_errf(err, errlen, "%s: the grid (ncols %d, nrows %d, cellsize %g, first node at %g, %g) is not the "
                  "terrain's (%d, %d, %g, %g, %g); write the upper surface on the terrain's grid", top_path,
                  top->ncols, top->nrows, top->cellsize, top->x0, top->y0, bot->ncols, bot->nrows, bot->cellsize,
                  bot->x0, bot->y0);
@@ -285,7 +276,7 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     for (int i = 0; i < nr; i++)
         for (int j = 0; j < nc; j++)
             if (!lahar_heightmap_valid(bot, i, j)) {
-                terr_err(err, errlen, "%s: the terrain has no data at row %d from the north, column %d, inside the "
+                lahar_errf(err, errlen, "%s: the terrain has no data at row %d from the north, column %d, inside the "
                          "grid of the region; a region between terrain and a surface needs the terrain everywhere "
                          "on the grid", top_path, nr - i, j + 1);
                 return -1;
@@ -298,7 +289,7 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     if (!pb->vert || !pb->tri) {
         free(pb->vert), free(pb->tri);
         pb->vert = NULL, pb->tri = NULL;
-        terr_err(err, errlen, "out of memory for the region");
+        lahar_errf(err, errlen, "out of memory for the region");
         return -1;
     }
     int any = 0;
@@ -320,7 +311,7 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     if (!any) {
         free(pb->vert), free(pb->tri);
         pb->vert = NULL, pb->tri = NULL;
-        terr_err(err, errlen, "%s: the upper surface is nowhere above the terrain; the region is empty", top_path);
+        lahar_errf(err, errlen, "%s: the upper surface is nowhere above the terrain; the region is empty", top_path);
         return -1;
     }
     int t = 0;
@@ -365,7 +356,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
     *n = 0;
     FILE *fp = fopen(path, "r");
     if (!fp) {
-        terr_err(err, errlen, "%s: cannot open the profile file: %s; check the path", path, strerror(errno));
+        lahar_errf(err, errlen, "%s: cannot open the profile file: %s; check the path", path, strerror(errno));
         return -1;
     }
     char line[4096];
@@ -374,7 +365,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
     while (fgets(line, sizeof line, fp)) {
         ln++;
         if (!strchr(line, '\n') && !feof(fp)) {
-            terr_err(err, errlen, "%s:%d: line longer than %d characters; one point x,y per line", path, ln,
+            lahar_errf(err, errlen, "%s:%d: line longer than %d characters; one point x,y per line", path, ln,
                      (int)sizeof line - 2);
             goto fail;
         }
@@ -398,7 +389,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
         while (ok && isspace((unsigned char)*end))
             end++;
         if (ok && *end != '\0' && *end != '#') {
-            terr_err(err, errlen, "%s:%d: more than two values ('%s'); one point x,y per line", path, ln, end);
+            lahar_errf(err, errlen, "%s:%d: more than two values ('%s'); one point x,y per line", path, ln, end);
             goto fail;
         }
         if (!ok) {
@@ -406,7 +397,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
                 header_ok = 0;
                 continue;
             }
-            terr_err(err, errlen, "%s:%d: expected two numbers x,y (m); got '%.60s'", path, ln, s);
+            lahar_errf(err, errlen, "%s:%d: expected two numbers x,y (m); got '%.60s'", path, ln, s);
             goto fail;
         }
         header_ok = 0;
@@ -414,7 +405,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
             cap = cap ? 2 * cap : 64;
             void *q = realloc(pts, (size_t)cap * sizeof *pts);
             if (!q) {
-                terr_err(err, errlen, "%s:%d: out of memory", path, ln);
+                lahar_errf(err, errlen, "%s:%d: out of memory", path, ln);
                 goto fail;
             }
             pts = q;
@@ -423,11 +414,11 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
         ++*n;
     }
     if (ferror(fp)) {
-        terr_err(err, errlen, "%s: cannot read the file", path);
+        lahar_errf(err, errlen, "%s: cannot read the file", path);
         goto fail;
     }
     if (*n < 2) {
-        terr_err(err, errlen, "%s:%d: the profile has %d point(s); it needs at least 2 (x,y per line)", path, ln, *n);
+        lahar_errf(err, errlen, "%s:%d: the profile has %d point(s); it needs at least 2 (x,y per line)", path, ln, *n);
         goto fail;
     }
     fclose(fp);
@@ -487,18 +478,18 @@ int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], in
     *np = 0;
     for (int i = 1; i < ng; i++)
         if (!(g[i][0] > g[i - 1][0])) {
-            terr_err(err, errlen, "the terrain's x must increase from point to point for a region between it and a "
+            lahar_errf(err, errlen, "the terrain's x must increase from point to point for a region between it and a "
                      "profile (point %d: x = %g after %g)", i, g[i][0], g[i - 1][0]);
             return -1;
         }
     for (int i = 1; i < nt; i++)
         if (!(t[i][0] > t[i - 1][0])) {
-            terr_err(err, errlen, "the profile's x must increase from point to point (point %d: x = %g after %g)", i,
+            lahar_errf(err, errlen, "the profile's x must increase from point to point (point %d: x = %g after %g)", i,
                      t[i][0], t[i - 1][0]);
             return -1;
         }
     if (t[0][0] < g[0][0] || t[nt - 1][0] > g[ng - 1][0]) {
-        terr_err(err, errlen, "the profile spans x = %g .. %g, beyond the terrain's %g .. %g; keep it above the "
+        lahar_errf(err, errlen, "the profile spans x = %g .. %g, beyond the terrain's %g .. %g; keep it above the "
                  "terrain", t[0][0], t[nt - 1][0], g[0][0], g[ng - 1][0]);
         return -1;
     }
@@ -508,7 +499,7 @@ int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], in
     double(*out)[3] = malloc(((size_t)2 * nt + 2 * ng + 4) * sizeof *out);
     if (!low || !out) {
         free(low), free(out);
-        terr_err(err, errlen, "out of memory");
+        lahar_errf(err, errlen, "out of memory");
         return -1;
     }
     const double xl = t[0][0], xr = t[nt - 1][0];
@@ -541,7 +532,7 @@ int lahar_profile_between(const double (*g)[3], int ng, const double (*t)[3], in
         m--;
     if (!above || m < 3) {
         free(out);
-        terr_err(err, errlen, "the profile is nowhere above the terrain%s; the region between them is empty",
+        lahar_errf(err, errlen, "the profile is nowhere above the terrain%s; the region between them is empty",
                  lift > 0 ? " (its surface and the particles' clearance dx/2)" : "");
         return -1;
     }
