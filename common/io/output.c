@@ -243,6 +243,28 @@ static int out_strings(hid_t loc, const char *name, int n, const char *const *s)
     return rc;
 }
 
+/* Append `rows` rows at row `start` of an extendible dataset of rank 1 (rows), 2 (rows x nb) or 3
+ * (rows x nb x 3) and flush it (SWMR readers see it). A rank > 1 dataset with nb = 0 is extended
+ * only. 0, or -1 on any HDF5 failure. */
+static int out_append_rows(hid_t id, hid_t mtype, int rank, hsize_t start, hsize_t rows, hsize_t nb, const void *buf)
+{
+    hsize_t newd[3] = {start + rows, nb, 3}, off[3] = {start, 0, 0}, cnt[3] = {rows, nb, 3};
+    if (H5Dset_extent(id, newd) < 0)
+        return -1;
+    if (nb == 0 && rank > 1)
+        return 0;
+    int rc = 0;
+    hid_t fsp = H5Dget_space(id), msp = H5Screate_simple(rank, cnt, NULL);
+    H5Sselect_hyperslab(fsp, H5S_SELECT_SET, off, NULL, cnt, NULL);
+    if (H5Dwrite(id, mtype, msp, fsp, H5P_DEFAULT, buf) < 0)
+        rc = -1;
+    H5Sclose(msp);
+    H5Sclose(fsp);
+    if (H5Dflush(id) < 0)
+        rc = -1;
+    return rc;
+}
+
 static double out_wall_seconds(void)
 {
     struct timespec ts;
@@ -612,24 +634,9 @@ static int forces_flush(forces_stream *fs)
     /* /t is extended, written and flushed last: a SWMR reader that sees n rows in /t finds
      * them in every other dataset */
     int rc = 0;
-    for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++) {
-        hsize_t newd[3] = {start + rows, nb, 3}, off[3] = {start, 0, 0}, cnt[3] = {rows, nb, 3};
-        if (H5Dset_extent(ds[k].id, newd) < 0) {
+    for (size_t k = 0; k < sizeof ds / sizeof ds[0]; k++)
+        if (out_append_rows(ds[k].id, ds[k].mtype, ds[k].rank, start, rows, nb, ds[k].buf) != 0)
             rc = -1;
-            continue;
-        }
-        if (nb == 0 && ds[k].rank > 1)
-            continue;
-        hid_t fsp = H5Dget_space(ds[k].id);
-        hid_t msp = H5Screate_simple(ds[k].rank, cnt, NULL);
-        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, off, NULL, cnt, NULL);
-        if (H5Dwrite(ds[k].id, ds[k].mtype, msp, fsp, H5P_DEFAULT, ds[k].buf) < 0)
-            rc = -1;
-        H5Sclose(msp);
-        H5Sclose(fsp);
-        if (H5Dflush(ds[k].id) < 0)
-            rc = -1;
-    }
     fs->rows += fs->nbuf;
     fs->nbuf = 0;
     fs->last_flush = out_wall_seconds();
@@ -1794,21 +1801,9 @@ static int gauge_flush(lahar_gauge_output *o)
             ds[nds].id = g->v[c], ds[nds].mtype = H5T_NATIVE_DOUBLE, ds[nds++].buf = g->bp + (size_t)c * GAUGE_BUFFER_ROWS;
         ds[nds].id = g->t, ds[nds].mtype = H5T_NATIVE_DOUBLE, ds[nds++].buf = g->bt;
         /* t last: a SWMR reader that sees n rows of t finds them in step and the values */
-        for (int d = 0; d < nds; d++) {
-            hsize_t newd = start + rows;
-            if (H5Dset_extent(ds[d].id, &newd) < 0) {
+        for (int d = 0; d < nds; d++)
+            if (out_append_rows(ds[d].id, ds[d].mtype, 1, start, rows, 0, ds[d].buf) != 0)
                 rc = -1;
-                continue;
-            }
-            hid_t fsp = H5Dget_space(ds[d].id), msp = H5Screate_simple(1, &rows, NULL);
-            H5Sselect_hyperslab(fsp, H5S_SELECT_SET, &start, NULL, &rows, NULL);
-            if (H5Dwrite(ds[d].id, ds[d].mtype, msp, fsp, H5P_DEFAULT, ds[d].buf) < 0)
-                rc = -1;
-            H5Sclose(msp);
-            H5Sclose(fsp);
-            if (H5Dflush(ds[d].id) < 0)
-                rc = -1;
-        }
         g->rows += g->nbuf;
         g->nbuf = 0;
     }
