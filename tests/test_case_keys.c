@@ -41,6 +41,43 @@ static int load_with(const char *section, const char *key, const char *value, la
     return lahar_case_load_mem("keys.yaml", text, (size_t)len, c, err, n);
 }
 
+/* The same case with a second material `m` of the model that uses KEY (soil keys: model: soil,
+ * kn: linear, the rest: hertz), KEY set to VALUE. */
+static int load_material(const char *key, const char *value, lahar_case *c, char *err, size_t n)
+{
+    static const char *const soil_keys[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping",
+                                            "av_alpha", "av_beta", NULL};
+    static const char *const hertz[][2] = {{"density", "2650"}, {"young", "1e8"}, {"restitution", "0.5"},
+                                           {"friction", "0.5"}, {NULL, NULL}};
+    static const char *const linear[][2] = {{"density", "2650"}, {"kn", "1e6"}, {"restitution", "0.5"},
+                                            {"friction", "0.5"}, {NULL, NULL}};
+    static const char *const soil[][2] = {{"density", "2000"}, {"young", "1e7"}, {"friction_angle", "30"},
+                                          {NULL, NULL}};
+    const char *model = "hertz";
+    const char *const (*base)[2] = hertz;
+    for (int i = 0; soil_keys[i]; i++)
+        if (!strcmp(key, soil_keys[i]))
+            model = "soil", base = soil;
+    if (!strcmp(key, "kn"))
+        model = "linear", base = linear;
+    char mat[512];
+    int k = snprintf(mat, sizeof mat, "model: %s", model);
+    for (int i = 0; base[i][0]; i++)
+        if (strcmp(base[i][0], key))
+            k += snprintf(mat + k, sizeof mat - (size_t)k, ", %s: %s", base[i][0], base[i][1]);
+    snprintf(mat + k, sizeof mat - (size_t)k, ", %s: %s", key, value);
+    char text[2048];
+    int len = snprintf(text, sizeof text,
+                       "dimensions: 2\n"
+                       "time: {end: 0.1}\n"
+                       "materials: {rock: {density: 2650, young: 1e8, restitution: 0.5, friction: 0.5}, m: {%s}}\n"
+                       "bodies: [{name: floor, shape: box, material: rock, motion: fixed, position: [0.05, -0.02],\n"
+                       "          size: [0.3, 0.02], radius: 0.001}]\n"
+                       "sph: {dx: 0.01, blocks: [{box: {lo: [0, 0], hi: [0.1, 0.1]}}]}\n",
+                       mat);
+    return lahar_case_load_mem("keys.yaml", text, (size_t)len, c, err, n);
+}
+
 int main(void)
 {
     static const char *const checked[] = {"time", "dem", "stability", "checkpoint", "sph"};
@@ -105,6 +142,43 @@ int main(void)
             tested++;
         }
     }
+    /* materials.NAME: each numeric key with a range, on a material of the model that uses it */
+    const lahar_key_section *ms = lahar_key_section_find("materials.NAME");
+    CHECK(ms != NULL, "no table for materials.NAME");
+    int tested_mat = 0;
+    for (const lahar_key *k = ms ? ms->keys : NULL; k && k->name; k++) {
+        if (k->type != LAHAR_KEY_NUMBER || !(k->range & (LAHAR_KEY_LO | LAHAR_KEY_HI)))
+            continue;
+        double bad = k->range & LAHAR_KEY_LO ? k->lo - 1.0 : k->hi + 1.0;
+        if (k->range & LAHAR_KEY_LO_OPEN && k->range & LAHAR_KEY_LO)
+            bad = k->lo;
+        char value[64], want[512], path[96];
+        snprintf(value, sizeof value, "%.17g", bad);
+        lahar_key_range_error(k, bad, want, sizeof want);
+        snprintf(path, sizeof path, "materials.m.%s: ", k->name);
+        int rc = load_material(k->name, value, &c, err, sizeof err);
+        if (rc == 0)
+            lahar_case_free(&c);
+        CHECK(rc != 0 && strstr(err, path) && strstr(err, want), "%s = %s: want '%s%s', got '%s'", path, value, path,
+              want, rc ? err : "(loaded)");
+        tested_mat++;
+    }
+    CHECK(tested_mat >= 12, "only %d material range checks exercised", tested_mat);
+    tested += tested_mat;
+    /* the materials' numeric defaults as stored */
+    if (load_material("cohesion", "0", &c, err, sizeof err) == 0) {
+        const lahar_material *mt = &c.materials[1];
+        const char *names[] = {"dilatancy", "permeability", "damping", "av_alpha", "av_beta"};
+        const double stored[] = {mt->dilatancy, mt->permeability, mt->damping, mt->av_alpha, mt->av_beta};
+        for (int i = 0; i < 5; i++) {
+            const lahar_key *k = lahar_key_find(ms, names[i]);
+            CHECK(k && lahar_key_default(k) == stored[i], "materials.NAME.%s: the loader stores %g, the table says %s",
+                  names[i], stored[i], k ? k->def : "(no entry)");
+            nd++;
+        }
+        lahar_case_free(&c);
+    } else
+        CHECK(0, "the soil material case does not load: %s", err);
     CHECK(tested >= 20, "only %d range checks exercised", tested);
     printf("%d keys' ranges checked against the loader, %d defaults\n", tested, nd);
     return failures != 0;

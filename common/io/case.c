@@ -60,17 +60,19 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
         if (rmap_get(m, dem_only[k]))
             rmap_fail(m, dem_only[k], "is a DEM contact key, but this material is an SPH soil (model: soil); remove "
                       "it (the soil-DEM contact uses the SPH coupling's K_n, Trujillo-Vela et al. 2020 eq. 15)");
-    mat->young = rmap_num(m, "young", 1, 0.0, "8.4e5");
-    mat->poisson = rmap_num(m, "poisson", 0, 0.3, "0.3");
-    double phi = rmap_num(m, "friction_angle", 1, 0.0, "30");
-    double coh = rmap_num(m, "cohesion", 0, 0.0, "0");
-    double psi = rmap_num(m, "dilatancy", 0, 0.0, "0");
-    double kh = rmap_num(m, "permeability", 0, 0.0, "1e-3");
-    double cd = rmap_num(m, "damping", 0, 0.0, "100");
-    double ava = rmap_num(m, "av_alpha", 0, 0.1, "1.0"), avb = rmap_num(m, "av_beta", 0, 0.0, "1.0");
+    /* the table (case_keys.c, materials.NAME) gives the defaults and ranges; the soil's own are
+     * its Poisson ratio (0.3) and mu_phi = tan(friction_angle) */
+    mat->young = rd_key_num_req(m, "young", 1, NAN);
+    mat->poisson = rd_key_num_def(m, "poisson", 0.3);
+    double phi = rd_key_num_req(m, "friction_angle", 1, NAN);
+    double coh = rd_key_num(m, "cohesion");
+    double psi = rd_key_num(m, "dilatancy");
+    double kh = rd_key_num(m, "permeability");
+    double cd = rd_key_num(m, "damping");
+    double ava = rd_key_num(m, "av_alpha"), avb = rd_key_num(m, "av_beta");
     if (m->r->failed)
         return;
-    mat->friction = rmap_num(m, "friction", 0, tan(phi * deg), "0.5");
+    mat->friction = rd_key_num_def(m, "friction", tan(phi * deg));
     if (m->r->failed)
         return;
     mat->friction_angle = phi * deg;
@@ -82,32 +84,10 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
     mat->av_beta = avb;
     mat->restitution = 1.0;
     mat->kt_ratio = 2.0 / 7.0;
-    if (!(mat->density > 0))
-        rmap_fail(m, "density", "must be > 0 kg/m^3 (got %g); the soil's bulk density, e.g. 2000", mat->density);
-    else if (!(mat->young > 0))
-        rmap_fail(m, "young", "must be > 0 Pa (got %g); the soil's Young's modulus, e.g. 8.4e5", mat->young);
-    else if (!(mat->poisson >= 0 && mat->poisson < 0.5))
-        rmap_fail(m, "poisson", "must be in [0, 0.5) (got %g)", mat->poisson);
-    else if (!(phi >= 0 && phi < 90))
-        rmap_fail(m, "friction_angle", "must be in [0, 90) degrees (got %g); sands are about 30", phi);
-    else if (!(coh >= 0))
-        rmap_fail(m, "cohesion", "must be >= 0 Pa (got %g); 0 for a dry sand", coh);
-    else if (!(phi > 0 || coh > 0))
+    if (!(phi > 0 || coh > 0))
         rmap_fail(m, "cohesion", "a soil with friction_angle 0 needs cohesion > 0 (it would have no strength)");
-    else if (!(psi >= 0 && psi <= phi))
+    else if (!(psi <= phi))
         rmap_fail(m, "dilatancy", "must be in [0, friction_angle = %g] degrees (got %g); 0 is usual", phi, psi);
-    else if (!(cd >= 0))
-        rmap_fail(m, "damping", "must be >= 0 1/s (got %g); 0 = off, about the column's first frequency pi c/(2 H) "
-                  "damps its start-up in a few periods", cd);
-    else if (!(ava >= 0))
-        rmap_fail(m, "av_alpha", "must be >= 0 (got %g); Monaghan's alpha of the soil, 0.1 by default, 1 in Trujillo-Vela et al.'s (2020) "
-                  "granular impact", ava);
-    else if (!(avb >= 0))
-        rmap_fail(m, "av_beta", "must be >= 0 (got %g); Monaghan's beta of the soil, 0 by default", avb);
-    else if (!(kh >= 0))
-        rmap_fail(m, "permeability", "must be >= 0 m/s (got %g); the Darcy hydraulic conductivity k_h", kh);
-    else if (!(mat->friction >= 0))
-        rmap_fail(m, "friction", "must be >= 0 (got %g); the soil-DEM friction coefficient mu_phi", mat->friction);
 }
 
 static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
@@ -155,7 +135,7 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
             return;
         c->nmaterial = i + 1;
         rmap_section(&m, "materials.NAME");
-        mat->density = rmap_num(&m, "density", 1, 0.0, "2650");
+        mat->density = rd_key_num(&m, "density");
         mat->model = (lahar_contact_model)rmap_enum(&m, "model", models, 0, LAHAR_CONTACT_HERTZ);
         if (r->failed)
             return;
@@ -171,35 +151,18 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
             if (rmap_get(&m, "kn"))
                 rmap_fail(&m, "kn", "is the stiffness of model: linear, but this material uses model: hertz; "
                           "remove kn or set model: linear");
-            mat->young = rmap_num(&m, "young", 1, 0.0, "1e8");
-            mat->poisson = rmap_num(&m, "poisson", 0, 0.25, "0.25");
+            mat->young = rd_key_num_req(&m, "young", 1, NAN);
         } else {
             if (rmap_get(&m, "young"))
                 rmap_fail(&m, "young", "is used by model: hertz, but this material uses model: linear; "
                           "remove young or set model: hertz");
-            mat->kn = rmap_num(&m, "kn", 1, 0.0, "1e6");
-            mat->poisson = rmap_num(&m, "poisson", 0, 0.25, "0.25");
+            mat->kn = rd_key_num_req(&m, "kn", 1, NAN);
         }
-        mat->kt_ratio = rmap_num(&m, "kt_ratio", 0, 2.0 / 7.0, "0.2857");
-        mat->restitution = rmap_num(&m, "restitution", 1, 0.0, "0.5");
-        mat->friction = rmap_num(&m, "friction", 1, 0.0, "0.5");
-        if (r->failed)
-            return;
-        if (!(mat->density > 0))
-            rmap_fail(&m, "density", "must be > 0 kg/m^3 (got %g)", mat->density);
-        else if (mat->model == LAHAR_CONTACT_HERTZ && !(mat->young > 0))
-            rmap_fail(&m, "young", "must be > 0 Pa (got %g); Young's modulus, e.g. 1e8", mat->young);
-        else if (!(mat->poisson >= 0 && mat->poisson < 0.5))
-            rmap_fail(&m, "poisson", "must be in [0, 0.5) (got %g)", mat->poisson);
-        else if (mat->model == LAHAR_CONTACT_LINEAR && !(mat->kn > 0))
-            rmap_fail(&m, "kn", "must be > 0 N/m (got %g)", mat->kn);
-        else if (!(mat->kt_ratio > 0))
-            rmap_fail(&m, "kt_ratio", "must be > 0 (got %g); 2/7 is the usual choice", mat->kt_ratio);
-        else if (!(mat->restitution > 0 && mat->restitution <= 1))
-            rmap_fail(&m, "restitution", "must be in (0, 1] (got %g); 1 is elastic, small values are very "
-                      "dissipative", mat->restitution);
-        else if (!(mat->friction >= 0))
-            rmap_fail(&m, "friction", "must be >= 0 (got %g); 0 is frictionless", mat->friction);
+        /* the table (case_keys.c, materials.NAME) gives the defaults and ranges */
+        mat->poisson = rd_key_num_def(&m, "poisson", 0.25);
+        mat->kt_ratio = rd_key_num_def(&m, "kt_ratio", 2.0 / 7.0);
+        mat->restitution = rd_key_num_req(&m, "restitution", 1, NAN);
+        mat->friction = rd_key_num_req(&m, "friction", 1, NAN);
     }
 }
 

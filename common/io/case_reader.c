@@ -339,9 +339,10 @@ void rmap_section(rmap *m, const char *path)
     rmap_check_keys(m, known);
 }
 
-/* A number key of the section's table: required or its default `def` (the table's default when it
- * is a number and def is NaN), checked against the table's range with the table's message. */
-double rd_key_num_def(rmap *m, const char *key, double def)
+/* A number key of the section's table, required or not as the caller says (keys required by one
+ * model of a section only), else its default `def` (the table's default when it is a number and
+ * def is NaN), checked against the table's range with the table's message. */
+double rd_key_num_req(rmap *m, const char *key, int required, double def)
 {
     const lahar_key *k = lahar_key_find(m->sec, key);
     if (!k) { /* a key missing from the table is a bug of the loader, not of the case */
@@ -353,7 +354,7 @@ double rd_key_num_def(rmap *m, const char *key, double def)
     char example[32];
     snprintf(example, sizeof example, "%s", k->def && !isnan(lahar_key_default(k)) ? k->def : "1");
     int present = rmap_get(m, key) != NULL;
-    double v = rmap_num(m, key, k->required, def, example);
+    double v = rmap_num(m, key, required, def, example);
     if (m->r->failed || !present)
         return v;
     if (!lahar_key_in_range(k, v)) {
@@ -362,6 +363,13 @@ double rd_key_num_def(rmap *m, const char *key, double def)
         rmap_fail(m, key, "%s", msg);
     }
     return v;
+}
+
+/* The same, required as the table says. */
+double rd_key_num_def(rmap *m, const char *key, double def)
+{
+    const lahar_key *k = lahar_key_find(m->sec, key);
+    return rd_key_num_req(m, key, k ? k->required : 0, def);
 }
 
 double rd_key_num(rmap *m, const char *key) { return rd_key_num_def(m, key, NAN); }
