@@ -29,7 +29,8 @@ RUN is the output folder of the run (its case: the header's case_path). Asserts:
     + 2 %.
 Also printed (information, cases/README.md "Debris flow"): the front (99 % quantile of the soil's and
 the water's x) per snapshot, its largest speed between snapshots and where it ends; the trackers'
-peak speeds; the control volumes' peak E_K (total and the bodies' part) and when.
+peak speeds; the control volumes' peak E_K (total and the bodies' part) and when, and per passage
+of a body through a control volume its peak E_K, the body's part and which boulder it was.
 Exit 0 when all hold, 1 otherwise."""
 import argparse
 import os
@@ -199,6 +200,22 @@ def main():
             i, j = int(np.argmax(ek)), int(np.argmax(eb))
             print("debris_flow_check: control volume %s: peak E_K %.3g J/m at %.2f s; bodies' part peak %.3g J/m at %.2f s"
                   % (n, ek[i], tc[i], eb[j], tc[j]))
+            # each passage of a body (a run of samples with a body in the box): its peak E_K, the
+            # body's part then, which boulder (nearest centre, x interpolated between body snapshots)
+            on = eb > 0
+            starts = np.flatnonzero(on & ~np.concatenate([[False], on[:-1]]))
+            ends = np.flatnonzero(on & ~np.concatenate([on[1:], [False]]))
+            xc = 0.5 * (cv.attrs["lo"][0] + cv.attrs["hi"][0])
+            for s0_, e0_ in zip(starts, ends):
+                k = s0_ + int(np.argmax(ek[s0_:e0_ + 1]))
+                who = "?"
+                if bt is not None:
+                    d = [abs(np.interp(tc[k], bt, pos[:, bi]) - xc) if nm.startswith("boulder") else np.inf
+                         for bi, nm in enumerate(names)]
+                    who = names[int(np.argmin(d))]
+                print("debris_flow_check: control volume %s: %s passes %.2f-%.2f s: peak E_K %.3g J/m at %.2f s "
+                      "(the body's part %.3g, the particles' %.3g)"
+                      % (n, who, tc[s0_], tc[e0_], ek[k], tc[k], eb[k], ek[k] - eb[k]))
     for msg in fails:
         print("debris_flow_check: FAIL " + msg)
     print("debris_flow_check: %s" % ("PASS" if not fails else "FAIL"))
