@@ -105,19 +105,6 @@ def main():
         print("debris_flow_check: front (99 %% of x) %.1f -> %.1f m (run-out %.1f m), fastest %.1f m/s at t = %.1f-%.1f s"
               % (fr[0, 1], fr[-1, 1], fr[-1, 1] - fr[0, 1], vf[kmax], fr[kmax, 0], fr[kmax + 1, 0]))
         g = snaps[keys[-1]]
-        sx, sy = g["x"][:][g["phase"][:] == 1], g["y"][:][g["phase"][:] == 1]
-        if len(sx):
-            # the soil's deposit: 1-99 % quantiles of x; thickness per dx column between them = its
-            # highest soil particle + dx/2 above the terrain's line
-            x1, x99 = float(np.quantile(sx, 0.01)), float(np.quantile(sx, 0.99))
-            c = np.floor(sx / dx).astype(np.int64)
-            th = []
-            for cc in np.unique(c[(sx >= x1) & (sx <= x99)]):
-                xm = (cc + 0.5) * dx
-                th.append(sy[c == cc].max() + 0.5 * dx - np.interp(xm, tp[:, 0], tp[:, 1]))
-            print("debris_flow_check: soil at %g s: front (99 %% of x) %.1f m (travel %.1f m), deposit %.1f-%.1f m, "
-                  "thickness mean %.2f / max %.2f m" % (g.attrs["time"], x99, x99 - float(np.quantile(s0["x"][:][s0["phase"][:] == 1], 0.99)),
-                                                       x1, x99, float(np.mean(th)), float(np.max(th))))
         if g.attrs["flow_entered"] <= 0:
             fails.append("the inlet delivered no water")
         ph, inl, p = g["phase"][:], g["inlet"][:], g["pressure"][:]
