@@ -18,9 +18,19 @@ RUN is the output folder of the run (its case: the header's case_path). Asserts:
   - boulders' potential energy (forces.h5 /energy E_P, eq. 37): for a boulder whose centre stays
     on the flat (x > 193.1 m + 2 R) over the last 2 s of the run, E_P constant within 1 % of m g R
     (the paper's Fig. 26a); a boulder not there yet is reported, not asserted.
+  - particle count against the paper's (Trujillo-Vela et al. 2020 §6: 7662 SPH points at the start,
+    8216 at the end of the 30 s with its three boulders, dx = 0.5 m), scaled by (0.5 m / dx)^2 for
+    another dx and, for a scene with fewer boulders, raised by the lattice points of the missing
+    discs (2 phases x pi R_B^2 / dx^2 each): all particles (the inlet's buffer included) at the
+    first snapshot within --count-tol (default 5 %) of the start count, and, when the run reaches
+    30 s, at the last snapshot within --count-tol of the end count;
+  - the inlet's volume: the particles that entered x dx^2 against 5 m x the integral of eq. 36
+    (a_G [G(t) - G(t0)], G the Gumbel CDF, up to t and the inlet's end) within one row (5 m x dx)
+    + 2 %.
 Also printed (information, cases/README.md "Debris flow"): the front (99 % quantile of the soil's and
 the water's x) per snapshot, its largest speed between snapshots and where it ends; the trackers'
-peak speeds; the control volumes' peak E_K (total and the bodies' part) and when.
+peak speeds; the control volumes' peak E_K (total and the bodies' part) and when, and per passage
+of a body through a control volume its peak E_K, the body's part and which boulder it was.
 Exit 0 when all hold, 1 otherwise."""
 import argparse
 import os
@@ -36,6 +46,8 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 FOOT_X, R_B = 193.1, 2.0
+# Trujillo-Vela et al. 2020 §6: SPH points at the start and at the end (30 s), dx = 0.5 m, 3 boulders
+PAPER_DX, PAPER_N0, PAPER_N1, PAPER_T1, PAPER_BOULDERS = 0.5, 7662, 8216, 30.0, 3
 
 
 def main():
@@ -43,6 +55,7 @@ def main():
     ap.add_argument("run")
     ap.add_argument("--pore-lo", type=float, default=0.4)
     ap.add_argument("--pore-hi", type=float, default=1.2)
+    ap.add_argument("--count-tol", type=float, default=0.05)
     a = ap.parse_args()
     fails = []
     with h5py.File(os.path.join(a.run, "particles.h5"), "r") as f:
@@ -51,7 +64,8 @@ def main():
         snaps = f["snapshots"]
         keys = sorted(snaps.keys())
         with open(f["header"].attrs["case_path"]) as cf:
-            tp = np.array(yaml.safe_load(cf)["terrain"]["points"], dtype=float)
+            case = yaml.safe_load(cf)
+        tp = np.array(case["terrain"]["points"], dtype=float)
         through = 0
         for k in keys:
             g = snaps[k]
@@ -99,6 +113,38 @@ def main():
         print("debris_flow_check: particles %d -> %d (soil %d -> %d), entered %d, removed water %d soil %d, t = %g s"
               % (len(s0["x"]), len(x), soil0, soil1, g.attrs["flow_entered"], g.attrs["flow_removed_water"],
                  g.attrs["flow_removed_soil"], g.attrs["time"]))
+        # the paper's counts, scaled to this dx and this number of boulders
+        nb = sum(1 for b in case.get("bodies", []) if str(b.get("name", "")).startswith("boulder"))
+        holes = (PAPER_BOULDERS - nb) * 2 * np.pi * R_B ** 2 / PAPER_DX ** 2
+        scale = (PAPER_DX / dx) ** 2
+        ref0, ref1 = (PAPER_N0 + holes) * scale, (PAPER_N1 + holes) * scale
+        n_start, n_end, t1 = len(s0["x"]), len(x), float(g.attrs["time"])
+        print("debris_flow_check: particle count at the start %d, paper's %.0f (scaled to dx = %g m, %d boulders): %+.1f %% "
+              "(bound %g %%)" % (n_start, ref0, dx, nb, 100 * (n_start / ref0 - 1), 100 * a.count_tol))
+        if abs(n_start / ref0 - 1) > a.count_tol:
+            fails.append("start count %d vs paper's %.0f" % (n_start, ref0))
+        if t1 >= PAPER_T1 - 1e-9:
+            print("debris_flow_check: particle count at %g s %d, paper's %.0f: %+.1f %% (bound %g %%)"
+                  % (t1, n_end, ref1, 100 * (n_end / ref1 - 1), 100 * a.count_tol))
+            if abs(n_end / ref1 - 1) > a.count_tol:
+                fails.append("end count %d vs paper's %.0f" % (n_end, ref1))
+        else:
+            print("debris_flow_check: run ends at %g s before the paper's %g s: end count %d (paper's %.0f) not asserted"
+                  % (t1, PAPER_T1, n_end, ref1))
+        for ild in case.get("inlets", []):
+            if "gumbel" not in ild:
+                continue
+            aG, bG, mG = (float(v) for v in ild["gumbel"])
+            t0, te = float(ild.get("start", 0.0)), min(t1, float(ild.get("end", t1)))
+            cdf = lambda tt: np.exp(-np.exp(-(tt - mG) / bG))  # noqa: E731
+            level = float(ild["level"])
+            vref = level * aG * (cdf(te) - cdf(t0)) if te > t0 else 0.0
+            vin = float(g.attrs["flow_entered"]) * dx * dx
+            bound = level * dx + 0.02 * vref
+            print("debris_flow_check: inlet %s: %.1f m^2 entered by %g s, eq. 36: %.1f m^2 (bound %.2g)"
+                  % (ild.get("name", "?"), vin, t1, vref, bound))
+            if abs(vin - vref) > bound:
+                fails.append("inlet volume %.1f vs eq. 36 %.1f m^2" % (vin, vref))
         if soil1 + g.attrs["flow_removed_soil"] != soil0:
             fails.append("soil count %d + removed %d != %d" % (soil1, g.attrs["flow_removed_soil"], soil0))
         w = (ph == 0) & (inl < 0)
@@ -154,6 +200,22 @@ def main():
             i, j = int(np.argmax(ek)), int(np.argmax(eb))
             print("debris_flow_check: control volume %s: peak E_K %.3g J/m at %.2f s; bodies' part peak %.3g J/m at %.2f s"
                   % (n, ek[i], tc[i], eb[j], tc[j]))
+            # each passage of a body (a run of samples with a body in the box): its peak E_K, the
+            # body's part then, which boulder (nearest centre, x interpolated between body snapshots)
+            on = eb > 0
+            starts = np.flatnonzero(on & ~np.concatenate([[False], on[:-1]]))
+            ends = np.flatnonzero(on & ~np.concatenate([on[1:], [False]]))
+            xc = 0.5 * (cv.attrs["lo"][0] + cv.attrs["hi"][0])
+            for s0_, e0_ in zip(starts, ends):
+                k = s0_ + int(np.argmax(ek[s0_:e0_ + 1]))
+                who = "?"
+                if bt is not None:
+                    d = [abs(np.interp(tc[k], bt, pos[:, bi]) - xc) if nm.startswith("boulder") else np.inf
+                         for bi, nm in enumerate(names)]
+                    who = names[int(np.argmin(d))]
+                print("debris_flow_check: control volume %s: %s passes %.2f-%.2f s: peak E_K %.3g J/m at %.2f s "
+                      "(the body's part %.3g, the particles' %.3g)"
+                      % (n, who, tc[s0_], tc[e0_], ek[k], tc[k], eb[k], ek[k] - eb[k]))
     for msg in fails:
         print("debris_flow_check: FAIL " + msg)
     print("debris_flow_check: %s" % ("PASS" if not fails else "FAIL"))

@@ -35,5 +35,6 @@ lahar_test(sph_split PROGRAM test_sph_split SOURCES test_sph_split.c
 # Open boundaries (sph_node/inflow/sph_inflow.h): discharge through an inlet against the Gumbel
 # hydrograph (Trujillo-Vela et al. 2020, eq. 36), a CSV t,Q table and a level table t,h, a 3D
 # inlet, mass balance, outflow counts, unique ids, the capacity error, a supercritical channel at
-# its steady depth.
+# its steady depth, saturated soil and water leaving through an outlet and the domain box (removed
+# and counted with their mass per phase).
 lahar_test(sph_inflow PROGRAM test_sph_inflow SOURCES test_sph_inflow.c LIBS lahar_sph LABELS fast sph TIMEOUT 300)

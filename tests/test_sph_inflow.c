@@ -26,7 +26,17 @@
  *  E. 3D: a rectangular inlet (0.1 m wide, level 0.06 m: 5 x 3 slots of dx = 0.02 m) on a
  *     floor, constant 0.5 m/s: 15 slots, area 0.1 x 0.06 m^2, the volume in against A u t within
  *     half a row + 1 %. (No side walls: the water spreads and speeds up past the section, so the
- *     velocity there is not the inlet's.) */
+ *     velocity there is not the inlet's.
+ *  G. Soil and water leaving (no inlet): a saturated block (a soil lattice and a water lattice on
+ *     the same points, as cases/debris_flow_2d.yaml) moving at 1 m/s towards an outlet that covers
+ *     the lower half of its height, the upper half leaving through the domain box 0.03 m further.
+ *     First one pass with particles already out (soil stress marked by id): exactly those
+ *     removed, counted per phase with their masses (summed in particle order: exact), the others
+ *     kept in order with their own stress. Then the block runs out: before every pass the
+ *     particles out (by the outlet's and the box's geometry) are predicted per phase; the
+ *     counters must grow by exactly those counts and masses, the soil's and the water's mass
+ *     balance hold (domain + removed = initial, 1e-12), and at the end every particle of both
+ *     phases is counted: removed = the block's count, removed mass = the block's mass per phase. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -501,6 +511,184 @@ static void test_3d(void)
     lahar_shape_free(&floor.shape);
 }
 
+/* G: soil and water through an outlet and the domain box */
+static int soil_out_geom(const lahar_outlet *o, const double lo[3], const double hi[3], double x, double y)
+{
+    if (!(x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1]))
+        return 1;
+    const double d = (x - o->x0[0]) * o->n[0] + (y - o->x0[1]) * o->n[1];
+    const double a = ((x - o->x0[0]) * o->e1[0] + (y - o->x0[1]) * o->e1[1]) / (o->e1[0] * o->e1[0] + o->e1[1] * o->e1[1]);
+    return d > 0.0 && d <= o->depth && a >= 0.0 && a <= 1.0;
+}
+
+static void test_soil_outflow(void)
+{
+    const double dx = 0.01, H = 0.1, W = 0.1, L = 0.15, u = 1.0, rho_s = 2000.0, rho_w = 1000.0;
+    const int ni = (int)(W / dx + 0.5), nj = (int)(H / dx + 0.5);
+    sph_params prm;
+    memset(&prm, 0, sizeof prm);
+    prm.dim = 2;
+    prm.dx = dx;
+    prm.kernel = "wendland2";
+    prm.h_over_dx = 1.41;
+    prm.rho0 = rho_w;
+    prm.c0 = 10.0;
+    prm.mu = 1e-3;
+    prm.alpha = 0.02;
+    prm.delta = 0.1;
+    prm.soil = 1;
+    prm.soil_mat = (sph_soil_material){.density = rho_s, .young = 1e6, .poisson = 0.3, .phi = 30.0 * 3.14159265358979323846 / 180.0,
+                                       .cohesion = 0.0, .psi = 0.0, .mu_phi = 0.5, .av_alpha = 0.1, .g_ref = G,
+                                       .rho_water = rho_w};
+    lahar_outlet out;
+    memset(&out, 0, sizeof out);
+    snprintf(out.name, sizeof out.name, "lower");
+    out.x0[0] = L, out.x0[1] = 0.0;
+    out.e1[1] = 0.5 * H; /* the lower half of the block's height */
+    out.n[0] = 1.0;
+    out.depth = 1.0;
+    const double lo[3] = {-1.0, -1.0, 0.0}, hi[3] = {L + 0.03, 1.0, 0.0};
+    const double g[3] = {0.0, -G, 0.0};
+    sph_inflow fl;
+    sph_fluid f;
+    memset(&f, 0, sizeof f);
+    char err[512];
+    const int64_t n0 = 2 * (int64_t)ni * nj + 8;
+    if (sph_inflow_init(&fl, 2, dx, 2.0 * 1.41 * dx, g, 0, NULL, 1, &out, 1, lo, hi, 1.0, err, sizeof err) != 0 ||
+        sph_fluid_init(&f, &prm, n0 + sph_inflow_capacity(&fl), err, sizeof err) != 0) {
+        CHECK(0, "soil outflow: set-up: %s", err);
+        sph_inflow_free(&fl);
+        sph_fluid_free(&f);
+        return;
+    }
+    sph_particles *p = &f.p;
+    CHECK(p->sig[0] != NULL, "soil outflow: the fluid has soil stress arrays");
+    /* 1. one pass with 8 particles already out: water and soil beyond the outlet, water and soil
+     *    beyond the box's x and y bounds; the block's own particles (in the domain) kept */
+    const double outside[8][3] = {{L + 0.005, 0.01, 0}, {L + 0.005, 0.02, 1}, {L + 0.5, 0.03, 0}, {L + 0.5, 0.04, 1},
+                                  {L + 0.1, 0.09, 0},   {L + 0.1, 0.08, 1},   {0.05, -1.5, 0},    {0.05, 1.5, 1}};
+    double m_out[2] = {0.0, 0.0}, m_all[2] = {0.0, 0.0};
+    int64_t c_out[2] = {0, 0}, c_all[2] = {0, 0};
+    for (int ph = 0; ph < 2; ph++)
+        for (int i = 0; i < ni; i++)
+            for (int j = 0; j < nj; j++) {
+                const double x[3] = {(i + 0.5) * dx, (j + 0.5) * dx, 0.0}, v[3] = {u, 0.0, 0.0};
+                const double rho = ph ? rho_s : rho_w;
+                /* masses differ slightly from particle to particle: a mix-up of phases or
+                 * particles in the counters shows */
+                const double m = rho * dx * dx * (1.0 + 1e-3 * (i + ni * j) / (ni * nj));
+                sph_particles_add(p, x, v, m, rho, ph ? SPH_SOIL_PHASE : 0);
+                if (ph == 0 && i == 0 && j == 0)
+                    for (int k = 0; k < 8; k++) {
+                        const double xo[3] = {outside[k][0], outside[k][1], 0.0};
+                        const int pk = (int)outside[k][2];
+                        const double mo = (pk ? rho_s : rho_w) * dx * dx * (1.0 + 0.01 * k);
+                        sph_particles_add(p, xo, v, mo, pk ? rho_s : rho_w, pk ? SPH_SOIL_PHASE : 0);
+                    }
+            }
+    for (int64_t i = 0; i < p->n; i++) {
+        const int ph = p->phase[i] == SPH_SOIL_PHASE;
+        const int o = soil_out_geom(&out, lo, hi, p->x[i], p->y[i]);
+        c_all[ph] += !o, m_all[ph] += o ? 0.0 : p->m[i];
+        if (o)
+            c_out[ph]++, m_out[ph] += p->m[i];
+        if (ph)
+            p->sig[0][i] = -1.0 - (double)p->id[i]; /* a mark that must travel with the particle */
+    }
+    CHECK(c_out[0] == 4 && c_out[1] == 4, "soil outflow: 4 water and 4 soil particles placed out (%lld, %lld)",
+          (long long)c_out[0], (long long)c_out[1]);
+    const int64_t nstart = p->n;
+    int64_t *ids = malloc((size_t)nstart * sizeof *ids);
+    int64_t nk = 0;
+    for (int64_t i = 0; i < p->n && ids; i++)
+        if (!soil_out_geom(&out, lo, hi, p->x[i], p->y[i]))
+            ids[nk++] = p->id[i];
+    if (sph_inflow_start(&fl, &f, 0.0, err, sizeof err) != 0 || !ids) {
+        CHECK(0, "soil outflow: start: %s", err);
+        free(ids);
+        sph_inflow_free(&fl);
+        sph_fluid_free(&f);
+        return;
+    }
+    const int64_t dn = sph_inflow_apply(&fl, &f, 0.0, 1e-4, err, sizeof err);
+    CHECK(dn == -8 && p->n == nstart - 8, "soil outflow: the first pass removed %lld particles (expected 8)", (long long)-dn);
+    for (int ph = 0; ph < 2; ph++)
+        CHECK(fl.counts.removed[ph] == c_out[ph] && fl.counts.removed_mass[ph] == m_out[ph],
+              "soil outflow: phase %d: removed %lld (%.17g kg/m), expected %lld (%.17g kg/m)", ph,
+              (long long)fl.counts.removed[ph], fl.counts.removed_mass[ph], (long long)c_out[ph], m_out[ph]);
+    int order = p->n == nk, marks = 1;
+    for (int64_t i = 0; i < p->n && order; i++) {
+        order = p->id[i] == ids[i];
+        if (p->phase[i] == SPH_SOIL_PHASE)
+            marks &= p->sig[0][i] == -1.0 - (double)p->id[i];
+    }
+    CHECK(order && marks, "soil outflow: kept particles in order (%d) with their own soil stress (%d)", order, marks);
+    free(ids);
+    for (int64_t i = 0; i < p->n; i++)
+        if (p->phase[i] == SPH_SOIL_PHASE)
+            p->sig[0][i] = 0.0;
+    /* 2. the block runs out through the outlet (lower half) and the box (upper half) */
+    if (sph_cells_sort(&f.cells, p) != 0 || sph_fluid_rates(&f, NULL, 1e-5) < 0) {
+        CHECK(0, "soil outflow: rates failed");
+        sph_inflow_free(&fl);
+        sph_fluid_free(&f);
+        return;
+    }
+    double worst = 0.0;
+    int64_t bad = 0, steps = 0, by_outlet = 0, by_box = 0;
+    while (p->n > 0 && f.t < 0.5) {
+        int64_t pc[2] = {0, 0};
+        double pm[2] = {0.0, 0.0};
+        for (int64_t i = 0; i < p->n; i++)
+            if (soil_out_geom(&out, lo, hi, p->x[i], p->y[i])) {
+                const int ph = p->phase[i] == SPH_SOIL_PHASE;
+                pc[ph]++, pm[ph] += p->m[i];
+                if (p->x[i] <= hi[0] && p->y[i] >= lo[1] && p->y[i] <= hi[1])
+                    by_outlet++;
+                else
+                    by_box++;
+            }
+        const int64_t r0[2] = {fl.counts.removed[0], fl.counts.removed[1]};
+        const double rm0[2] = {fl.counts.removed_mass[0], fl.counts.removed_mass[1]};
+        const double dt = fmin(sph_fluid_dt(&f), 1e-3);
+        if (sph_inflow_apply(&fl, &f, f.t, dt, err, sizeof err) == INT64_MIN) {
+            CHECK(0, "soil outflow: %s", err);
+            break;
+        }
+        double md[2] = {0.0, 0.0};
+        for (int64_t i = 0; i < p->n; i++)
+            md[p->phase[i] == SPH_SOIL_PHASE] += p->m[i];
+        for (int ph = 0; ph < 2; ph++) {
+            bad += fl.counts.removed[ph] - r0[ph] != pc[ph];
+            bad += fabs(fl.counts.removed_mass[ph] - rm0[ph] - pm[ph]) > 1e-12 * m_all[ph];
+            worst = fmax(worst, fabs(md[ph] + fl.counts.removed_mass[ph] - m_out[ph] - m_all[ph]) / m_all[ph]);
+        }
+        if (p->n > 0 && sph_fluid_step(&f, dt, NULL) != 0) {
+            CHECK(0, "soil outflow: step failed at t = %g", f.t);
+            break;
+        }
+        steps++;
+    }
+    const double rs = fl.counts.removed_mass[1] - m_out[1], rw = fl.counts.removed_mass[0] - m_out[0];
+    printf("soil outflow: %lld steps to t = %.3g s: removed %lld water (%.6g kg/m) and %lld soil (%.6g kg/m) of the "
+           "block's %lld + %lld (%.6g + %.6g kg/m), %lld by the outlet, %lld by the box; worst per-phase mass balance %.3g\n",
+           (long long)steps, f.t, (long long)(fl.counts.removed[0] - c_out[0]), rw,
+           (long long)(fl.counts.removed[1] - c_out[1]), rs, (long long)c_all[0], (long long)c_all[1], m_all[0],
+           m_all[1], (long long)by_outlet, (long long)by_box, worst);
+    CHECK(p->n == 0, "soil outflow: %lld particles still in the domain at t = %g s", (long long)p->n, f.t);
+    CHECK(bad == 0, "soil outflow: %lld passes where the counters did not grow by the particles out", (long long)bad);
+    CHECK(by_outlet > 0 && by_box > 0, "soil outflow: %lld particles left through the outlet, %lld through the box "
+          "(both must act)", (long long)by_outlet, (long long)by_box);
+    CHECK(worst < 1e-12, "soil outflow: per-phase mass balance off by %.3g", worst);
+    CHECK(fl.counts.removed[0] - c_out[0] == c_all[0] && fl.counts.removed[1] - c_out[1] == c_all[1],
+          "soil outflow: removed %lld water, %lld soil of %lld, %lld", (long long)(fl.counts.removed[0] - c_out[0]),
+          (long long)(fl.counts.removed[1] - c_out[1]), (long long)c_all[0], (long long)c_all[1]);
+    CHECK(fabs(rs - m_all[1]) <= 1e-12 * m_all[1] && fabs(rw - m_all[0]) <= 1e-12 * m_all[0],
+          "soil outflow: removed mass soil %.17g of %.17g, water %.17g of %.17g", rs, m_all[1], rw, m_all[0]);
+    sph_fluid_free(&f);
+    sph_inflow_free(&fl);
+}
+
 int main(void)
 {
     lahar_inlet in;
@@ -519,5 +707,6 @@ int main(void)
     test_steady();
     test_3d();
     test_level();
+    test_soil_outflow();
     return failures ? 1 : 0;
 }
