@@ -526,16 +526,16 @@ static void test_soil_outflow(void)
     const double dx = 0.01, H = 0.1, W = 0.1, L = 0.15, u = 1.0, rho_s = 2000.0, rho_w = 1000.0;
     const int ni = (int)(W / dx + 0.5), nj = (int)(H / dx + 0.5);
     sph_params prm;
-    memset(&prm, 0, sizeof prm);
+    sph_params_default(&prm);
     prm.dim = 2;
     prm.dx = dx;
-    prm.kernel = "wendland2";
-    prm.h_over_dx = 1.41;
+    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
+    prm.opt.h_over_dx = 1.41;
     prm.rho0 = rho_w;
-    prm.c0 = 10.0;
-    prm.mu = 1e-3;
-    prm.alpha = 0.02;
-    prm.delta = 0.1;
+    prm.opt.c0 = 10.0;
+    prm.opt.mu = 1e-3;
+    prm.opt.alpha = 0.02;
+    prm.opt.delta = 0.1;
     prm.soil = 1;
     prm.soil_mat = (sph_soil_material){.density = rho_s, .young = 1e6, .poisson = 0.3, .phi = 30.0 * 3.14159265358979323846 / 180.0,
                                        .cohesion = 0.0, .psi = 0.0, .mu_phi = 0.5, .av_alpha = 0.1, .g_ref = G,
