@@ -123,7 +123,7 @@ void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                       "not both");
             return;
         }
-        in->level = has_lt ? 1.0 : rmap_num(&m, "level", 1, 0.0, "0.1");
+        in->level = has_lt ? 1.0 : rd_key_num_req(&m, "level", 1, NAN);
         if (has_lt) { /* a level table t,h: the level is its largest value (the slots of the section) */
             char full[2048], err[1400];
             if (inflow_csv(&m, "level_hydrograph", full, sizeof full) != 0)
@@ -149,10 +149,11 @@ void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                 in->level = fmax(in->level, in->level_h[k]);
             }
         }
-        in->t_start = rmap_num(&m, "start", 0, 0.0, "0.0");
-        in->t_end = rmap_num(&m, "end", 0, 1e300, "15.0");
-        const double layers = rmap_num(&m, "layers", 0, 0.0, "4");
-        const double maxp = rmap_num(&m, "max_particles", 0, 0.0, "100000");
+        /* defaults and ranges: the key table (inlets[]); 0 layers / max_particles: computed at set-up */
+        in->t_start = rd_key_num(&m, "start");
+        in->t_end = rd_key_num_def(&m, "end", 1e300);
+        const double layers = rd_key_num_def(&m, "layers", 0.0);
+        const double maxp = rd_key_num_def(&m, "max_particles", 0.0);
         if (r->failed)
             return;
         if (!(in->level > 0.0)) {
@@ -165,17 +166,7 @@ void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
                       in->t_end);
             return;
         }
-        if (layers != floor(layers) || layers > 64.0 || (rmap_get(&m, "layers") && layers < 1.0)) {
-            rmap_fail(&m, "layers", "must be a whole number of buffer rows in 1 .. 64 (got %g); leave it out for the "
-                      "kernel support / dx", layers);
-            return;
-        }
         in->layers = (int)layers;
-        if (maxp != floor(maxp) || maxp > 1e12 || (rmap_get(&m, "max_particles") && maxp < 1.0)) {
-            rmap_fail(&m, "max_particles", "must be a whole number >= 1 (got %g); leave it out for the estimate from "
-                      "the hydrograph", maxp);
-            return;
-        }
         in->max_particles = (int64_t)maxp;
         const int has_v = rmap_get(&m, "velocity") != NULL, has_g = rmap_get(&m, "gumbel") != NULL,
                   has_h = rmap_get(&m, "hydrograph") != NULL;
@@ -188,11 +179,7 @@ void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
         /* the buffer only moves forward (rows are created behind it): no backflow through an inlet */
         if (has_v) {
             in->kind = LAHAR_HYDRO_CONSTANT;
-            in->velocity = rmap_num(&m, "velocity", 1, 0.0, "0.5");
-            if (!r->failed && !(in->velocity >= 0.0)) {
-                rmap_fail(&m, "velocity", "must be >= 0 (got %g m/s): the inflow along the inward normal", in->velocity);
-                return;
-            }
+            in->velocity = rd_key_num_req(&m, "velocity", 1, NAN);
         } else if (has_g) {
             in->kind = LAHAR_HYDRO_GUMBEL;
             rmap_vec(&m, "gumbel", 3, in->gumbel, 1, "[35, 2, 3]");
@@ -264,9 +251,7 @@ void case_read_outlets(reader *r, yaml_node_t *n, lahar_case *c)
         rmap_name(&m, "name", 0, def, o->name);
         if (read_section(&m, r->dim, o->x0, o->e1, o->e2, o->n, "outward") != 0)
             return;
-        o->depth = rmap_num(&m, "depth", 0, 1e30, "1.0");
-        if (!r->failed && !(o->depth > 0.0))
-            rmap_fail(&m, "depth", "must be > 0 (got %g m): how far beyond the section particles are removed", o->depth);
+        o->depth = rd_key_num_def(&m, "depth", 1e30);
     }
 }
 

@@ -114,14 +114,10 @@ static void read_level_gauge(reader *r, rmap *pm, const lahar_case *c, lahar_pro
     }
     pr->body = -1;
     pr->size = 0.0;
-    pr->rate = rmap_num(pm, "rate", 0, 0.0, "1000");
+    pr->rate = rd_key_num(pm, "rate");
     if (!rmap_vec(pm, "position", v, pr->x, 1, dim == 3 ? "[0.5, 0.3] (x, y of the vertical line)"
                                                            : "[0.5] (x of the vertical line)"))
         return;
-    if (!(pr->rate >= 0.0) || !isfinite(pr->rate)) {
-        rmap_fail(pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)", pr->rate);
-        return;
-    }
     for (int a = 0; a < v; a++)
         if (!(pr->x[a] >= lo[a] && pr->x[a] <= hi[a])) {
             rmap_fail(pm, "position", "lies outside the domain (the box of the bodies and blocks, %s in [%g, %g]; got "
@@ -191,20 +187,12 @@ void case_read_probes(reader *r, yaml_node_t *n, lahar_case *c)
             continue;
         }
         rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[0.5, 0.0, 0.01]" : "[0.5, 0.01]");
-        pr->size = rmap_num(&pm, "size", 0, 0.0, "0.009");
-        pr->rate = rmap_num(&pm, "rate", 0, 0.0, "20000");
+        pr->size = rd_key_num(&pm, "size");
+        pr->rate = rd_key_num(&pm, "rate");
         pr->body = -1;
         const char *bname = rmap_str(&pm, "body", 0, NULL, "wall_right");
         if (r->failed)
             return;
-        if (!(pr->size >= 0.0) || !isfinite(pr->size)) {
-            rmap_fail(&pm, "size", "must be >= 0 (got %g): the sensor's diameter in m (0 = a point)", pr->size);
-            return;
-        }
-        if (!(pr->rate >= 0.0) || !isfinite(pr->rate)) {
-            rmap_fail(&pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)", pr->rate);
-            return;
-        }
         if (pr->size > 0.0 && !bname) {
             rmap_fail(&pm, "size", "is the diameter of a sensor on a body's surface; give body: NAME, or remove size "
                       "for a point probe in the fluid");
@@ -300,10 +288,7 @@ void case_read_gauges(reader *r, yaml_node_t *tn, yaml_node_t *vn, lahar_case *c
                     rmap_fail(&pm, "name", "'%s' is already the name of a probe, tracker or control volume; names "
                               "must be unique", pr->name);
             pr->body = -1;
-            pr->rate = rmap_num(&pm, "rate", 0, 0.0, "10");
-            if (!r->failed && (!(pr->rate >= 0.0) || !isfinite(pr->rate)))
-                rmap_fail(&pm, "rate", "must be >= 0 (got %g): samples per second (0 or absent = every step)",
-                          pr->rate);
+            pr->rate = rd_key_num(&pm, "rate");
             if (sct == 0) {
                 pr->kind = LAHAR_PROBE_TRACKER;
                 rmap_vec(&pm, "position", dim, pr->x, 1, dim == 3 ? "[10.0, 0.0, 5.0]" : "[10.0, 5.0]");

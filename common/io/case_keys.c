@@ -95,8 +95,8 @@ static const lahar_key probe_keys[] = {
     {"kind", LAHAR_KEY_CHOICE, 0, "pressure", 0, 0, 0, probe_kinds, "", "pressure (a point) or level (water level on a vertical line)"},
     {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the point (pressure) or the horizontal place of the line (level: [x] in 2D, [x, y] in 3D)"},
     {"body", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "pressure probes: a body's name: the probe is a sensor on its surface"},
-    {"size", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m", "pressure probes on a body: sensor diameter (0 = a point)"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step)"},
+    {"size", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m", "pressure probes on a body: sensor diameter (0 = a point); the sensor's diameter in m, 0 for a point"},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step); samples per second, 0 or absent = every step"},
     END};
 
 static const lahar_key inlet_keys[] = {
@@ -107,13 +107,13 @@ static const lahar_key inlet_keys[] = {
     {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "inward normal, perpendicular to the edges (normalised)"},
     {"level", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "m", "water depth above the section's lowest point along gravity (or level_hydrograph)"},
     {"level_hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,h: the level h(t) instead of level (path relative to the case file)"},
-    {"velocity", LAHAR_KEY_NUMBER, 0, NULL, LO, 0, 0, NULL, "m/s", "a constant inflow velocity (one of velocity, gumbel, hydrograph)"},
+    {"velocity", LAHAR_KEY_NUMBER, 0, NULL, LO, 0, 0, NULL, "m/s", "a constant inflow velocity (one of velocity, gumbel, hydrograph); the inflow along the inward normal"},
     {"gumbel", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "[a_G (m), beta_G (s), mu_G (s)]: u of Trujillo-Vela et al. 2020, eq. 36"},
     {"hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,u (m/s) or t,Q (m^2/s in 2D, m^3/s in 3D), relative to the case file"},
     {"start", LAHAR_KEY_NUMBER, 0, "0", 0, 0, 0, NULL, "s", "the inflow acts from start"},
     {"end", LAHAR_KEY_NUMBER, 0, "forever", 0, 0, 0, NULL, "s", "... until end (u = 0 outside [start, end))"},
     {"layers", LAHAR_KEY_WHOLE, 0, "support/dx", LO | HI, 1, 64, NULL, "", "buffer rows behind the section"},
-    {"max_particles", LAHAR_KEY_WHOLE, 0, "estimate", LO, 1, 0, NULL, "", "most particles the inlet may create (default: from the hydrograph + 10 %)"},
+    {"max_particles", LAHAR_KEY_WHOLE, 0, "estimate", LO | HI, 1, 1e12, NULL, "", "most particles the inlet may create (default: from the hydrograph + 10 %)"},
     END};
 
 static const lahar_key outlet_keys[] = {
@@ -122,7 +122,7 @@ static const lahar_key outlet_keys[] = {
     {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]"},
     {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge"},
     {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "outward normal, perpendicular to the edges (normalised)"},
-    {"depth", LAHAR_KEY_NUMBER, 0, "unlimited", LOX, 0, 0, NULL, "m", "how far beyond the section particles are removed"},
+    {"depth", LAHAR_KEY_NUMBER, 0, "unlimited", LOX, 0, 0, NULL, "m", "how far beyond the section particles are removed; how far beyond the section, m"},
     END};
 
 static const lahar_key domain_keys[] = {
@@ -229,14 +229,14 @@ static const char *const cv_axes[] = {"x", "y", "z", NULL};
 static const lahar_key tracker_keys[] = {
     {"name", LAHAR_KEY_TEXT, 0, "tracker<i>", 0, 0, 0, NULL, "", "unique name"},
     {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the particle nearest this point at t = 0 is followed"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output)"},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output"},
     END};
 
 static const lahar_key control_volume_keys[] = {
     {"name", LAHAR_KEY_TEXT, 0, "cv<i>", 0, 0, 0, NULL, "", "unique name"},
     {"box", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]}: kinetic energy (Trujillo-Vela et al. 2020 eq. 39) and mass inside"},
     {"axis", LAHAR_KEY_CHOICE, 0, "x", 0, 0, 0, cv_axes, "", "direction of the mass flux recorded through the box"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output)"},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output"},
     END};
 
 static const lahar_key_section sections[] = {
