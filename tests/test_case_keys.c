@@ -179,6 +179,27 @@ int main(void)
         lahar_case_free(&c);
     } else
         CHECK(0, "the soil material case does not load: %s", err);
+    /* bodies[]: a shape-specific key (the table's `only`) on a disc, which none of them belongs to, is
+     * refused as unknown; on a shape it belongs to it is known */
+    const lahar_key_section *bs = lahar_key_section_find("bodies[]");
+    int shape_keys = 0;
+    for (const lahar_key *k = bs ? bs->keys : NULL; k && k->name; k++) {
+        if (!k->only)
+            continue;
+        CHECK(!lahar_key_applies(k, "disc"), "bodies[].%s: a disc has no shape-specific keys", k->name);
+        char text[1024], want[96];
+        int len = snprintf(text, sizeof text,
+                           "dimensions: 2\ntime: {end: 0.1}\n"
+                           "materials: {rock: {density: 2650, young: 1e8, restitution: 0.5, friction: 0.5}}\n"
+                           "bodies: [{name: b, shape: disc, material: rock, radius: 0.01, %s: 1}]\n", k->name);
+        snprintf(want, sizeof want, "bodies[0].%s: unknown key", k->name);
+        int rc = lahar_case_load_mem("keys.yaml", text, (size_t)len, &c, err, sizeof err);
+        if (rc == 0)
+            lahar_case_free(&c);
+        CHECK(rc != 0 && strstr(err, want), "want '%s', got '%s'", want, rc ? err : "(loaded)");
+        shape_keys++;
+    }
+    CHECK(shape_keys >= 6, "only %d shape-specific body keys", shape_keys);
     CHECK(tested >= 20, "only %d range checks exercised", tested);
     printf("%d keys' ranges checked against the loader, %d defaults\n", tested, nd);
     return failures != 0;

@@ -358,19 +358,6 @@ static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
 
 static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cache *mc)
 {
-    static const char *const common_keys[] = {"name", "shape", "material", "motion", "position", "orientation",
-                                              "velocity", "angular_velocity", "radius", "record_contacts"};
-    static const char *const extra[SH_N][3] = {
-        [SH_SPHERE] = {NULL},
-        [SH_DISC] = {NULL},
-        [SH_BOX] = {"size", NULL},
-        [SH_SEGMENT] = {"vertices", NULL},
-        [SH_POLYLINE] = {"vertices", "closed", NULL},
-        [SH_POLYGON] = {"vertices", NULL},
-        [SH_POLYHEDRON] = {"vertices", "faces", NULL},
-        [SH_PLANE] = {"normal", "size", NULL},
-        [SH_STL] = {"file", "scale", NULL},
-    };
     const int dim = r->dim;
     char prefix[KEY_MAX];
     snprintf(prefix, sizeof prefix, "bodies[%d]", i);
@@ -381,14 +368,16 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
     int kind = rmap_enum(&m, "shape", shape_names, 1, SH_SPHERE);
     if (r->failed)
         return;
-    const char *keys[16];
+    /* the keys of bodies[] (case_keys.c) that belong to this shape */
+    const lahar_key_section *sec = lahar_key_section_find("bodies[]");
+    const char *keys[32];
     int nk = 0;
-    for (size_t k = 0; k < sizeof common_keys / sizeof *common_keys; k++)
-        keys[nk++] = common_keys[k];
-    for (int k = 0; extra[kind][k]; k++)
-        keys[nk++] = extra[kind][k];
+    for (const lahar_key *k = sec ? sec->keys : NULL; k && k->name && nk < 31; k++)
+        if (lahar_key_applies(k, shape_names[kind]))
+            keys[nk++] = k->name;
     keys[nk] = NULL;
     rmap_check_keys(&m, keys);
+    m.sec = sec;
 
     char defname[LAHAR_NAME_MAX];
     snprintf(defname, sizeof defname, "body%d", i);

@@ -10,124 +10,124 @@
 #define HI LAHAR_KEY_HI
 #define LOX (LAHAR_KEY_LO | LAHAR_KEY_LO_OPEN)
 #define HIX (LAHAR_KEY_HI | LAHAR_KEY_HI_OPEN)
-#define END {NULL, 0, 0, NULL, 0, 0, 0, NULL, NULL, NULL}
+#define END {NULL, 0, 0, NULL, 0, 0, 0, NULL, NULL, NULL, NULL}
 
 static const char *const bools[] = {"false", "true", NULL};
 
 static const lahar_key top_keys[] = {
-    {"dimensions", LAHAR_KEY_WHOLE, 1, NULL, LO | HI, 2, 3, NULL, "", "2 or 3; 2D scenes live in the x-y plane (masses and forces per unit thickness)"},
-    {"gravity", LAHAR_KEY_VECTOR, 0, "[0, 0, -9.81] (2D: [0, -9.81])", 0, 0, 0, NULL, "m/s^2", "acceleration of gravity"},
-    {"time", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "", "duration, step bounds and output intervals"},
-    {"materials", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "name -> material (required when there are bodies or soil)"},
-    {"dem", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the DEM engine and its step"},
-    {"bodies", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "rigid bodies (sphero-polyhedra)"},
-    {"sph", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "SPH water and soil and their coupling with the bodies"},
-    {"probes", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "pressure probes and water-level gauges (OUT/gauges.h5)"},
-    {"stability", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "instability checks that stop a run"},
-    {"checkpoint", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "coordinated checkpoints for lahar resume (none without it)"},
-    {"output", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "what the snapshots and streams hold"},
-    {"check", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the reference lahar check compares the run with"},
-    {"terrain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "a fixed DEM body from a 2D profile (points or CSV) or a 3D ESRI ASCII heightmap"},
-    {"trackers", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "material points followed through the run (OUT/gauges.h5)"},
-    {"control_volumes", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "boxes where kinetic energy, mass and mass flux are recorded (OUT/gauges.h5)"},
-    {"inlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections where water enters with a hydrograph (cases/README.md)"},
-    {"outlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections beyond which particles are removed and counted"},
-    {"domain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: particles outside this box are removed and counted"},
+    {"dimensions", LAHAR_KEY_WHOLE, 1, NULL, LO | HI, 2, 3, NULL, "", "2 or 3; 2D scenes live in the x-y plane (masses and forces per unit thickness)", NULL},
+    {"gravity", LAHAR_KEY_VECTOR, 0, "[0, 0, -9.81] (2D: [0, -9.81])", 0, 0, 0, NULL, "m/s^2", "acceleration of gravity", NULL},
+    {"time", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "", "duration, step bounds and output intervals", NULL},
+    {"materials", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "name -> material (required when there are bodies or soil)", NULL},
+    {"dem", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the DEM engine and its step", NULL},
+    {"bodies", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "rigid bodies (sphero-polyhedra)", NULL},
+    {"sph", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "SPH water and soil and their coupling with the bodies", NULL},
+    {"probes", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "pressure probes and water-level gauges (OUT/gauges.h5)", NULL},
+    {"stability", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "instability checks that stop a run", NULL},
+    {"checkpoint", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "coordinated checkpoints for lahar resume (none without it)", NULL},
+    {"output", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "what the snapshots and streams hold", NULL},
+    {"check", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "the reference lahar check compares the run with", NULL},
+    {"terrain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "a fixed DEM body from a 2D profile (points or CSV) or a 3D ESRI ASCII heightmap", NULL},
+    {"trackers", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "material points followed through the run (OUT/gauges.h5)", NULL},
+    {"control_volumes", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "boxes where kinetic energy, mass and mass flux are recorded (OUT/gauges.h5)", NULL},
+    {"inlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections where water enters with a hydrograph (cases/README.md)", NULL},
+    {"outlets", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: sections beyond which particles are removed and counted", NULL},
+    {"domain", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "open boundaries: particles outside this box are removed and counted", NULL},
     END};
 
 static const lahar_key time_keys[] = {
-    {"end", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "s", "simulated duration; give the simulated duration in seconds"},
-    {"dt_max", LAHAR_KEY_NUMBER, 0, "1e-3", LOX, 0, 0, NULL, "s", "upper bound of the coordinator step (the DEM node subcycles below it); it bounds the coordinator step, e.g. 1e-3"},
-    {"dt_min", LAHAR_KEY_NUMBER, 0, "1e-9", LOX, 0, 0, NULL, "s", "a step below this stops the run as a dt collapse (<= dt_max)"},
-    {"output_interval", LAHAR_KEY_NUMBER, 0, "end/100", LOX, 0, 0, NULL, "s", "snapshot interval (<= end)"},
-    {"forces_interval", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "s", "interval of the per-body force stream; 0 records every step"},
+    {"end", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "s", "simulated duration; give the simulated duration in seconds", NULL},
+    {"dt_max", LAHAR_KEY_NUMBER, 0, "1e-3", LOX, 0, 0, NULL, "s", "upper bound of the coordinator step (the DEM node subcycles below it); it bounds the coordinator step, e.g. 1e-3", NULL},
+    {"dt_min", LAHAR_KEY_NUMBER, 0, "1e-9", LOX, 0, 0, NULL, "s", "a step below this stops the run as a dt collapse (<= dt_max)", NULL},
+    {"output_interval", LAHAR_KEY_NUMBER, 0, "end/100", LOX, 0, 0, NULL, "s", "snapshot interval (<= end)", NULL},
+    {"forces_interval", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "s", "interval of the per-body force stream; 0 records every step", NULL},
     END};
 
 static const char *const material_models[] = {"linear", "hertz", "soil", NULL};
 static const lahar_key material_keys[] = {
-    {"density", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "kg/m^3", "density (bodies: their mass properties come from it, soil: bulk density)"},
-    {"model", LAHAR_KEY_CHOICE, 0, "hertz", 0, 0, 0, material_models, "", "DEM contact law (linear, hertz) or an SPH soil (soil)"},
-    {"young", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "Pa", "Young's modulus (required for hertz and soil)"},
-    {"poisson", LAHAR_KEY_NUMBER, 0, "0.25 (soil: 0.3)", LO | HIX, 0, 0.5, NULL, "", "Poisson's ratio"},
-    {"kn", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "N/m", "normal stiffness (required for linear, N/m per m in 2D)"},
-    {"kt_ratio", LAHAR_KEY_NUMBER, 0, "2/7", LOX, 0, 0, NULL, "", "tangential / normal stiffness (DEM); 2/7 is the usual choice"},
-    {"restitution", LAHAR_KEY_NUMBER, 0, NULL, LOX | HI, 0, 1, NULL, "", "normal coefficient of restitution (required for DEM materials); 1 is elastic, small values are very dissipative"},
-    {"friction", LAHAR_KEY_NUMBER, 0, "soil: tan(friction_angle)", LO, 0, 0, NULL, "", "Coulomb friction coefficient (DEM: required, soil: the soil-DEM mu_phi); 0 is frictionless"},
-    {"friction_angle", LAHAR_KEY_NUMBER, 0, NULL, LO | HIX, 0, 90, NULL, "degrees", "soil: Mohr-Coulomb friction angle (required for soil); sands are about 30"},
-    {"cohesion", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Pa", "soil: cohesion; 0 for a dry sand"},
-    {"dilatancy", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "degrees", "soil: dilatancy angle (<= friction_angle); 0 is usual"},
-    {"permeability", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m/s", "soil: Darcy hydraulic conductivity k_h (seepage)"},
-    {"damping", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "1/s", "soil: velocity damping of the start-up; 0 = off, about the column's first frequency pi c/(2 H) damps its start-up in a few periods"},
-    {"av_alpha", LAHAR_KEY_NUMBER, 0, "0.1", LO, 0, 0, NULL, "", "soil: Monaghan's alpha; 0.1 by default, 1 in Trujillo-Vela et al.'s (2020) granular impact"},
-    {"av_beta", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "", "soil: Monaghan's beta; 0 by default"},
+    {"density", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "kg/m^3", "density (bodies: their mass properties come from it, soil: bulk density)", NULL},
+    {"model", LAHAR_KEY_CHOICE, 0, "hertz", 0, 0, 0, material_models, "", "DEM contact law (linear, hertz) or an SPH soil (soil)", NULL},
+    {"young", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "Pa", "Young's modulus (required for hertz and soil)", NULL},
+    {"poisson", LAHAR_KEY_NUMBER, 0, "0.25 (soil: 0.3)", LO | HIX, 0, 0.5, NULL, "", "Poisson's ratio", NULL},
+    {"kn", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "N/m", "normal stiffness (required for linear, N/m per m in 2D)", NULL},
+    {"kt_ratio", LAHAR_KEY_NUMBER, 0, "2/7", LOX, 0, 0, NULL, "", "tangential / normal stiffness (DEM); 2/7 is the usual choice", NULL},
+    {"restitution", LAHAR_KEY_NUMBER, 0, NULL, LOX | HI, 0, 1, NULL, "", "normal coefficient of restitution (required for DEM materials); 1 is elastic, small values are very dissipative", NULL},
+    {"friction", LAHAR_KEY_NUMBER, 0, "soil: tan(friction_angle)", LO, 0, 0, NULL, "", "Coulomb friction coefficient (DEM: required, soil: the soil-DEM mu_phi); 0 is frictionless", NULL},
+    {"friction_angle", LAHAR_KEY_NUMBER, 0, NULL, LO | HIX, 0, 90, NULL, "degrees", "soil: Mohr-Coulomb friction angle (required for soil); sands are about 30", NULL},
+    {"cohesion", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Pa", "soil: cohesion; 0 for a dry sand", NULL},
+    {"dilatancy", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "degrees", "soil: dilatancy angle (<= friction_angle); 0 is usual", NULL},
+    {"permeability", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m/s", "soil: Darcy hydraulic conductivity k_h (seepage)", NULL},
+    {"damping", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "1/s", "soil: velocity damping of the start-up; 0 = off, about the column's first frequency pi c/(2 H) damps its start-up in a few periods", NULL},
+    {"av_alpha", LAHAR_KEY_NUMBER, 0, "0.1", LO, 0, 0, NULL, "", "soil: Monaghan's alpha; 0.1 by default, 1 in Trujillo-Vela et al.'s (2020) granular impact", NULL},
+    {"av_beta", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "", "soil: Monaghan's beta; 0 by default", NULL},
     END};
 
 static const lahar_key dem_keys[] = {
-    {"engine", LAHAR_KEY_TEXT, 0, "spheropoly", 0, 0, 0, NULL, "", "name of the DEM engine (`lahar-dem --list` shows them)"},
-    {"dt_safety", LAHAR_KEY_NUMBER, 0, "0.02", LOX | HI, 0, 1, NULL, "", "fraction of the shortest contact period used as the DEM step; it is the fraction of the contact period used as the DEM step, 0.02 is safe"},
+    {"engine", LAHAR_KEY_TEXT, 0, "spheropoly", 0, 0, 0, NULL, "", "name of the DEM engine (`lahar-dem --list` shows them)", NULL},
+    {"dt_safety", LAHAR_KEY_NUMBER, 0, "0.02", LOX | HI, 0, 1, NULL, "", "fraction of the shortest contact period used as the DEM step; it is the fraction of the contact period used as the DEM step, 0.02 is safe", NULL},
     END};
 
 static const lahar_key stability_keys[] = {
-    {"density_band", LAHAR_KEY_VECTOR, 0, "[0.5, 2.0]", 0, 0, 0, NULL, "", "[lo, hi], 0 < lo < 1 < hi: the band of rho / rho0 every SPH particle must stay in"},
-    {"max_overlap", LAHAR_KEY_NUMBER, 0, "0.5", LOX | HI, 0, 1, NULL, "", "largest body-body overlap as a fraction of the smaller sweep radius; it is the largest body-body overlap as a fraction of the smaller sweep radius, e.g. 0.5"},
-    {"dt_collapse", LAHAR_KEY_NUMBER, 0, "1e-3", LO | HIX, 0, 1, NULL, "", "the run stops when the step falls below this fraction of the first step (0: only time.dt_min); the run stops when the step falls below this fraction of the first step (0: only time.dt_min), e.g. 1e-3"},
+    {"density_band", LAHAR_KEY_VECTOR, 0, "[0.5, 2.0]", 0, 0, 0, NULL, "", "[lo, hi], 0 < lo < 1 < hi: the band of rho / rho0 every SPH particle must stay in", NULL},
+    {"max_overlap", LAHAR_KEY_NUMBER, 0, "0.5", LOX | HI, 0, 1, NULL, "", "largest body-body overlap as a fraction of the smaller sweep radius; it is the largest body-body overlap as a fraction of the smaller sweep radius, e.g. 0.5", NULL},
+    {"dt_collapse", LAHAR_KEY_NUMBER, 0, "1e-3", LO | HIX, 0, 1, NULL, "", "the run stops when the step falls below this fraction of the first step (0: only time.dt_min); the run stops when the step falls below this fraction of the first step (0: only time.dt_min), e.g. 1e-3", NULL},
     END};
 
 static const lahar_key checkpoint_keys[] = {
-    {"interval", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "s", "simulated time between checkpoints; a checkpoint is written at the first step ending at or after each multiple of it, e.g. 0.1"},
-    {"keep", LAHAR_KEY_WHOLE, 0, "2", LO | HI, 1, 1000, NULL, "", "how many of the newest checkpoints stay on disk; it is how many of the newest checkpoints stay on disk, e.g. 2"},
+    {"interval", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "s", "simulated time between checkpoints; a checkpoint is written at the first step ending at or after each multiple of it, e.g. 0.1", NULL},
+    {"keep", LAHAR_KEY_WHOLE, 0, "2", LO | HI, 1, 1000, NULL, "", "how many of the newest checkpoints stay on disk; it is how many of the newest checkpoints stay on disk, e.g. 2", NULL},
     END};
 
 static const char *const output_forces[] = {"none", "all", NULL};
 static const lahar_key output_keys[] = {
-    {"fields", LAHAR_KEY_LIST, 0, "all", 0, 0, 0, NULL, "", "particle fields of every snapshot: any of velocity, density, pressure, phase, id, stress (positions always)"},
-    {"forces", LAHAR_KEY_CHOICE, 0, "all", 0, 0, 0, output_forces, "", "all = write the per-body force stream forces.h5, none = do not"},
+    {"fields", LAHAR_KEY_LIST, 0, "all", 0, 0, 0, NULL, "", "particle fields of every snapshot: any of velocity, density, pressure, phase, id, stress (positions always)", NULL},
+    {"forces", LAHAR_KEY_CHOICE, 0, "all", 0, 0, 0, output_forces, "", "all = write the per-body force stream forces.h5, none = do not", NULL},
     END};
 
 static const lahar_key check_keys[] = {
-    {"reference", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "name of the reference (cases/README.md \"check: references\")"},
-    {"metrics", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "metric name -> bound: passes when its value is <= bound (1 to 16 metrics)"},
+    {"reference", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "name of the reference (cases/README.md \"check: references\")", NULL},
+    {"metrics", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "metric name -> bound: passes when its value is <= bound (1 to 16 metrics)", NULL},
     END};
 
 static const char *const probe_kinds[] = {"pressure", "level", NULL};
 static const lahar_key probe_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "probe<i>", 0, 0, 0, NULL, "", "unique name"},
-    {"kind", LAHAR_KEY_CHOICE, 0, "pressure", 0, 0, 0, probe_kinds, "", "pressure (a point) or level (water level on a vertical line)"},
-    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the point (pressure) or the horizontal place of the line (level: [x] in 2D, [x, y] in 3D)"},
-    {"body", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "pressure probes: a body's name: the probe is a sensor on its surface"},
-    {"size", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m", "pressure probes on a body: sensor diameter (0 = a point); the sensor's diameter in m, 0 for a point"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step); samples per second, 0 or absent = every step"},
+    {"name", LAHAR_KEY_TEXT, 0, "probe<i>", 0, 0, 0, NULL, "", "unique name", NULL},
+    {"kind", LAHAR_KEY_CHOICE, 0, "pressure", 0, 0, 0, probe_kinds, "", "pressure (a point) or level (water level on a vertical line)", NULL},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the point (pressure) or the horizontal place of the line (level: [x] in 2D, [x, y] in 3D)", NULL},
+    {"body", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "pressure probes: a body's name: the probe is a sensor on its surface", NULL},
+    {"size", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "m", "pressure probes on a body: sensor diameter (0 = a point); the sensor's diameter in m, 0 for a point", NULL},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step); samples per second, 0 or absent = every step", NULL},
     END};
 
 static const lahar_key inlet_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "inlet<i>", 0, 0, 0, NULL, "", "name (messages)"},
-    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)"},
-    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]"},
-    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge, perpendicular to edge"},
-    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "inward normal, perpendicular to the edges (normalised)"},
-    {"level", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "m", "water depth above the section's lowest point along gravity (or level_hydrograph)"},
-    {"level_hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,h: the level h(t) instead of level (path relative to the case file)"},
-    {"velocity", LAHAR_KEY_NUMBER, 0, NULL, LO, 0, 0, NULL, "m/s", "a constant inflow velocity (one of velocity, gumbel, hydrograph); the inflow along the inward normal"},
-    {"gumbel", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "[a_G (m), beta_G (s), mu_G (s)]: u of Trujillo-Vela et al. 2020, eq. 36"},
-    {"hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,u (m/s) or t,Q (m^2/s in 2D, m^3/s in 3D), relative to the case file"},
-    {"start", LAHAR_KEY_NUMBER, 0, "0", 0, 0, 0, NULL, "s", "the inflow acts from start"},
-    {"end", LAHAR_KEY_NUMBER, 0, "forever", 0, 0, 0, NULL, "s", "... until end (u = 0 outside [start, end))"},
-    {"layers", LAHAR_KEY_WHOLE, 0, "support/dx", LO | HI, 1, 64, NULL, "", "buffer rows behind the section"},
-    {"max_particles", LAHAR_KEY_WHOLE, 0, "estimate", LO | HI, 1, 1e12, NULL, "", "most particles the inlet may create (default: from the hydrograph + 10 %)"},
+    {"name", LAHAR_KEY_TEXT, 0, "inlet<i>", 0, 0, 0, NULL, "", "name (messages)", NULL},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)", NULL},
+    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]", NULL},
+    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge, perpendicular to edge", NULL},
+    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "inward normal, perpendicular to the edges (normalised)", NULL},
+    {"level", LAHAR_KEY_NUMBER, 0, NULL, LOX, 0, 0, NULL, "m", "water depth above the section's lowest point along gravity (or level_hydrograph)", NULL},
+    {"level_hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,h: the level h(t) instead of level (path relative to the case file)", NULL},
+    {"velocity", LAHAR_KEY_NUMBER, 0, NULL, LO, 0, 0, NULL, "m/s", "a constant inflow velocity (one of velocity, gumbel, hydrograph); the inflow along the inward normal", NULL},
+    {"gumbel", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "[a_G (m), beta_G (s), mu_G (s)]: u of Trujillo-Vela et al. 2020, eq. 36", NULL},
+    {"hydrograph", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "CSV t,u (m/s) or t,Q (m^2/s in 2D, m^3/s in 3D), relative to the case file", NULL},
+    {"start", LAHAR_KEY_NUMBER, 0, "0", 0, 0, 0, NULL, "s", "the inflow acts from start", NULL},
+    {"end", LAHAR_KEY_NUMBER, 0, "forever", 0, 0, 0, NULL, "s", "... until end (u = 0 outside [start, end))", NULL},
+    {"layers", LAHAR_KEY_WHOLE, 0, "support/dx", LO | HI, 1, 64, NULL, "", "buffer rows behind the section", NULL},
+    {"max_particles", LAHAR_KEY_WHOLE, 0, "estimate", LO | HI, 1, 1e12, NULL, "", "most particles the inlet may create (default: from the hydrograph + 10 %)", NULL},
     END};
 
 static const lahar_key outlet_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "outlet<i>", 0, 0, 0, NULL, "", "name (messages)"},
-    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)"},
-    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]"},
-    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge"},
-    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "outward normal, perpendicular to the edges (normalised)"},
-    {"depth", LAHAR_KEY_NUMBER, 0, "unlimited", LOX, 0, 0, NULL, "m", "how far beyond the section particles are removed; how far beyond the section, m"},
+    {"name", LAHAR_KEY_TEXT, 0, "outlet<i>", 0, 0, 0, NULL, "", "name (messages)", NULL},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "one end of the line (2D) / a corner of the rectangle (3D)", NULL},
+    {"edge", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the section is position + a edge (+ b edge2), a, b in [0, 1]", NULL},
+    {"edge2", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "3D (required there): the rectangle's second edge", NULL},
+    {"normal", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "", "outward normal, perpendicular to the edges (normalised)", NULL},
+    {"depth", LAHAR_KEY_NUMBER, 0, "unlimited", LOX, 0, 0, NULL, "m", "how far beyond the section particles are removed; how far beyond the section, m", NULL},
     END};
 
 static const lahar_key domain_keys[] = {
-    {"lo", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "lower corner of the box"},
-    {"hi", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "upper corner (> lo on every axis)"},
+    {"lo", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "lower corner of the box", NULL},
+    {"hi", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "upper corner (> lo on every axis)", NULL},
     END};
 
 static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
@@ -138,105 +138,112 @@ static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
 static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
 static const char *const scheme_names[] = {"delta", "riemann", NULL};
 static const lahar_key sph_keys[] = {
-    {"dx", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "particle spacing; it is the particle spacing"},
-    {"density", LAHAR_KEY_NUMBER, 0, "1000", LOX, 0, 0, NULL, "kg/m^3", "rest density rho0 of the water"},
-    {"kernel", LAHAR_KEY_CHOICE, 0, "cubic", 0, 0, 0, kernels, "", "smoothing kernel: cubic (support 2h), quintic (Morris 1997, 3h), wendland2 (Wendland C2, 2h)"},
-    {"h_over_dx", LAHAR_KEY_NUMBER, 0, "1.3", LO | HI, 0.5, 4, NULL, "", "smoothing length h = h_over_dx dx; h = h_over_dx dx, 1.0-1.5 is usual"},
-    {"c0", LAHAR_KEY_NUMBER, 0, "10 U_ref", LOX, 0, 0, NULL, "m/s", "numerical speed of sound (U_ref: cases/README.md); about 10 x the largest expected flow speed"},
-    {"eos", LAHAR_KEY_CHOICE, 0, "linear", 0, 0, 0, eos_names, "", "equation of state: linear p = c0^2 (rho - rho0) (Trujillo-Vela et al. 2020 eq. 3) or tait (Canelas et al. 2015 eq. 19)"},
-    {"gamma", LAHAR_KEY_NUMBER, 0, "7", LO, 1, 0, NULL, "", "Tait exponent (only with eos: tait); 7 for water"},
-    {"viscosity", LAHAR_KEY_NUMBER, 0, "1e-3", LO, 0, 0, NULL, "Pa s", "dynamic viscosity; water is 1e-3"},
-    {"alpha", LAHAR_KEY_NUMBER, 0, "0", LO | HI, 0, 1, NULL, "", "Monaghan artificial viscosity; 0.01-0.1 is usual, 0 = off"},
-    {"delta", LAHAR_KEY_NUMBER, 0, "0.1", LO | HI, 0, 1, NULL, "", "delta-SPH density diffusion; 0.1 is usual, 0 = off"},
-    {"cfl", LAHAR_KEY_NUMBER, 0, "0.25", LOX | HI, 0, 1, NULL, "", "acoustic step factor: dt <= cfl h / (c0 + |v|max) (Canelas et al. 2015 eq. 20)"},
-    {"cfl_force", LAHAR_KEY_NUMBER, 0, "0.25", LOX | HI, 0, 1, NULL, "", "force step factor: dt <= cfl_force sqrt(h / |a|max)"},
-    {"cfl_visc", LAHAR_KEY_NUMBER, 0, "0.125", LOX | HI, 0, 1, NULL, "", "viscous step factor: dt <= cfl_visc h^2 / nu"},
-    {"body_force", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s^2", "acceleration of the fluid only, added to gravity (drives periodic flows)"},
-    {"periodic", LAHAR_KEY_MAPPING, 0, "none", 0, 0, 0, NULL, "", "{x: [lo, hi], y: ..., z: ...}: periodic axes, each a whole number of dx holding 3 kernel supports"},
-    {"shepard_interval", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 1e6, NULL, "", "steps between Shepard density filters (Canelas et al. 2015 eq. 5); 0 = off"},
-    {"sps", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "Smagorinsky SPS turbulence (Canelas et al. 2015 eq. 10-11)"},
-    {"sps_cs", LAHAR_KEY_NUMBER, 0, "0.12", LOX | HIX, 0, 1, NULL, "", "Smagorinsky constant of sps: true; 0.12 is usual"},
-    {"halo", LAHAR_KEY_NUMBER, 0, "dx/2", 0, 0, 0, NULL, "m", "coupling halo: a particle closer than it to a body is pushed back (Trujillo-Vela et al. 2020 eq. 14)"},
-    {"kappa", LAHAR_KEY_NUMBER, 0, "the kernel's support (2, quintic 3)", LOX | HI, 0, 4, NULL, "", "coupling range in h: particles within kappa h of a body feel it"},
-    {"wall_viscous", LAHAR_KEY_CHOICE, 0, "halfspace", 0, 0, 0, wall_viscous_names, "", "wall shear of the virtual particle: halfspace (Morris operator over the half-space) or paper (Trujillo-Vela et al. 2020 eq. 17)"},
-    {"initial_pressure", LAHAR_KEY_CHOICE, 0, "none", 0, 0, 0, initial_pressure_names, "", "none: particles start at rho0; hydrostatic: at the density of rho |g| depth, per block"},
-    {"wall_pressure", LAHAR_KEY_CHOICE, 0, "penalty", 0, 0, 0, wall_pressure_names, "", "penalty (Trujillo-Vela et al. 2020 eq. 15) or ghost: plus ghost layers behind the surface (Adami et al. 2012)"},
-    {"penalty_stiffness", LAHAR_KEY_CHOICE, 0, "step", 0, 0, 0, penalty_stiffness_names, "", "K_n = 0.1 m_min / dt^2 with the step's dt (step) or the acoustic step (acoustic; use with wall_pressure: ghost)"},
-    {"soil_wall_stress", LAHAR_KEY_CHOICE, 0, "penalty", 0, 0, 0, wall_pressure_names, "", "soil on bodies: penalty (eq. 15 + friction spring) or ghost (ghost layers carry the soil stress; recommended)"},
-    {"shifting", LAHAR_KEY_NUMBER, 0, "0", LO | HI, 0, 0.5, NULL, "", "particle shifting coefficient A (Lind et al. 2012; water-only flows without a free surface); 0.01 is usual, 0 = off (particle shifting: confined flows only, lahar detects no free surface)"},
-    {"shifting_density", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "the shift also changes the density as the continuity equation would (keeps a closed box's volume)"},
-    {"background_pressure", LAHAR_KEY_NUMBER, 0, "0 (transport_velocity: rho0 c0^2)", LO, 0, 0, NULL, "Pa", "background pressure p_b (Adami et al. 2013)"},
-    {"transport_velocity", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "transport-velocity formulation (Adami et al. 2013): fully periodic water-only flows"},
-    {"body_layers", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 8, NULL, "", "particles within N dx of sphere/disc bodies start on N concentric layers; 0 = the plain lattice, 2-3 usual"},
-    {"scheme", LAHAR_KEY_CHOICE, 0, "delta", 0, 0, 0, scheme_names, "", "delta: delta-SPH + artificial viscosity; riemann: the low-dissipation Riemann solver of Zhang, Hu & Adams 2017 (alpha and delta then 0)"},
-    {"riemann_limiter", LAHAR_KEY_NUMBER, 0, "3", LO | HI, 0, 100, NULL, "", "eta of the Riemann scheme's dissipation limiter beta = min(eta max(dU, 0), c0); 3 as in Zhang et al. 2017, 0 = no limiter (the full acoustic dissipation)"},
-    {"blocks", LAHAR_KEY_LIST, 1, NULL, 0, 0, 0, NULL, "", "regions filled with particles (non-empty)"},
+    {"dx", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "particle spacing; it is the particle spacing", NULL},
+    {"density", LAHAR_KEY_NUMBER, 0, "1000", LOX, 0, 0, NULL, "kg/m^3", "rest density rho0 of the water", NULL},
+    {"kernel", LAHAR_KEY_CHOICE, 0, "cubic", 0, 0, 0, kernels, "", "smoothing kernel: cubic (support 2h), quintic (Morris 1997, 3h), wendland2 (Wendland C2, 2h)", NULL},
+    {"h_over_dx", LAHAR_KEY_NUMBER, 0, "1.3", LO | HI, 0.5, 4, NULL, "", "smoothing length h = h_over_dx dx; h = h_over_dx dx, 1.0-1.5 is usual", NULL},
+    {"c0", LAHAR_KEY_NUMBER, 0, "10 U_ref", LOX, 0, 0, NULL, "m/s", "numerical speed of sound (U_ref: cases/README.md); about 10 x the largest expected flow speed", NULL},
+    {"eos", LAHAR_KEY_CHOICE, 0, "linear", 0, 0, 0, eos_names, "", "equation of state: linear p = c0^2 (rho - rho0) (Trujillo-Vela et al. 2020 eq. 3) or tait (Canelas et al. 2015 eq. 19)", NULL},
+    {"gamma", LAHAR_KEY_NUMBER, 0, "7", LO, 1, 0, NULL, "", "Tait exponent (only with eos: tait); 7 for water", NULL},
+    {"viscosity", LAHAR_KEY_NUMBER, 0, "1e-3", LO, 0, 0, NULL, "Pa s", "dynamic viscosity; water is 1e-3", NULL},
+    {"alpha", LAHAR_KEY_NUMBER, 0, "0", LO | HI, 0, 1, NULL, "", "Monaghan artificial viscosity; 0.01-0.1 is usual, 0 = off", NULL},
+    {"delta", LAHAR_KEY_NUMBER, 0, "0.1", LO | HI, 0, 1, NULL, "", "delta-SPH density diffusion; 0.1 is usual, 0 = off", NULL},
+    {"cfl", LAHAR_KEY_NUMBER, 0, "0.25", LOX | HI, 0, 1, NULL, "", "acoustic step factor: dt <= cfl h / (c0 + |v|max) (Canelas et al. 2015 eq. 20)", NULL},
+    {"cfl_force", LAHAR_KEY_NUMBER, 0, "0.25", LOX | HI, 0, 1, NULL, "", "force step factor: dt <= cfl_force sqrt(h / |a|max)", NULL},
+    {"cfl_visc", LAHAR_KEY_NUMBER, 0, "0.125", LOX | HI, 0, 1, NULL, "", "viscous step factor: dt <= cfl_visc h^2 / nu", NULL},
+    {"body_force", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s^2", "acceleration of the fluid only, added to gravity (drives periodic flows)", NULL},
+    {"periodic", LAHAR_KEY_MAPPING, 0, "none", 0, 0, 0, NULL, "", "{x: [lo, hi], y: ..., z: ...}: periodic axes, each a whole number of dx holding 3 kernel supports", NULL},
+    {"shepard_interval", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 1e6, NULL, "", "steps between Shepard density filters (Canelas et al. 2015 eq. 5); 0 = off", NULL},
+    {"sps", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "Smagorinsky SPS turbulence (Canelas et al. 2015 eq. 10-11)", NULL},
+    {"sps_cs", LAHAR_KEY_NUMBER, 0, "0.12", LOX | HIX, 0, 1, NULL, "", "Smagorinsky constant of sps: true; 0.12 is usual", NULL},
+    {"halo", LAHAR_KEY_NUMBER, 0, "dx/2", 0, 0, 0, NULL, "m", "coupling halo: a particle closer than it to a body is pushed back (Trujillo-Vela et al. 2020 eq. 14)", NULL},
+    {"kappa", LAHAR_KEY_NUMBER, 0, "the kernel's support (2, quintic 3)", LOX | HI, 0, 4, NULL, "", "coupling range in h: particles within kappa h of a body feel it", NULL},
+    {"wall_viscous", LAHAR_KEY_CHOICE, 0, "halfspace", 0, 0, 0, wall_viscous_names, "", "wall shear of the virtual particle: halfspace (Morris operator over the half-space) or paper (Trujillo-Vela et al. 2020 eq. 17)", NULL},
+    {"initial_pressure", LAHAR_KEY_CHOICE, 0, "none", 0, 0, 0, initial_pressure_names, "", "none: particles start at rho0; hydrostatic: at the density of rho |g| depth, per block", NULL},
+    {"wall_pressure", LAHAR_KEY_CHOICE, 0, "penalty", 0, 0, 0, wall_pressure_names, "", "penalty (Trujillo-Vela et al. 2020 eq. 15) or ghost: plus ghost layers behind the surface (Adami et al. 2012)", NULL},
+    {"penalty_stiffness", LAHAR_KEY_CHOICE, 0, "step", 0, 0, 0, penalty_stiffness_names, "", "K_n = 0.1 m_min / dt^2 with the step's dt (step) or the acoustic step (acoustic; use with wall_pressure: ghost)", NULL},
+    {"soil_wall_stress", LAHAR_KEY_CHOICE, 0, "penalty", 0, 0, 0, wall_pressure_names, "", "soil on bodies: penalty (eq. 15 + friction spring) or ghost (ghost layers carry the soil stress; recommended)", NULL},
+    {"shifting", LAHAR_KEY_NUMBER, 0, "0", LO | HI, 0, 0.5, NULL, "", "particle shifting coefficient A (Lind et al. 2012; water-only flows without a free surface); 0.01 is usual, 0 = off (particle shifting: confined flows only, lahar detects no free surface)", NULL},
+    {"shifting_density", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "the shift also changes the density as the continuity equation would (keeps a closed box's volume)", NULL},
+    {"background_pressure", LAHAR_KEY_NUMBER, 0, "0 (transport_velocity: rho0 c0^2)", LO, 0, 0, NULL, "Pa", "background pressure p_b (Adami et al. 2013)", NULL},
+    {"transport_velocity", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "transport-velocity formulation (Adami et al. 2013): fully periodic water-only flows", NULL},
+    {"body_layers", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 8, NULL, "", "particles within N dx of sphere/disc bodies start on N concentric layers; 0 = the plain lattice, 2-3 usual", NULL},
+    {"scheme", LAHAR_KEY_CHOICE, 0, "delta", 0, 0, 0, scheme_names, "", "delta: delta-SPH + artificial viscosity; riemann: the low-dissipation Riemann solver of Zhang, Hu & Adams 2017 (alpha and delta then 0)", NULL},
+    {"riemann_limiter", LAHAR_KEY_NUMBER, 0, "3", LO | HI, 0, 100, NULL, "", "eta of the Riemann scheme's dissipation limiter beta = min(eta max(dU, 0), c0); 3 as in Zhang et al. 2017, 0 = no limiter (the full acoustic dissipation)", NULL},
+    {"blocks", LAHAR_KEY_LIST, 1, NULL, 0, 0, 0, NULL, "", "regions filled with particles (non-empty)", NULL},
     END};
 
 static const lahar_key periodic_keys[] = {
-    {"x", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along x"},
-    {"y", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along y"},
-    {"z", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along z (3D)"},
+    {"x", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along x", NULL},
+    {"y", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along y", NULL},
+    {"z", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "[lo, hi): the period along z (3D)", NULL},
     END};
 
 static const char *const phases[] = {"water", "soil", NULL};
 static const lahar_key block_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "block<i>", 0, 0, 0, NULL, "", "unique name"},
-    {"box", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]} corners (one of box, polygon, stl)"},
-    {"polygon", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] a simple polygon, convex or not"},
-    {"stl", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "3D: {file, scale: 1, position: [0, 0, 0]} a closed watertight surface"},
-    {"velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s", "initial velocity; each component a number or an expression in x, y, z"},
-    {"pressure", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "Pa", "water: initial pressure, a number or an expression in x, y, z"},
-    {"initial", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{file: F.h5}: per-particle vx, vy (, vz), pressure in lattice order"},
-    {"phase", LAHAR_KEY_CHOICE, 0, "water", 0, 0, 0, phases, "", "water or soil"},
-    {"material", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "soil blocks: a materials entry with model: soil (required for soil)"},
-    {"between", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{top: ...}: the region between the terrain and an upper surface (2D polyline, 3D grid file)"},
+    {"name", LAHAR_KEY_TEXT, 0, "block<i>", 0, 0, 0, NULL, "", "unique name", NULL},
+    {"box", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]} corners (one of box, polygon, stl)", NULL},
+    {"polygon", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] a simple polygon, convex or not", NULL},
+    {"stl", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "3D: {file, scale: 1, position: [0, 0, 0]} a closed watertight surface", NULL},
+    {"velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s", "initial velocity; each component a number or an expression in x, y, z", NULL},
+    {"pressure", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "Pa", "water: initial pressure, a number or an expression in x, y, z", NULL},
+    {"initial", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{file: F.h5}: per-particle vx, vy (, vz), pressure in lattice order", NULL},
+    {"phase", LAHAR_KEY_CHOICE, 0, "water", 0, 0, 0, phases, "", "water or soil", NULL},
+    {"material", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "soil blocks: a materials entry with model: soil (required for soil)", NULL},
+    {"between", LAHAR_KEY_MAPPING, 0, NULL, 0, 0, 0, NULL, "", "{top: ...}: the region between the terrain and an upper surface (2D polyline, 3D grid file)", NULL},
     END};
 
 static const char *const shapes[] = {"sphere", "disc", "box", "segment", "polyline", "polygon", "polyhedron",
                                      "plane", "stl", NULL};
 static const char *const motions[] = {"free", "fixed", "prescribed", NULL};
+/* the shapes a shape-specific key of bodies[] belongs to */
+static const char *const box_plane[] = {"box", "plane", NULL};
+static const char *const vertex_shapes[] = {"segment", "polyline", "polygon", "polyhedron", NULL};
+static const char *const polyhedron_only[] = {"polyhedron", NULL};
+static const char *const polyline_only[] = {"polyline", NULL};
+static const char *const plane_only[] = {"plane", NULL};
+static const char *const stl_only[] = {"stl", NULL};
 static const lahar_key body_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "body<i>", 0, 0, 0, NULL, "", "unique name"},
-    {"shape", LAHAR_KEY_CHOICE, 1, NULL, 0, 0, 0, shapes, "", "sphere, box, segment, polyhedron, plane, stl (3D); disc, box, segment, polygon, polyline (2D)"},
-    {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a name from materials"},
-    {"motion", LAHAR_KEY_CHOICE, 0, "free", 0, 0, 0, motions, "", "free, fixed (a wall) or prescribed (moves with its given velocities)"},
-    {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sphere/disc radius, otherwise the sweep (rounding) radius of the core"},
-    {"position", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m", "where the shape's local origin goes"},
-    {"orientation", LAHAR_KEY_MAPPING, 0, "none", 0, 0, 0, NULL, "", "{axis: [x, y, z], angle_deg: a} (2D: angle_deg only, about +z)"},
-    {"velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s", "initial velocity (not for fixed bodies)"},
-    {"angular_velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "rad/s", "world frame (2D: one number about +z)"},
-    {"record_contacts", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "the SPH node writes every fluid contact point on this body (contacts.h5)"},
-    {"size", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "box: outer size [sx, sy(, sz)] (every side > 2 radius); plane: [a, b]"},
-    {"vertices", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "segment, polyline, polygon, polyhedron: [[x, y(, z)], ...] in the local frame"},
-    {"faces", LAHAR_KEY_LIST, 0, "the convex hull", 0, 0, 0, NULL, "", "polyhedron: [[i, j, k, ...], ...] counter-clockwise seen from outside"},
-    {"closed", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "polyline: join the last point to the first"},
-    {"normal", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "plane: outward normal (the side bodies stay on)"},
-    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "stl: ASCII or binary STL path, relative to the case file"},
-    {"scale", LAHAR_KEY_NUMBER, 0, "1", LOX, 0, 0, NULL, "", "stl: factor on the file's coordinates (0.001 for mm)"},
+    {"name", LAHAR_KEY_TEXT, 0, "body<i>", 0, 0, 0, NULL, "", "unique name", NULL},
+    {"shape", LAHAR_KEY_CHOICE, 1, NULL, 0, 0, 0, shapes, "", "sphere, box, segment, polyhedron, plane, stl (3D); disc, box, segment, polygon, polyline (2D)", NULL},
+    {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a name from materials", NULL},
+    {"motion", LAHAR_KEY_CHOICE, 0, "free", 0, 0, 0, motions, "", "free, fixed (a wall) or prescribed (moves with its given velocities)", NULL},
+    {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sphere/disc radius, otherwise the sweep (rounding) radius of the core", NULL},
+    {"position", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m", "where the shape's local origin goes", NULL},
+    {"orientation", LAHAR_KEY_MAPPING, 0, "none", 0, 0, 0, NULL, "", "{axis: [x, y, z], angle_deg: a} (2D: angle_deg only, about +z)", NULL},
+    {"velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "m/s", "initial velocity (not for fixed bodies)", NULL},
+    {"angular_velocity", LAHAR_KEY_VECTOR, 0, "0", 0, 0, 0, NULL, "rad/s", "world frame (2D: one number about +z)", NULL},
+    {"record_contacts", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "the SPH node writes every fluid contact point on this body (contacts.h5)", NULL},
+    {"size", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "m", "box: outer size [sx, sy(, sz)] (every side > 2 radius); plane: [a, b]", box_plane},
+    {"vertices", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "segment, polyline, polygon, polyhedron: [[x, y(, z)], ...] in the local frame", vertex_shapes},
+    {"faces", LAHAR_KEY_LIST, 0, "the convex hull", 0, 0, 0, NULL, "", "polyhedron: [[i, j, k, ...], ...] counter-clockwise seen from outside", polyhedron_only},
+    {"closed", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "polyline: join the last point to the first", polyline_only},
+    {"normal", LAHAR_KEY_VECTOR, 0, NULL, 0, 0, 0, NULL, "", "plane: outward normal (the side bodies stay on)", plane_only},
+    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "stl: ASCII or binary STL path, relative to the case file", stl_only},
+    {"scale", LAHAR_KEY_NUMBER, 0, "1", LOX, 0, 0, NULL, "", "stl: factor on the file's coordinates (0.001 for mm)", stl_only},
     END};
 
 
 static const lahar_key terrain_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "terrain", 0, 0, 0, NULL, "", "the body's name"},
-    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "2D: a CSV of x,y; 3D: an ESRI ASCII grid (.asc); relative to the case file (or points)"},
-    {"points", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] the profile, instead of file"},
-    {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a DEM material (its friction is the bed's mu_phi against soil)"},
-    {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sweep radius of the surface (it lies radius above the points)"},
+    {"name", LAHAR_KEY_TEXT, 0, "terrain", 0, 0, 0, NULL, "", "the body's name", NULL},
+    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "2D: a CSV of x,y; 3D: an ESRI ASCII grid (.asc); relative to the case file (or points)", NULL},
+    {"points", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] the profile, instead of file", NULL},
+    {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a DEM material (its friction is the bed's mu_phi against soil)", NULL},
+    {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sweep radius of the surface (it lies radius above the points)", NULL},
     END};
 
 static const char *const cv_axes[] = {"x", "y", "z", NULL};
 static const lahar_key tracker_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "tracker<i>", 0, 0, 0, NULL, "", "unique name"},
-    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the particle nearest this point at t = 0 is followed"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output"},
+    {"name", LAHAR_KEY_TEXT, 0, "tracker<i>", 0, 0, 0, NULL, "", "unique name", NULL},
+    {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the particle nearest this point at t = 0 is followed", NULL},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output", NULL},
     END};
 
 static const lahar_key control_volume_keys[] = {
-    {"name", LAHAR_KEY_TEXT, 0, "cv<i>", 0, 0, 0, NULL, "", "unique name"},
-    {"box", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]}: kinetic energy (Trujillo-Vela et al. 2020 eq. 39) and mass inside"},
-    {"axis", LAHAR_KEY_CHOICE, 0, "x", 0, 0, 0, cv_axes, "", "direction of the mass flux recorded through the box"},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output"},
+    {"name", LAHAR_KEY_TEXT, 0, "cv<i>", 0, 0, 0, NULL, "", "unique name", NULL},
+    {"box", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]}: kinetic energy (Trujillo-Vela et al. 2020 eq. 39) and mass inside", NULL},
+    {"axis", LAHAR_KEY_CHOICE, 0, "x", 0, 0, 0, cv_axes, "", "direction of the mass flux recorded through the box", NULL},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output", NULL},
     END};
 
 static const lahar_key_section sections[] = {
@@ -265,6 +272,16 @@ const lahar_key_section *lahar_key_sections(int *count)
 {
     *count = (int)(sizeof sections / sizeof sections[0]);
     return sections;
+}
+
+int lahar_key_applies(const lahar_key *k, const char *variant)
+{
+    if (!k->only)
+        return 1;
+    for (int i = 0; k->only[i]; i++)
+        if (strcmp(k->only[i], variant) == 0)
+            return 1;
+    return 0;
 }
 
 const lahar_key_section *lahar_key_section_find(const char *path)

@@ -33,7 +33,11 @@ typedef struct {
     const char *const *choices; /* LAHAR_KEY_CHOICE (NULL-terminated) */
     const char *unit;           /* "m", "Pa s", ... ; "" for dimensionless */
     const char *doc;            /* one line: what it is (and, after "; ", a hint for range errors) */
+    const char *const *only;    /* the variants of the section the key belongs to (bodies[]: the shapes),
+                                   NULL-terminated; NULL: every variant */
 } lahar_key;
+/* 1 when key k belongs to the variant `variant` (always when k->only is NULL). */
+int lahar_key_applies(const lahar_key *k, const char *variant);
 
 typedef struct {
     const char *path; /* "sph", "time", "materials.NAME", "sph.blocks[]", ... ("" = the top) */
