@@ -179,6 +179,29 @@ int main(void)
         lahar_case_free(&c);
     } else
         CHECK(0, "the soil material case does not load: %s", err);
+    /* the sph choices are read as the index of the value in the table's list: that list must be in
+     * the order of the C enum stored (scene.h) */
+    static const char *const choice_keys[] = {"eos", "wall_viscous", "initial_pressure", "wall_pressure",
+                                              "penalty_stiffness", "scheme"};
+    const lahar_key_section *ss = lahar_key_section_find("sph");
+    int nchoice = 0;
+    for (size_t q = 0; q < sizeof choice_keys / sizeof choice_keys[0]; q++) {
+        const lahar_key *k = lahar_key_find(ss, choice_keys[q]);
+        CHECK(k && k->choices, "sph.%s: no choices in the table", choice_keys[q]);
+        for (int v = 0; k && k->choices && k->choices[v]; v++) {
+            if (load_with("sph", k->name, k->choices[v], &c, err, sizeof err) != 0) {
+                CHECK(0, "sph.%s: %s does not load: %s", k->name, k->choices[v], err);
+                continue;
+            }
+            const int stored[] = {(int)c.sph.eos, (int)c.sph.wall_viscous, (int)c.sph.initial_pressure,
+                                  (int)c.sph.wall_pressure, (int)c.sph.penalty_stiffness, (int)c.sph.scheme};
+            CHECK(stored[q] == v, "sph.%s: %s is choice %d of the table but the loader stores %d", k->name,
+                  k->choices[v], v, stored[q]);
+            lahar_case_free(&c);
+            nchoice++;
+        }
+    }
+    CHECK(nchoice >= 12, "only %d choices checked", nchoice);
     /* bodies[]: a shape-specific key (the table's `only`) on a disc, which none of them belongs to, is
      * refused as unknown; on a shape it belongs to it is known */
     const lahar_key_section *bs = lahar_key_section_find("bodies[]");

@@ -92,7 +92,6 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
 
 static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const models[] = {"linear", "hertz", "soil", NULL};
     static const char *const soil_only[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping",
                                             "av_alpha", "av_beta", NULL};
     static const char *const dem_only[] = {"kn", "kt_ratio", "restitution", NULL};
@@ -136,7 +135,7 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
         c->nmaterial = i + 1;
         rmap_section(&m, "materials.NAME");
         mat->density = rd_key_num(&m, "density");
-        mat->model = (lahar_contact_model)rmap_enum(&m, "model", models, 0, LAHAR_CONTACT_HERTZ);
+        mat->model = (lahar_contact_model)rd_key_choice(&m, "model");
         if (r->failed)
             return;
         if (mat->model == LAHAR_CONTACT_SOIL) {
@@ -146,7 +145,7 @@ static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
         for (int k = 0; soil_only[k] && !r->failed; k++)
             if (rmap_get(&m, soil_only[k]))
                 rmap_fail(&m, soil_only[k], "is a key of an SPH soil (model: soil), but this material uses model: "
-                          "%s; remove it or set model: soil", models[mat->model]);
+                          "%s; remove it or set model: soil", lahar_key_find(m.sec, "model")->choices[mat->model]);
         if (mat->model == LAHAR_CONTACT_HERTZ) {
             if (rmap_get(&m, "kn"))
                 rmap_fail(&m, "kn", "is the stiffness of model: linear, but this material uses model: hertz; "
@@ -246,7 +245,6 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
 {
     /* bit i = field_names[i], matching LAHAR_PFIELD_* in output.h */
     static const char *const field_names[] = {"velocity", "density", "pressure", "phase", "id", "stress", NULL};
-    static const char *const forces_names[] = {"none", "all", NULL};
     int has_soil = 0;
     for (int b = 0; b < c->nblock; b++)
         has_soil |= c->blocks[b].phase == 1;
@@ -258,7 +256,7 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
     if (rmap_open(r, n, "output", &m) != 0)
         return;
     rmap_section(&m, "output");
-    c->output_forces = rmap_enum(&m, "forces", forces_names, 0, 1);
+    c->output_forces = rd_key_choice(&m, "forces");
     yaml_node_t *f = rmap_get(&m, "fields");
     if (!f || r->failed)
         return;

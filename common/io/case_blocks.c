@@ -250,9 +250,9 @@ static void read_block_between(reader *r, yaml_node_t *bn, const char *prefix, l
 }
 
 /* phase: water (default) | soil, and for soil the model: soil material it is made of. */
-static void read_block_phase(rmap *bm, lahar_particle_block *pb, const char *const *phases, const lahar_case *c)
+static void read_block_phase(rmap *bm, lahar_particle_block *pb, const lahar_case *c)
 {
-    pb->phase = rmap_enum(bm, "phase", phases, 0, 0);
+    pb->phase = rd_key_choice(bm, "phase"); /* the table's order: water 0, soil 1 (SPH_SOIL_PHASE) */
     pb->material = -1;
     if (bm->r->failed)
         return;
@@ -521,7 +521,6 @@ void case_read_block(reader *r, yaml_node_t *n, int i, lahar_case *c)
 
 static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c, rmap *bmo)
 {
-    static const char *const phases[] = {"water", "soil", NULL};
     static const char *const boxkeys[] = {"lo", "hi", NULL};
     const int dim = r->dim;
     lahar_particle_block *pb = &c->blocks[i];
@@ -536,7 +535,7 @@ static void read_block_geometry(reader *r, yaml_node_t *n, int i, lahar_case *c,
     for (int j = 0; j < i && !r->failed; j++)
         if (strcmp(c->blocks[j].name, pb->name) == 0)
             rmap_fail(bmo, "name", "'%s' is already the name of sph.blocks[%d]; block names must be unique", pb->name, j);
-    read_block_phase(bmo, pb, phases, c);
+    read_block_phase(bmo, pb, c);
     yaml_node_t *bx = rmap_get(bmo, "box"), *pg = rmap_get(bmo, "polygon"), *st = rmap_get(bmo, "stl");
     yaml_node_t *bw = rmap_get(bmo, "between");
     if (r->failed)

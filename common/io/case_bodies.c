@@ -20,12 +20,14 @@
 /* --- bodies -------------------------------------------------------------------------------------- */
 
 enum { SH_SPHERE, SH_DISC, SH_BOX, SH_SEGMENT, SH_POLYLINE, SH_POLYGON, SH_POLYHEDRON, SH_PLANE, SH_STL, SH_N };
-static const char *const shape_names[] = {"sphere", "disc", "box", "segment", "polyline", "polygon",
-                                          "polyhedron", "plane", "stl", NULL};
+/* the shape's name: the key table's choices of bodies[].shape, in the order of SH_* */
+static const char *shape_name(int kind)
+{
+    return lahar_key_find(lahar_key_section_find("bodies[]"), "shape")->choices[kind];
+}
 /* 2: 2D only, 3: 3D only, 0: both */
 static const int shape_dim[SH_N] = {3, 2, 0, 0, 2, 2, 3, 3, 3};
 static const int shape_fixed_only[SH_N] = {0, 0, 0, 0, 1, 0, 0, 1, 1};
-static const char *const motion_names[] = {"free", "fixed", "prescribed", NULL};
 
 /* Read a list of points (each `dim` numbers) into a new array of 3-vectors (z = 0 in 2D). */
 double (*case_read_points(reader *r, yaml_node_t *n, const char *key, int dim, int *np))[3]
@@ -277,7 +279,7 @@ static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
             else
                 rc = lahar_shape_make_segment(s, p[0], p[1], radius);
         } else if (kind == SH_POLYLINE) {
-            int closed = rmap_bool(m, "closed", 0);
+            int closed = rd_key_bool(m, "closed");
             if (!r->failed) {
                 rc = lahar_shape_make_polyline(s, (const double(*)[3])p, np, closed, radius, err, sizeof err);
                 if (rc != 0)
@@ -365,15 +367,16 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
     if (rmap_open(r, n, prefix, &m) != 0)
         return;
     lahar_body *b = &c->bodies[i];
-    int kind = rmap_enum(&m, "shape", shape_names, 1, SH_SPHERE);
+    const lahar_key_section *sec = lahar_key_section_find("bodies[]");
+    m.sec = sec;
+    int kind = rd_key_choice(&m, "shape");
     if (r->failed)
         return;
     /* the keys of bodies[] (case_keys.c) that belong to this shape */
-    const lahar_key_section *sec = lahar_key_section_find("bodies[]");
     const char *keys[32];
     int nk = 0;
     for (const lahar_key *k = sec ? sec->keys : NULL; k && k->name && nk < 31; k++)
-        if (lahar_key_applies(k, shape_names[kind]))
+        if (lahar_key_applies(k, shape_name(kind)))
             keys[nk++] = k->name;
     keys[nk] = NULL;
     rmap_check_keys(&m, keys);
@@ -390,17 +393,17 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
     if (shape_dim[kind] && shape_dim[kind] != dim) {
         static const char *const alt[SH_N] = {"disc", "sphere", "", "", "segment or stl", "box or polyhedron",
                                               "polygon", "polyline", "polyline"};
-        rmap_fail(&m, "shape", "'%s' is a %dD shape but the case has dimensions: %d; use %s", shape_names[kind],
+        rmap_fail(&m, "shape", "'%s' is a %dD shape but the case has dimensions: %d; use %s", shape_name(kind),
                   shape_dim[kind], dim, alt[kind]);
         return;
     }
-    b->motion = (lahar_motion)rmap_enum(&m, "motion", motion_names, 0, LAHAR_MOTION_FREE);
-    b->record_contacts = rmap_bool(&m, "record_contacts", 0);
+    b->motion = (lahar_motion)rd_key_choice(&m, "motion");
+    b->record_contacts = rd_key_bool(&m, "record_contacts");
     const char *mat = rmap_str(&m, "material", 1, NULL, c->nmaterial ? c->materials[0].name : "rock");
     if (r->failed)
         return;
     if (shape_fixed_only[kind] && b->motion != LAHAR_MOTION_FIXED) {
-        rmap_fail(&m, "shape", "'%s' bodies can only be walls: add `motion: fixed`%s", shape_names[kind],
+        rmap_fail(&m, "shape", "'%s' bodies can only be walls: add `motion: fixed`%s", shape_name(kind),
                   kind == SH_STL ? " (STL surfaces may be open and non-convex)" : "");
         return;
     }

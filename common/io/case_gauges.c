@@ -139,7 +139,6 @@ static void read_level_gauge(reader *r, rmap *pm, const lahar_case *c, lahar_pro
 
 void case_read_probes(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const kinds[] = {"pressure", "level", NULL};
     if (!n || r->failed)
         return;
     if (n->type != YAML_SEQUENCE_NODE) {
@@ -177,7 +176,7 @@ void case_read_probes(reader *r, yaml_node_t *n, lahar_case *c)
         for (int j = 0; j < i && !r->failed; j++)
             if (strcmp(c->probes[j].name, pr->name) == 0)
                 rmap_fail(&pm, "name", "'%s' is already the name of probes[%d]; probe names must be unique", pr->name, j);
-        pr->kind = rmap_enum(&pm, "kind", kinds, 0, LAHAR_PROBE_PRESSURE);
+        pr->kind = rd_key_choice(&pm, "kind");
         if (r->failed)
             return;
         if (pr->kind == LAHAR_PROBE_LEVEL) {
@@ -246,7 +245,6 @@ void case_read_probes(reader *r, yaml_node_t *n, lahar_case *c)
 void case_read_gauges(reader *r, yaml_node_t *tn, yaml_node_t *vn, lahar_case *c)
 {
     static const char *const boxkeys[] = {"lo", "hi", NULL};
-    static const char *const axes[] = {"x", "y", "z", NULL};
     yaml_node_t *secs[2] = {tn, vn};
     const char *secname[2] = {"trackers", "control_volumes"};
     const int dim = r->dim;
@@ -295,7 +293,7 @@ void case_read_gauges(reader *r, yaml_node_t *tn, yaml_node_t *vn, lahar_case *c
                 continue;
             }
             pr->kind = LAHAR_PROBE_CONTROL_VOLUME;
-            pr->axis = rmap_enum(&pm, "axis", axes, 0, 0);
+            pr->axis = rd_key_choice(&pm, "axis");
             if (!r->failed && pr->axis >= dim) {
                 rmap_fail(&pm, "axis", "'z' is not an axis of a 2D case; use x or y");
                 return;

@@ -373,3 +373,30 @@ double rd_key_num_def(rmap *m, const char *key, double def)
 }
 
 double rd_key_num(rmap *m, const char *key) { return rd_key_num_def(m, key, NAN); }
+
+/* A choice key of the section's table: the index of its value in the table's choices (which are in
+ * the order of the C enum the caller stores), required or defaulted as the table says. */
+int rd_key_choice(rmap *m, const char *key)
+{
+    const lahar_key *k = lahar_key_find(m->sec, key);
+    if (!k || !k->choices) {
+        rmap_fail(m, key, "internal: no choice entry in the key table (common/io/case_keys.c)");
+        return 0;
+    }
+    int def = 0;
+    for (int i = 0; k->def && k->choices[i]; i++)
+        if (strcmp(k->choices[i], k->def) == 0)
+            def = i;
+    return rmap_enum(m, key, k->choices, k->required, def);
+}
+
+/* A true/false key of the section's table, defaulted as the table says. */
+int rd_key_bool(rmap *m, const char *key)
+{
+    const lahar_key *k = lahar_key_find(m->sec, key);
+    if (!k) {
+        rmap_fail(m, key, "internal: no entry in the key table (common/io/case_keys.c)");
+        return 0;
+    }
+    return rmap_bool(m, key, k->def && strcmp(k->def, "true") == 0);
+}

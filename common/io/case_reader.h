@@ -45,6 +45,8 @@ void rd_key_join(const char *prefix, const char *key, char out[KEY_MAX]);
 double rd_key_num(rmap *m, const char *key);
 double rd_key_num_def(rmap *m, const char *key, double def);
 double rd_key_num_req(rmap *m, const char *key, int required, double def);
+int rd_key_choice(rmap *m, const char *key);
+int rd_key_bool(rmap *m, const char *key);
 const char *rd_node_kind(const yaml_node_t *n);
 int rd_number(reader *r, yaml_node_t *n, const char *key, double *out);
 int rd_vec(reader *r, yaml_node_t *n, const char *key, int count, double *out);

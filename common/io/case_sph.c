@@ -83,18 +83,12 @@ static double sph_reference_speed(const lahar_case *c)
  * default dx/2 stays 0). */
 static void read_sph_options(rmap *m, lahar_sph_options *o, int dim, double dx)
 {
-    static const char *const kernels[] = {"cubic", "quintic", "wendland2", NULL};
-    static const char *const eos_names[] = {"linear", "tait", NULL};
-    static const char *const wall_names[] = {"halfspace", "paper", NULL};
-    static const char *const initial_pressure_names[] = {"none", "hydrostatic", NULL};
-    static const char *const wall_pressure_names[] = {"penalty", "ghost", NULL};
-    static const char *const penalty_stiffness_names[] = {"step", "acoustic", NULL};
-    static const char *const scheme_names[] = {"delta", "riemann", NULL}; /* LAHAR_SPH_SCHEME_* */
-    int kind = rmap_enum(m, "kernel", kernels, 0, 0);
-    snprintf(o->kernel, sizeof o->kernel, "%s", kernels[kind]);
+    /* choices, their order (the C enums of scene.h) and defaults: the key table */
+    int kind = rd_key_choice(m, "kernel");
+    snprintf(o->kernel, sizeof o->kernel, "%s", lahar_key_find(m->sec, "kernel")->choices[kind]);
     const kernel_def *kd = kernel_find(o->kernel);
     o->h_over_dx = rd_key_num(m, "h_over_dx");
-    o->eos = (lahar_sph_eos)rmap_enum(m, "eos", eos_names, 0, LAHAR_SPH_EOS_LINEAR);
+    o->eos = (lahar_sph_eos)rd_key_choice(m, "eos");
     o->gamma = rd_key_num(m, "gamma");
     o->mu = rd_key_num(m, "viscosity");
     o->alpha = rd_key_num(m, "alpha");
@@ -105,23 +99,19 @@ static void read_sph_options(rmap *m, lahar_sph_options *o, int dim, double dx)
     rmap_vec(m, "body_force", dim, o->body_force, 0, "");
     o->shepard_interval = (int)rd_key_num(m, "shepard_interval");
     o->shifting = rd_key_num(m, "shifting");
-    o->sps = rmap_bool(m, "sps", 0);
-    o->shifting_density = rmap_bool(m, "shifting_density", 0);
-    o->transport_velocity = rmap_bool(m, "transport_velocity", 0);
+    o->sps = rd_key_bool(m, "sps");
+    o->shifting_density = rd_key_bool(m, "shifting_density");
+    o->transport_velocity = rd_key_bool(m, "transport_velocity");
     o->body_layers = (int)rd_key_num(m, "body_layers");
     o->sps_cs = rd_key_num(m, "sps_cs");
     o->halo = rmap_num(m, "halo", 0, 0.5 * dx, "0.005");
     o->kappa = rmap_num(m, "kappa", 0, kd ? kd->kappa : 2.0, "2");
-    o->wall_viscous = (lahar_sph_wall_viscous)rmap_enum(m, "wall_viscous", wall_names, 0, LAHAR_SPH_WALL_HALFSPACE);
-    o->initial_pressure = (lahar_sph_initial_pressure)rmap_enum(m, "initial_pressure", initial_pressure_names, 0,
-                                                                LAHAR_SPH_INITIAL_PRESSURE_NONE);
-    o->wall_pressure = (lahar_sph_wall_pressure)rmap_enum(m, "wall_pressure", wall_pressure_names, 0,
-                                                          LAHAR_SPH_WALL_PRESSURE_PENALTY);
-    o->penalty_stiffness = (lahar_sph_penalty_stiffness)rmap_enum(m, "penalty_stiffness", penalty_stiffness_names, 0,
-                                                                  LAHAR_SPH_PENALTY_STEP);
-    o->soil_wall_stress = (lahar_sph_wall_pressure)rmap_enum(m, "soil_wall_stress", wall_pressure_names, 0,
-                                                             LAHAR_SPH_WALL_PRESSURE_PENALTY);
-    o->scheme = (lahar_sph_scheme)rmap_enum(m, "scheme", scheme_names, 0, LAHAR_SPH_SCHEME_DELTA);
+    o->wall_viscous = (lahar_sph_wall_viscous)rd_key_choice(m, "wall_viscous");
+    o->initial_pressure = (lahar_sph_initial_pressure)rd_key_choice(m, "initial_pressure");
+    o->wall_pressure = (lahar_sph_wall_pressure)rd_key_choice(m, "wall_pressure");
+    o->penalty_stiffness = (lahar_sph_penalty_stiffness)rd_key_choice(m, "penalty_stiffness");
+    o->soil_wall_stress = (lahar_sph_wall_pressure)rd_key_choice(m, "soil_wall_stress");
+    o->scheme = (lahar_sph_scheme)rd_key_choice(m, "scheme");
     o->riemann_limiter = rd_key_num(m, "riemann_limiter");
     if (o->scheme == LAHAR_SPH_SCHEME_RIEMANN) { /* its own dissipation replaces delta-SPH and Monaghan's */
         if (!rmap_get(m, "delta"))
