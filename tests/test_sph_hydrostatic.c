@@ -9,8 +9,8 @@
  *     below the surface) within 1 % of rho0 g H (RMS) and 1.5 % (max);
  *   - no particle crossed a wall, the free surface stays level (height spread < dx/2) and the
  *     kinetic energy has decayed (|v|max < 1 % of sqrt(g H)).
- * usage: test_sph_hydrostatic [NY [T [ghost [riemann]]]] (riemann: sph.scheme riemann, Zhang et al. 2017,
- * instead of the artificial viscosity; the same bounds). With "ghost" the walls carry the pressure of ghost
+ * usage: test_sph_hydrostatic [NY [T [ghost [riemann [ETA]]]]] (riemann: sph.scheme riemann, Zhang et al.
+ * 2017, instead of the artificial viscosity, with the limiter eta = ETA, default 3; the same bounds). With "ghost" the walls carry the pressure of ghost
  * layers (LAHAR_SPH_WALL_PRESSURE_GHOST, sph_coupling.h) and the gauges start at dx/2 above the floor,
  * where the penalty wall alone reads +13 % of rho0 g H at 1.5 dx: the same bounds hold there; the
  * side walls then carry part of the weight (the ghosts beside a particle complete its vertical
@@ -56,7 +56,7 @@ int main(int argc, char **argv)
     const int ghost = argc > 3 && strcmp(argv[3], "ghost") == 0;
     if (argc > 4 && strcmp(argv[4], "riemann") == 0) { /* the Riemann scheme (sph_riemann.h): its own dissipation */
         prm.opt.scheme = LAHAR_SPH_SCHEME_RIEMANN;
-        prm.opt.riemann_limiter = 3.0;
+        prm.opt.riemann_limiter = argc > 5 ? atof(argv[5]) : 3.0; /* 0: the full acoustic dissipation */
         prm.opt.alpha = 0.0;
     }
     if (ghost)
