@@ -34,8 +34,10 @@ typedef struct {
     vec3 *xi;             /* tangential spring */
     unsigned char *touch; /* in contact at the last evaluation (xi is its spring, else 0) */
     unsigned char *fall;  /* wall list: the centre is beyond the face's rim, general path */
-    vec3 *f, *ta, *tb;    /* force on b (wall list: on the sphere), torque on a and on b */
-    double *delta;
+    unsigned char *deep;  /* wall list: the centre was farther than the skin inside the face's rim at the build */
+    vec3 *f, *ta, *tb;    /* force on b (wall list: on the sphere), torque on a and on b; sphere list:
+                             only the entries across two parts of the threaded loop */
+    double *delta;        /* wall list: overlap */
     dem_pair_consts *pc;  /* normal-law constants of the pair (m*, R* fixed) */
 } sps_list;
 
@@ -68,6 +70,12 @@ struct sp_spheres {
     int *inc_start, *inc, inc_cap; /* per sphere its sphere-sphere entries (CSR, ascending) */
     int *inc_mid;         /* per sphere: entries [inc_start, inc_mid) have it as b, the rest as a */
     int *wstart;          /* per sphere its wall entries [wstart[k], wstart[k+1]) */
+    int *pstart;          /* per sphere a its sphere-sphere entries as a: [pstart[a], pstart[a+1]) */
+    vec3 *wunit;          /* per wall its unit normal (the one geom_point_polygon_inside uses) */
+    /* the force loop in parts of consecutive spheres [part[t], part[t+1]) of about equal work, one
+     * per thread; xpair[xstart[t] .. xstart[t+1]) are the entries of part t whose partner is in a
+     * later part (npart = 1: no thread team, no such entry) */
+    int npart, *part, *xstart, *xpair, xcap;
     vec3 *sf, *st;        /* per sphere: fast-path force and torque */
     int *scnt;
     /* build grid */
@@ -84,7 +92,7 @@ static int list_reserve(sps_list *l, int need)
     if (need <= l->cap) return 0;
     int c = l->cap > 0 ? l->cap : 256;
     while (c < need) c *= 2;
-    void *p[10];
+    void *p[11];
     p[0] = realloc(l->a, sizeof(int) * (size_t)c);
     if (p[0]) l->a = p[0];
     p[1] = realloc(l->b, sizeof(int) * (size_t)c);
@@ -105,7 +113,9 @@ static int list_reserve(sps_list *l, int need)
     if (p[8]) l->delta = p[8];
     p[9] = realloc(l->pc, sizeof(dem_pair_consts) * (size_t)c);
     if (p[9]) l->pc = p[9];
-    for (int k = 0; k < 10; k++)
+    p[10] = realloc(l->deep, (size_t)c);
+    if (p[10]) l->deep = p[10];
+    for (int k = 0; k < 11; k++)
         if (!p[k]) return -1;
     l->cap = c;
     return 0;
@@ -118,6 +128,7 @@ static void list_free(sps_list *l)
     free(l->xi);
     free(l->touch);
     free(l->fall);
+    free(l->deep);
     free(l->f);
     free(l->ta);
     free(l->tb);
@@ -219,12 +230,20 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->sf = malloc(sizeof(vec3) * (size_t)ns);
     s->st = malloc(sizeof(vec3) * (size_t)ns);
     s->scnt = malloc(sizeof(int) * (size_t)ns);
+    s->pstart = calloc((size_t)ns + 1, sizeof(int));
+    s->wunit = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
+    s->npart = ns >= SPS_PAR_MIN && e->nthr > 1 ? e->nthr : 1;
+    s->part = calloc((size_t)s->npart + 1, sizeof(int));
+    s->xstart = calloc((size_t)s->npart + 1, sizeof(int));
+    s->xcap = s->npart > 1 ? 2 * ns + 64 : 1;
+    s->xpair = malloc(sizeof(int) * (size_t)s->xcap);
     s->cell_of = malloc(sizeof(int) * (size_t)ns);
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
     if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->v0 || !s->x || !s->v || !s->w ||
-        !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt || !s->cell_of || !s->order || !s->cell_start)
+        !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt ||
+        !s->pstart || !s->wunit || !s->part || !s->xstart || !s->xpair || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
     for (int i = 0; i < nb; i++) {
@@ -312,6 +331,11 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->sf);
     free(s->st);
     free(s->scnt);
+    free(s->pstart);
+    free(s->wunit);
+    free(s->part);
+    free(s->xstart);
+    free(s->xpair);
     free(s->cell_of);
     free(s->order);
     free(s->cell_start);
@@ -336,7 +360,7 @@ static int build_lists(lahar_dem_engine *e)
     double cs = 2.0 * s->rmax + s->skin;
     vec3 lo = v3(DBL_MAX, DBL_MAX, DBL_MAX), hi = v3(-DBL_MAX, -DBL_MAX, -DBL_MAX);
     for (int k = 0; k < n; k++) {
-        vec3 x = e->st[s->body[k]].x;
+        vec3 x = s->x[k];
         lo = v3(fmin(lo.x, x.x), fmin(lo.y, x.y), fmin(lo.z, x.z));
         hi = v3(fmax(hi.x, x.x), fmax(hi.y, x.y), fmax(hi.z, x.z));
     }
@@ -351,7 +375,7 @@ static int build_lists(lahar_dem_engine *e)
     int nc = (int)(dn[0] * dn[1] * dn[2]);
     memset(s->cell_start, 0, sizeof(int) * (size_t)(nc + 1));
     for (int k = 0; k < n; k++) {
-        vec3 x = e->st[s->body[k]].x;
+        vec3 x = s->x[k];
         long long cx = (long long)((x.x - lo.x) / cs), cy = (long long)((x.y - lo.y) / cs);
         long long cz = e->dim == 3 ? (long long)((x.z - lo.z) / cs) : 0;
         cx = cx < dn[0] ? cx : dn[0] - 1;
@@ -370,6 +394,7 @@ static int build_lists(lahar_dem_engine *e)
     pl->n = 0;
     int zr = e->dim == 3 ? 1 : 0;
     for (int a = 0; a < n; a++) {
+        s->pstart[a] = pl->n;
         int c = s->cell_of[a];
         long long cx = c % dn[0], cy = (c / dn[0]) % dn[1], cz = c / (dn[0] * dn[1]);
         vec3 xa = s->x0[a];
@@ -405,6 +430,7 @@ static int build_lists(lahar_dem_engine *e)
             pl->n++;
         }
     }
+    s->pstart[n] = pl->n;
     /* incidence: each sphere's entries in ascending entry index (= ascending partner) */
     if (2 * pl->n > s->inc_cap) {
         int c = s->inc_cap;
@@ -434,21 +460,61 @@ static int build_lists(lahar_dem_engine *e)
     /* sphere-wall: walls whose plane is within the skin of the sphere's surface */
     sps_list *wl = &s->wl;
     wl->n = 0;
+    for (int w = 0; w < s->nwall; w++) s->wunit[w] = v3_normalize(e->nw[e->geo[s->wall_body[w]].f0]);
     for (int a = 0; a < n; a++) {
         s->wstart[a] = wl->n;
         for (int w = 0; w < s->nwall; w++) {
             const sp_geo *g = &e->geo[s->wall_body[w]];
-            double dpl = v3_dot(v3_sub(s->x0[a], e->fw[e->fstart[g->fs0]]), e->nw[g->f0]);
+            const vec3 *poly = e->fw + e->fstart[g->fs0];
+            int m = e->fstart[g->fs0 + 1] - e->fstart[g->fs0];
+            double dpl = v3_dot(v3_sub(s->x0[a], poly[0]), e->nw[g->f0]);
             if (fabs(dpl) >= s->rad[a] + g->radius + s->skin) continue;
             if (list_reserve(wl, wl->n + 1)) return -1;
             wl->a[wl->n] = a;
             wl->b[wl->n] = w;
             /* vertex-face: m* = the sphere's mass, R* = its radius (README, contact laws) */
             wl->pc[wl->n] = dem_pair_consts_make(&e->laws[s->mat[a] * e->nmat + g->material], s->mass[a], s->rad[a]);
+            /* deep: the projected centre is farther than the skin inside every edge's line */
+            vec3 nn = s->wunit[w], pp = v3_axpy(-v3_dot(v3_sub(s->x0[a], poly[0]), nn), nn, s->x0[a]);
+            int deep = 1;
+            for (int i = 0; i < m && deep; i++) {
+                vec3 ab = v3_sub(poly[i + 1 < m ? i + 1 : 0], poly[i]);
+                deep = v3_dot(v3_cross(ab, v3_sub(pp, poly[i])), nn) > s->skin * v3_norm(ab);
+            }
+            wl->deep[wl->n] = (unsigned char)deep;
             wl->n++;
         }
     }
     s->wstart[n] = wl->n;
+    /* parts of about equal work (entries as a, walls, the sphere itself) for the threaded loop */
+    if (s->npart > 1) {
+        double total = (double)pl->n + (double)wl->n + (double)n, acc = 0.0;
+        int t = 1;
+        s->part[0] = 0;
+        for (int k = 0; k < n && t < s->npart; k++) {
+            acc += (double)(s->pstart[k + 1] - s->pstart[k]) + (double)(s->wstart[k + 1] - s->wstart[k]) + 1.0;
+            while (t < s->npart && acc >= total * t / s->npart) s->part[t++] = k + 1;
+        }
+        while (t <= s->npart) s->part[t++] = n;
+        int nx = 0;
+        for (t = 0; t < s->npart; t++) {
+            s->xstart[t] = nx;
+            for (int p = s->pstart[s->part[t]]; p < s->pstart[s->part[t + 1]]; p++) {
+                if (pl->b[p] < s->part[t + 1]) continue;
+                if (nx == s->xcap) {
+                    int *q = realloc(s->xpair, sizeof(int) * (size_t)(2 * s->xcap));
+                    if (!q) return -1;
+                    s->xpair = q;
+                    s->xcap *= 2;
+                }
+                s->xpair[nx++] = p;
+            }
+        }
+        s->xstart[s->npart] = nx;
+    } else {
+        s->part[0] = 0;
+        s->part[1] = n;
+    }
     s->built = 1;
     return 0;
 }
@@ -467,11 +533,11 @@ static inline vec3 spring_rotate(vec3 xi, vec3 n)
     return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
 }
 
-/* direct = 1 (one thread): the force goes straight into the two spheres' sums (sf, st, scnt) instead
- * of the entry. In list order each sphere then receives its partners in ascending order, the
- * order of the per-sphere sums of the threaded path: the same bits. */
-static inline __attribute__((always_inline)) void pair_force(lahar_dem_engine *e, sp_spheres *s, int p, double h,
-                                                             int direct)
+/* The force of listed pair p (sphere a < sphere b) at the current positions: 1 in contact with the
+ * force on b in *f and the torques on a and b in *ta, *tb (a gets -f), 0 out of contact. Updates
+ * the entry's spring and contact flag; *bad |= the overlap limit is exceeded. */
+static inline __attribute__((always_inline)) int pair_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h,
+                                                            vec3 *f, vec3 *ta, vec3 *tb, int *bad)
 {
     sps_list *l = &s->pl;
     int a = l->a[p], b = l->b[p];
@@ -479,11 +545,8 @@ static inline __attribute__((always_inline)) void pair_force(lahar_dem_engine *e
     vec3 dx = v3_sub(s->x[b], s->x[a]);
     double d2 = v3_norm2(dx);
     if (d2 >= rs * rs) {
-        if (l->touch[p]) { /* the sums add every entry: one out of contact holds +0 */
-            l->touch[p] = 0;
-            if (!direct) l->f[p] = l->ta[p] = l->tb[p] = v3(0.0, 0.0, 0.0);
-        }
-        return;
+        l->touch[p] = 0;
+        return 0;
     }
     double d = sqrt(d2);
     vec3 n = d > 1e-12 * rs ? v3_scale(dx, 1.0 / d) : v3(0.0, 0.0, 1.0);
@@ -504,28 +567,22 @@ static inline __attribute__((always_inline)) void pair_force(lahar_dem_engine *e
     vec3 c = v3_cross(n, ft);
     l->touch[p] = 1;
     l->xi[p] = xi;
-    l->delta[p] = delta;
-    vec3 f = v3_axpy(fn, n, ft), ta = v3_scale(c, -la), tb = v3_scale(c, -lb);
-    if (direct) {
-        s->sf[a] = v3_sub(s->sf[a], f);
-        s->st[a] = v3_add(s->st[a], ta);
-        s->scnt[a]++;
-        s->sf[b] = v3_add(s->sf[b], f);
-        s->st[b] = v3_add(s->st[b], tb);
-        s->scnt[b]++;
-    } else {
-        l->f[p] = f;
-        l->ta[p] = ta;
-        l->tb[p] = tb;
-    }
+    *bad |= delta > e->max_overlap * (ra < rb ? ra : rb);
+    *f = v3_axpy(fn, n, ft);
+    *ta = v3_scale(c, -la);
+    *tb = v3_scale(c, -lb);
+    return 1;
 }
 
 /* Sphere a against wall w: vertex-face when the centre projects inside the face, else the pair
- * goes to the general narrow phase (edges and corners of the face). Force on the sphere. */
-static void wall_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
+ * goes to the general narrow phase (edges and corners of the face). Force on the sphere. An entry
+ * whose centre was deep inside the face at the list build (`deep`: farther than the skin from every
+ * edge) stays inside until the next build (a centre moves less than skin/2), so the polygon test is
+ * skipped; the projection is the one of geom_point_polygon_inside (same bits). */
+static void wall_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h)
 {
     sps_list *l = &s->wl;
-    int a = l->a[p], wb = s->wall_body[l->b[p]];
+    int a = l->a[p], w = l->b[p], wb = s->wall_body[w];
     const sp_geo *gw = &e->geo[wb];
     const vec3 xa = s->x[a];
     double ra = s->rad[a], rs = ra + gw->radius;
@@ -538,7 +595,10 @@ static void wall_force(lahar_dem_engine *e, sp_spheres *s, int p, double h)
         return;
     }
     vec3 c;
-    if (!geom_point_polygon_inside(xa, e->fw + b0, m, nrm, &c)) {
+    if (l->deep[p]) {
+        vec3 nn = s->wunit[w];
+        c = v3_axpy(-v3_dot(v3_sub(xa, e->fw[b0]), nn), nn, xa);
+    } else if (!geom_point_polygon_inside(xa, e->fw + b0, m, nrm, &c)) {
         l->touch[p] = 0;
         l->fall[p] = 1;
         return;
@@ -579,6 +639,84 @@ static int overlap_fault(lahar_dem_engine *e, int a, int b, double delta, double
     return -1;
 }
 
+/* Phase 1 of part t (threaded only): the entries of its spheres whose partner belongs to a later
+ * part, forces kept in the entry for the two sums. */
+static void forces_cross(const lahar_dem_engine *e, sp_spheres *s, int t, double h, int *cnt, int *bad)
+{
+    sps_list *l = &s->pl;
+    int c = 0, bd = 0;
+    for (int q = s->xstart[t]; q < s->xstart[t + 1]; q++) {
+        int p = s->xpair[q];
+        c += pair_force(e, s, p, h, &l->f[p], &l->ta[p], &l->tb[p], &bd);
+    }
+    *cnt += c;
+    *bad |= bd;
+}
+
+/* Phase 2 of part t: the sums of its spheres [k0, k1), each in ascending partner order (the
+ * entries of earlier parts first, as their partners are smaller), then its walls. The sums of a
+ * are kept in registers over its run of entries. */
+static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h, int *cnt, int *bad)
+{
+    sps_list *l = &s->pl, *wl = &s->wl;
+    const int k0 = s->part[t], k1 = s->part[t + 1];
+    for (int k = k0; k < k1; k++) {
+        vec3 f = v3(0.0, 0.0, 0.0), tq = v3(0.0, 0.0, 0.0);
+        int m = 0;
+        for (int q = s->inc_start[k]; q < s->inc_mid[k]; q++) {
+            int p = s->inc[q];
+            if (l->a[p] >= k0) break;
+            if (!l->touch[p]) continue;
+            m++;
+            f = v3_add(f, l->f[p]);
+            tq = v3_add(tq, l->tb[p]);
+        }
+        s->sf[k] = f;
+        s->st[k] = tq;
+        s->scnt[k] = m;
+    }
+    int c = 0, bd = 0;
+    for (int a = k0; a < k1; a++) {
+        vec3 fa = s->sf[a], tqa = s->st[a];
+        int ma = s->scnt[a];
+        for (int p = s->pstart[a]; p < s->pstart[a + 1]; p++) {
+            int b = l->b[p];
+            if (b >= k1) { /* computed in phase 1 */
+                if (!l->touch[p]) continue;
+                ma++;
+                fa = v3_sub(fa, l->f[p]);
+                tqa = v3_add(tqa, l->ta[p]);
+                continue;
+            }
+            vec3 f, ta, tb;
+            if (!pair_force(e, s, p, h, &f, &ta, &tb, &bd)) continue;
+            c++;
+            ma++;
+            fa = v3_sub(fa, f);
+            tqa = v3_add(tqa, ta);
+            s->sf[b] = v3_add(s->sf[b], f);
+            s->st[b] = v3_add(s->st[b], tb);
+            s->scnt[b]++;
+        }
+        s->sf[a] = fa;
+        s->st[a] = tqa;
+        s->scnt[a] = ma;
+    }
+    for (int p = s->wstart[k0]; p < s->wstart[k1]; p++) {
+        wall_force(e, s, p, h);
+        if (!wl->touch[p]) continue;
+        int a = wl->a[p];
+        double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
+        c++;
+        bd |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
+        s->sf[a] = v3_add(s->sf[a], wl->f[p]);
+        s->st[a] = v3_add(s->st[a], wl->ta[p]);
+        s->scnt[a]++;
+    }
+    *cnt += c;
+    *bad |= bd;
+}
+
 int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
     sp_spheres *s = e->sph;
@@ -610,91 +748,28 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
     }
     sps_list *pl = &s->pl, *wl = &s->wl;
     int cnt = 0, bad = 0;
-    if (e->nthr == 1 || n < SPS_PAR_MIN) {
-        /* one thread: forces straight into the sums (pair_force, direct), walls after the pairs */
-        memset(s->sf, 0, sizeof(vec3) * (size_t)n);
-        memset(s->st, 0, sizeof(vec3) * (size_t)n);
-        memset(s->scnt, 0, sizeof(int) * (size_t)n);
-        for (int p = 0; p < pl->n; p++) {
-            pair_force(e, s, p, h, 1);
-            if (pl->touch[p]) {
-                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
-                cnt++;
-                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
-            }
-        }
-        for (int p = 0; p < wl->n; p++) {
-            wall_force(e, s, p, h);
-            if (wl->touch[p]) {
-                int a = wl->a[p];
-                double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
-                cnt++;
-                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
-                s->sf[a] = v3_add(s->sf[a], wl->f[p]);
-                s->st[a] = v3_add(s->st[a], wl->ta[p]);
-                s->scnt[a]++;
-            }
-        }
+    const int np = s->npart;
+    if (np == 1) {
+        forces_own(e, s, 0, h, &cnt, &bad);
     } else {
-#pragma omp parallel num_threads(e->nthr) reduction(+ : cnt) reduction(| : bad)
-    {
-#pragma omp for schedule(static)
-        for (int p = 0; p < pl->n; p++) {
-            pair_force(e, s, p, h, 0);
-            if (pl->touch[p]) {
-                double ra = s->rad[pl->a[p]], rb = s->rad[pl->b[p]];
-                cnt++;
-                bad |= pl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
-            }
+#pragma omp parallel num_threads(np) reduction(+ : cnt) reduction(| : bad)
+        {
+            /* a team smaller than asked for takes several parts per thread */
+            int id = omp_get_thread_num(), nt = omp_get_num_threads();
+            for (int t = id; t < np; t += nt) forces_cross(e, s, t, h, &cnt, &bad);
+#pragma omp barrier
+            for (int t = id; t < np; t += nt) forces_own(e, s, t, h, &cnt, &bad);
         }
-#pragma omp for schedule(static)
-        for (int p = 0; p < wl->n; p++) {
-            wall_force(e, s, p, h);
-            if (wl->touch[p]) {
-                double ra = s->rad[wl->a[p]], rb = e->geo[s->wall_body[wl->b[p]]].radius;
-                cnt++;
-                bad |= wl->delta[p] > e->max_overlap * (ra < rb ? ra : rb);
-            }
-        }
-        /* each sphere sums its own entries in ascending partner order, then its walls */
-#pragma omp for schedule(static)
-        for (int k = 0; k < n; k++) {
-            vec3 f = v3(0.0, 0.0, 0.0), t = v3(0.0, 0.0, 0.0);
-            int m = 0;
-            /* entries out of contact hold +0 (pair_force), adding them changes no bit of a sum
-             * that starts at +0, so there is no branch on the contact state */
-            for (int q = s->inc_start[k]; q < s->inc_mid[k]; q++) {
-                int p = s->inc[q];
-                m += pl->touch[p];
-                f = v3_add(f, pl->f[p]);
-                t = v3_add(t, pl->tb[p]);
-            }
-            for (int q = s->inc_mid[k]; q < s->inc_start[k + 1]; q++) {
-                int p = s->inc[q];
-                m += pl->touch[p];
-                f = v3_sub(f, pl->f[p]);
-                t = v3_add(t, pl->ta[p]);
-            }
-            for (int p = s->wstart[k]; p < s->wstart[k + 1]; p++) {
-                if (!wl->touch[p]) continue;
-                m++;
-                f = v3_add(f, wl->f[p]);
-                t = v3_add(t, wl->ta[p]);
-            }
-            s->sf[k] = f;
-            s->st[k] = t;
-            s->scnt[k] = m;
-        }
-    }
     }
     /* the overlap limit: the first offender in list order is reported */
     for (int p = 0; bad && p < pl->n; p++) {
         if (!pl->touch[p]) continue;
         int a = pl->a[p], b = pl->b[p];
         double rmin = fmin(s->rad[a], s->rad[b]);
-        if (pl->delta[p] > e->max_overlap * rmin) {
-            vec3 xa = e->st[s->body[a]].x, xb = e->st[s->body[b]].x;
-            return overlap_fault(e, s->body[a], s->body[b], pl->delta[p], rmin, v3_scale(v3_add(xa, xb), 0.5), err, errlen);
+        double delta = s->rad[a] + s->rad[b] - sqrt(v3_norm2(v3_sub(s->x[b], s->x[a])));
+        if (delta > e->max_overlap * rmin) {
+            vec3 xa = s->x[a], xb = s->x[b];
+            return overlap_fault(e, s->body[a], s->body[b], delta, rmin, v3_scale(v3_add(xa, xb), 0.5), err, errlen);
         }
     }
     for (int p = 0; bad && p < wl->n; p++) {
@@ -702,7 +777,7 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
         int a = wl->a[p], wb = s->wall_body[wl->b[p]];
         double rmin = fmin(s->rad[a], e->geo[wb].radius);
         if (wl->delta[p] > e->max_overlap * rmin)
-            return overlap_fault(e, s->body[a], wb, wl->delta[p], rmin, e->st[s->body[a]].x, err, errlen);
+            return overlap_fault(e, s->body[a], wb, wl->delta[p], rmin, s->x[a], err, errlen);
     }
     s->ncontact = cnt;
     e->contacts_evaluated += cnt;
