@@ -57,11 +57,15 @@ struct sp_spheres {
     double *rad, *mass;
     int *mat;             /* material */
     double *iner;         /* moment of inertia (3D: the equal moments; 2D: about z) */
+    double *inv_iner;     /* 1 / iner */
     int *v0;              /* index of the sphere's vertex in e->vw */
-    /* hot data of the force loops, a copy of e->st kept by sps_kick / sps_drift (SoA by field,
-     * contiguous by sphere); stale after create and read_restart until sps_forces copies it */
-    vec3 *x, *v, *w;
-    int stale;
+    /* the spheres' state (SoA by field, contiguous by sphere): the body states in e->st are stale
+     * (sps_sync writes them, sps_state reads the state) */
+    vec3 *x, *v, *w, *L;
+    quat *q;
+    int nfall;            /* wall entries of the last evaluation beyond the face's rim (general path) */
+    int finite;           /* every centre, velocity and angular velocity finite, |x| <= 1e12 m */
+    double worst;         /* largest squared displacement of a centre since the list build */
     double skin, rmax;
     vec3 *x0;             /* centres at the last build */
     int built;
@@ -82,7 +86,8 @@ struct sp_spheres {
     int *cell_start, *cell_of, *order, ncell_cap;
     int *cand, cand_cap;
     int ncontact;
-    int deferred;         /* the spheres' forces are in sf/st/scnt, not yet in the body states */
+    int deferred;         /* the spheres' forces are in sf/st/scnt only (no general contact on a
+                             sphere), not in the body states */
 };
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -196,6 +201,8 @@ int sps_general_large(const lahar_dem_engine *e, const int **ids)
     return e->sph->ngen;
 }
 
+static void sps_load(lahar_dem_engine *e);
+
 int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
 {
     int ns = 0;
@@ -218,11 +225,13 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->mass = malloc(sizeof(double) * (size_t)ns);
     s->mat = malloc(sizeof(int) * (size_t)ns);
     s->iner = malloc(sizeof(double) * (size_t)ns);
+    s->inv_iner = malloc(sizeof(double) * (size_t)ns);
     s->v0 = malloc(sizeof(int) * (size_t)ns);
     s->x = malloc(sizeof(vec3) * (size_t)ns);
     s->v = malloc(sizeof(vec3) * (size_t)ns);
     s->w = malloc(sizeof(vec3) * (size_t)ns);
-    s->stale = 1;
+    s->L = malloc(sizeof(vec3) * (size_t)ns);
+    s->q = malloc(sizeof(quat) * (size_t)ns);
     s->x0 = malloc(sizeof(vec3) * (size_t)ns);
     s->inc_start = calloc((size_t)ns + 1, sizeof(int));
     s->inc_mid = calloc((size_t)ns + 1, sizeof(int));
@@ -241,7 +250,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
-    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->v0 || !s->x || !s->v || !s->w ||
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->q ||
         !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt ||
         !s->pstart || !s->wunit || !s->part || !s->xstart || !s->xpair || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
@@ -260,6 +269,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
             s->mass[s->n] = g->mass;
             s->mat[s->n] = g->material;
             s->iner[s->n] = e->dim == 2 ? g->inertia[2] : g->inertia[0];
+            s->inv_iner[s->n] = 1.0 / s->iner[s->n];
             s->v0[s->n] = g->v0;
             rmin = fmin(rmin, g->radius);
             s->rmax = fmax(s->rmax, g->radius);
@@ -292,6 +302,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->cand_cap = 256;
     s->cand = malloc(sizeof(int) * (size_t)s->cand_cap);
     if (!s->inc || !s->cand) goto oom;
+    sps_load(e);
     return 0;
 oom:
     snprintf(err, errlen, "spheropoly: out of memory for the sphere fast path");
@@ -319,10 +330,13 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->mass);
     free(s->mat);
     free(s->iner);
+    free(s->inv_iner);
     free(s->v0);
     free(s->x);
     free(s->v);
     free(s->w);
+    free(s->L);
+    free(s->q);
     free(s->x0);
     free(s->inc_start);
     free(s->inc_mid);
@@ -656,7 +670,7 @@ static void forces_cross(const lahar_dem_engine *e, sp_spheres *s, int t, double
 /* Phase 2 of part t: the sums of its spheres [k0, k1), each in ascending partner order (the
  * entries of earlier parts first, as their partners are smaller), then its walls. The sums of a
  * are kept in registers over its run of entries. */
-static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h, int *cnt, int *bad)
+static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h, int *cnt, int *bad, int *nfall)
 {
     sps_list *l = &s->pl, *wl = &s->wl;
     const int k0 = s->part[t], k1 = s->part[t + 1];
@@ -702,8 +716,10 @@ static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h
         s->st[a] = tqa;
         s->scnt[a] = ma;
     }
+    int nf = 0;
     for (int p = s->wstart[k0]; p < s->wstart[k1]; p++) {
         wall_force(e, s, p, h);
+        nf += wl->fall[p];
         if (!wl->touch[p]) continue;
         int a = wl->a[p];
         double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
@@ -715,50 +731,36 @@ static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h
     }
     *cnt += c;
     *bad |= bd;
+    *nfall += nf;
 }
 
 int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
     sp_spheres *s = e->sph;
-    const int n = s->n;
-    if (s->stale) {
-        for (int k = 0; k < n; k++) {
-            const sp_state *st = &e->st[s->body[k]];
-            s->x[k] = st->x;
-            s->v[k] = st->v;
-            s->w[k] = st->w;
-        }
-        s->stale = 0;
-    }
-    /* rebuild when a sphere moved more than skin/2 since the last build */
-    double lim2 = 0.25 * s->skin * s->skin, worst = 0.0;
-    if (s->built) {
-#pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(max : worst) if (n >= SPS_PAR_MIN)
-        for (int k = 0; k < n; k++) {
-            double d2 = v3_norm2(v3_sub(s->x[k], s->x0[k]));
-            worst = d2 > worst ? d2 : worst;
-        }
-    }
-    if (!s->built || worst > lim2) {
+    /* rebuild when a sphere moved more than skin/2 since the last build (the drift keeps the
+     * largest squared displacement) */
+    double lim2 = 0.25 * s->skin * s->skin;
+    if (!s->built || s->worst > lim2) {
         /* hand the springs over (after a restart the history is already in ph/wh) */
         if (s->built && (hist_take(&s->ph, &s->pl) || hist_take(&s->wh, &s->wl))) goto oom;
         if (build_lists(e)) goto oom;
         hist_give(&s->ph, &s->pl);
         hist_give(&s->wh, &s->wl);
+        s->worst = 0.0;
     }
     sps_list *pl = &s->pl, *wl = &s->wl;
-    int cnt = 0, bad = 0;
+    int cnt = 0, bad = 0, nfall = 0;
     const int np = s->npart;
     if (np == 1) {
-        forces_own(e, s, 0, h, &cnt, &bad);
+        forces_own(e, s, 0, h, &cnt, &bad, &nfall);
     } else {
-#pragma omp parallel num_threads(np) reduction(+ : cnt) reduction(| : bad)
+#pragma omp parallel num_threads(np) reduction(+ : cnt, nfall) reduction(| : bad)
         {
             /* a team smaller than asked for takes several parts per thread */
             int id = omp_get_thread_num(), nt = omp_get_num_threads();
             for (int t = id; t < np; t += nt) forces_cross(e, s, t, h, &cnt, &bad);
 #pragma omp barrier
-            for (int t = id; t < np; t += nt) forces_own(e, s, t, h, &cnt, &bad);
+            for (int t = id; t < np; t += nt) forces_own(e, s, t, h, &cnt, &bad, &nfall);
         }
     }
     /* the overlap limit: the first offender in list order is reported */
@@ -780,6 +782,7 @@ int sps_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
             return overlap_fault(e, s->body[a], wb, wl->delta[p], rmin, s->x[a], err, errlen);
     }
     s->ncontact = cnt;
+    s->nfall = nfall;
     e->contacts_evaluated += cnt;
     return 0;
 oom:
@@ -827,29 +830,47 @@ void sps_accumulate_walls(lahar_dem_engine *e)
 /* ---------------------------------------------------------------------------------------------- */
 /* Integration of the free spheres: the same kick-drift-kick as the general bodies (README,
  * "Integration") with the sphere's equal moments: w = L / I, and the drift turns the orientation by
- * the single exact rotation exp(h L / I) (2D: about z). Each sphere writes only its own state. */
+ * the single exact rotation exp(h L / I) (2D: about z). The compact arrays are the spheres' state:
+ * the body states (e->st) are written only when the general path needs them (sps_sync) and read
+ * through sps_state. Each sphere writes only its own entries. */
 
-void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
+/* Contact force and torque of sphere k as the kick takes them. */
+static inline void sphere_fc(const lahar_dem_engine *e, const sp_spheres *s, int k, vec3 *f, vec3 *t)
+{
+    if (s->deferred) { /* what sps_accumulate (and compute_forces' 2D projection) would have written */
+        *f = s->sf[k];
+        *t = s->st[k];
+        if (e->dim == 2) {
+            f->z = 0.0;
+            t->x = t->y = 0.0;
+        }
+    } else {
+        *f = e->st[s->body[k]].fc;
+        *t = e->st[s->body[k]].tc;
+    }
+}
+
+static inline int state_ok(vec3 x, vec3 v, vec3 w)
+{
+    double sum = x.x + x.y + x.z + v.x + v.y + v.z + w.x + w.y + w.z;
+    return isfinite(sum) && fabs(x.x) <= 1e12 && fabs(x.y) <= 1e12 && fabs(x.z) <= 1e12;
+}
+
+void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads, double hdrift)
 {
     sp_spheres *s = e->sph;
     const vec3 g = e->g;
-    const int two_d = e->dim == 2, deferred = s->deferred;
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
+    const int two_d = e->dim == 2;
+    int ok = 1;
+    double worst = 0.0;
+#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN) reduction(& : ok) reduction(max : worst)
     for (int k = 0; k < s->n; k++) {
-        int i = s->body[k];
-        sp_state *st = &e->st[i];
         double m = s->mass[k];
-        if (deferred) { /* what sps_accumulate (and compute_forces' 2D projection) would have written */
-            st->fc = s->sf[k];
-            st->tc = s->st[k];
-            if (two_d) {
-                st->fc.z = 0.0;
-                st->tc.x = st->tc.y = 0.0;
-            }
-            e->ncontact_body[i] = s->scnt[k];
-        }
-        vec3 f = v3_axpy(m, g, st->fc), t = st->tc;
+        vec3 f, t;
+        sphere_fc(e, s, k, &f, &t);
+        f = v3_axpy(m, g, f);
         if (loads) {
+            int i = s->body[k];
             f = v3_add(f, v3_load(loads[i].force));
             t = v3_add(t, v3_load(loads[i].torque));
         }
@@ -857,46 +878,102 @@ void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
             f.z = 0.0;
             t.x = t.y = 0.0;
         }
-        st->v = v3_axpy(half / m, f, st->v);
-        st->L = v3_axpy(half, t, st->L);
-        st->w = two_d ? v3(0.0, 0.0, st->L.z / s->iner[k]) : v3_scale(st->L, 1.0 / s->iner[k]);
-        s->v[k] = st->v;
-        s->w[k] = st->w;
+        vec3 v = v3_axpy(half / m, f, s->v[k]), L = v3_axpy(half, t, s->L[k]);
+        vec3 w = two_d ? v3(0.0, 0.0, L.z / s->iner[k]) : v3_scale(L, s->inv_iner[k]); /* = L (1/I) */
+        s->v[k] = v;
+        s->L[k] = L;
+        s->w[k] = w;
+        vec3 x = s->x[k];
+        if (hdrift > 0.0) { /* the drift that follows the first kick */
+            x = v3_axpy(hdrift, v, x);
+            /* the orientation turns by the angle h |L| / I about L (2D: about z), exp(h/(2I) L) */
+            vec3 u = two_d ? v3(0.0, 0.0, L.z) : L;
+            if (v3_norm2(u) > 0.0) s->q[k] = q_renormalize(q_mul(q_exp_scaled(u, 0.5 * hdrift * s->inv_iner[k]), s->q[k]));
+            s->x[k] = x;
+            double d2 = v3_norm2(v3_sub(x, s->x0[k]));
+            worst = d2 > worst ? d2 : worst;
+        }
+        ok &= state_ok(x, v, w);
     }
-    s->deferred = 0;
+    s->finite = ok;
+    if (hdrift > 0.0) s->worst = worst;
 }
 
-void sps_drift(lahar_dem_engine *e, double h)
+int sps_finite(const lahar_dem_engine *e) { return e->sph->finite; }
+
+/* The compact state into the body states (and the world vertex = the centre), for the general
+ * path. */
+void sps_sync(lahar_dem_engine *e)
 {
-    const sp_spheres *s = e->sph;
-    const int two_d = e->dim == 2;
+    sp_spheres *s = e->sph;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN)
     for (int k = 0; k < s->n; k++) {
         sp_state *st = &e->st[s->body[k]];
-        st->x = v3_axpy(h, st->v, st->x);
-        if (two_d) {
-            st->q = q_normalize(q_mul(q_axis_angle(v3(0.0, 0.0, 1.0), h * st->L.z / s->iner[k]), st->q));
-        } else {
-            double ln = v3_norm(st->L);
-            if (ln > 0.0) st->q = q_normalize(q_mul(q_axis_angle(v3_scale(st->L, 1.0 / ln), ln / s->iner[k] * h), st->q));
-        }
-        e->vw[s->v0[k]] = st->x; /* the vertex is the centre: x + q 0 */
-        s->x[k] = st->x;
+        st->x = s->x[k];
+        st->v = s->v[k];
+        st->L = s->L[k];
+        st->w = s->w[k];
+        st->q = s->q[k];
+        e->vw[s->v0[k]] = s->x[k];
     }
 }
 
-int sps_finite(const lahar_dem_engine *e)
+/* The body states into the compact state (create, read_restart). */
+static void sps_load(lahar_dem_engine *e)
+{
+    sp_spheres *s = e->sph;
+    int ok = 1;
+    for (int k = 0; k < s->n; k++) {
+        const sp_state *st = &e->st[s->body[k]];
+        s->x[k] = s->x0[k] = st->x;
+        s->v[k] = st->v;
+        s->L[k] = st->L;
+        s->w[k] = st->w;
+        s->q[k] = st->q;
+        ok &= state_ok(st->x, st->v, st->w);
+    }
+    s->finite = ok;
+    s->worst = 0.0;
+}
+
+void sps_fc(const lahar_dem_engine *e, int i, vec3 *f, vec3 *t)
 {
     const sp_spheres *s = e->sph;
-    if (s->stale) return 0;
-    int ok = 1;
-#pragma omp parallel for schedule(static) num_threads(e->nthr) reduction(& : ok) if (s->n >= SPS_PAR_MIN)
-    for (int k = 0; k < s->n; k++) {
-        vec3 x = s->x[k], v = s->v[k], w = s->w[k];
-        double sum = x.x + x.y + x.z + v.x + v.y + v.z + w.x + w.y + w.z;
-        ok &= isfinite(sum) && fabs(x.x) <= 1e12 && fabs(x.y) <= 1e12 && fabs(x.z) <= 1e12;
+    int k = s ? s->of_body[i] : -1;
+    if (k >= 0 && s->deferred) {
+        sphere_fc(e, s, k, f, t);
+    } else {
+        *f = e->st[i].fc;
+        *t = e->st[i].tc;
     }
-    return ok;
+}
+
+int sps_needs_sync(const lahar_dem_engine *e)
+{
+    const sp_spheres *s = e->sph;
+    return e->nfree > s->n || s->ngen > 0 || s->nfall > 0;
+}
+
+sp_state sps_state(const lahar_dem_engine *e, int i)
+{
+    const sp_spheres *s = e->sph;
+    sp_state st = e->st[i];
+    int k = s ? s->of_body[i] : -1;
+    if (k < 0) return st;
+    st.x = s->x[k];
+    st.v = s->v[k];
+    st.L = s->L[k];
+    st.w = s->w[k];
+    st.q = s->q[k];
+    if (s->deferred) sphere_fc(e, s, k, &st.fc, &st.tc);
+    return st;
+}
+
+int sps_ncontact_of(const lahar_dem_engine *e, int i)
+{
+    const sp_spheres *s = e->sph;
+    int k = s ? s->of_body[i] : -1;
+    return k >= 0 && s->deferred ? s->scnt[k] : e->ncontact_body[i];
 }
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -944,8 +1021,8 @@ int sps_read_restart(lahar_dem_engine *e, FILE *f)
     if (!s) return 0;
     if (fread(&s->ncontact, sizeof(int), 1, f) != 1) return -1;
     if (hist_read(&s->ph, f, s->n, s->n) || hist_read(&s->wh, f, s->n, s->nwall)) return -1;
-    s->stale = 1;
     s->deferred = 0;
+    sps_load(e);
     s->built = 0; /* the next evaluation builds the lists at the restart positions and takes ph/wh */
     return 0;
 }
