@@ -71,15 +71,15 @@ struct sp_spheres {
     int built;
     sps_list pl, wl;      /* sphere-sphere and sphere-wall lists */
     sps_hist ph, wh;      /* history hand-over */
-    int *inc_start, *inc, inc_cap; /* per sphere its sphere-sphere entries (CSR, ascending) */
-    int *inc_mid;         /* per sphere: entries [inc_start, inc_mid) have it as b, the rest as a */
+    int *bcount;          /* n + 1 counters of the list build */
     int *wstart;          /* per sphere its wall entries [wstart[k], wstart[k+1]) */
     int *pstart;          /* per sphere a its sphere-sphere entries as a: [pstart[a], pstart[a+1]) */
     vec3 *wunit;          /* per wall its unit normal (the one geom_point_polygon_inside uses) */
     /* the force loop in parts of consecutive spheres [part[t], part[t+1]) of about equal work, one
      * per thread; xpair[xstart[t] .. xstart[t+1]) are the entries of part t whose partner is in a
-     * later part (npart = 1: no thread team, no such entry) */
-    int npart, *part, *xstart, *xpair, xcap;
+     * later part (npart = 1: no thread team, no such entry); xin[xinstart[t] .. xinstart[t+1]) the
+     * entries whose partner b is in part t from earlier parts, by (b, a) */
+    int npart, *part, *xstart, *xpair, *xinstart, *xin, xcap;
     vec3 *sf, *st;        /* per sphere: fast-path force and torque */
     int *scnt;
     /* build grid */
@@ -233,8 +233,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->L = malloc(sizeof(vec3) * (size_t)ns);
     s->q = malloc(sizeof(quat) * (size_t)ns);
     s->x0 = malloc(sizeof(vec3) * (size_t)ns);
-    s->inc_start = calloc((size_t)ns + 1, sizeof(int));
-    s->inc_mid = calloc((size_t)ns + 1, sizeof(int));
+    s->bcount = calloc((size_t)ns + 1, sizeof(int));
     s->wstart = calloc((size_t)ns + 1, sizeof(int));
     s->sf = malloc(sizeof(vec3) * (size_t)ns);
     s->st = malloc(sizeof(vec3) * (size_t)ns);
@@ -246,13 +245,15 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->xstart = calloc((size_t)s->npart + 1, sizeof(int));
     s->xcap = s->npart > 1 ? 2 * ns + 64 : 1;
     s->xpair = malloc(sizeof(int) * (size_t)s->xcap);
+    s->xin = malloc(sizeof(int) * (size_t)s->xcap);
+    s->xinstart = calloc((size_t)s->npart + 1, sizeof(int));
     s->cell_of = malloc(sizeof(int) * (size_t)ns);
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
     if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->q ||
-        !s->inc_start || !s->inc_mid || !s->wstart || !s->sf || !s->st || !s->scnt ||
-        !s->pstart || !s->wunit || !s->part || !s->xstart || !s->xpair || !s->cell_of || !s->order || !s->cell_start)
+        !s->bcount || !s->wstart || !s->sf || !s->st || !s->scnt ||
+        !s->pstart || !s->wunit || !s->part || !s->xstart || !s->xpair || !s->xin || !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
     for (int i = 0; i < nb; i++) {
@@ -297,11 +298,9 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     if (list_reserve(&s->pl, 8 * s->n + 64) || list_reserve(&s->wl, 2 * s->n + 64) || hist_reserve(&s->ph, 8 * s->n + 64) ||
         hist_reserve(&s->wh, 2 * s->n + 64))
         goto oom;
-    s->inc_cap = 2 * s->pl.cap;
-    s->inc = malloc(sizeof(int) * (size_t)s->inc_cap);
     s->cand_cap = 256;
     s->cand = malloc(sizeof(int) * (size_t)s->cand_cap);
-    if (!s->inc || !s->cand) goto oom;
+    if (!s->cand) goto oom;
     sps_load(e);
     return 0;
 oom:
@@ -338,9 +337,7 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->L);
     free(s->q);
     free(s->x0);
-    free(s->inc_start);
-    free(s->inc_mid);
-    free(s->inc);
+    free(s->bcount);
     free(s->wstart);
     free(s->sf);
     free(s->st);
@@ -350,6 +347,8 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->part);
     free(s->xstart);
     free(s->xpair);
+    free(s->xin);
+    free(s->xinstart);
     free(s->cell_of);
     free(s->order);
     free(s->cell_start);
@@ -445,32 +444,6 @@ static int build_lists(lahar_dem_engine *e)
         }
     }
     s->pstart[n] = pl->n;
-    /* incidence: each sphere's entries in ascending entry index (= ascending partner) */
-    if (2 * pl->n > s->inc_cap) {
-        int c = s->inc_cap;
-        while (c < 2 * pl->n) c *= 2;
-        int *p = realloc(s->inc, sizeof(int) * (size_t)c);
-        if (!p) return -1;
-        s->inc = p;
-        s->inc_cap = c;
-    }
-    memset(s->inc_start, 0, sizeof(int) * (size_t)(n + 1));
-    for (int p = 0; p < pl->n; p++) {
-        s->inc_start[pl->a[p] + 1]++;
-        s->inc_start[pl->b[p] + 1]++;
-    }
-    for (int k = 0; k < n; k++) s->inc_start[k + 1] += s->inc_start[k];
-    for (int p = 0; p < pl->n; p++) { /* p ascending: each sphere's run stays ascending */
-        s->inc[s->inc_start[pl->a[p]]++] = p;
-        s->inc[s->inc_start[pl->b[p]]++] = p;
-    }
-    for (int k = n; k > 0; k--) s->inc_start[k] = s->inc_start[k - 1];
-    s->inc_start[0] = 0;
-    for (int k = 0; k < n; k++) { /* the entries with partner a < k come first (smaller index) */
-        int q = s->inc_start[k];
-        while (q < s->inc_start[k + 1] && pl->b[s->inc[q]] == k) q++;
-        s->inc_mid[k] = q;
-    }
     /* sphere-wall: walls whose plane is within the skin of the sphere's surface */
     sps_list *wl = &s->wl;
     wl->n = 0;
@@ -517,14 +490,23 @@ static int build_lists(lahar_dem_engine *e)
                 if (pl->b[p] < s->part[t + 1]) continue;
                 if (nx == s->xcap) {
                     int *q = realloc(s->xpair, sizeof(int) * (size_t)(2 * s->xcap));
-                    if (!q) return -1;
-                    s->xpair = q;
+                    if (q) s->xpair = q;
+                    int *r = realloc(s->xin, sizeof(int) * (size_t)(2 * s->xcap));
+                    if (r) s->xin = r;
+                    if (!q || !r) return -1;
                     s->xcap *= 2;
                 }
                 s->xpair[nx++] = p;
             }
         }
         s->xstart[s->npart] = nx;
+        /* the same entries by partner b, stable (a ascending within b): counting sort */
+        int *cnt = s->bcount;
+        memset(cnt, 0, sizeof(int) * (size_t)(n + 1));
+        for (int q = 0; q < nx; q++) cnt[pl->b[s->xpair[q]] + 1]++;
+        for (int k = 0; k < n; k++) cnt[k + 1] += cnt[k];
+        for (t = 0; t <= s->npart; t++) s->xinstart[t] = cnt[s->part[t]];
+        for (int q = 0; q < nx; q++) s->xin[cnt[pl->b[s->xpair[q]]]++] = s->xpair[q];
     } else {
         s->part[0] = 0;
         s->part[1] = n;
@@ -547,19 +529,26 @@ static inline vec3 spring_rotate(vec3 xi, vec3 n)
     return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
 }
 
-/* The force of listed pair p (sphere a < sphere b) at the current positions: 1 in contact with the
- * force on b in *f and the torques on a and b in *ta, *tb (a gets -f), 0 out of contact. Updates
- * the entry's spring and contact flag; *bad |= the overlap limit is exceeded. */
-static inline __attribute__((always_inline)) int pair_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h,
-                                                            vec3 *f, vec3 *ta, vec3 *tb, int *bad)
+/* Sphere a of a pair: its state and radius (loaded once per run of a's entries). */
+typedef struct {
+    vec3 x, v, w;
+    double r;
+} sps_side;
+
+/* The force between sphere a and sphere b (b's state, the pair's law and constants, its spring and
+ * contact flag) at the current positions: 1 in contact with the force on b in *f and the torques on
+ * a and b in *ta, *tb (a gets -f), 0 out of contact. Updates the spring and the contact flag;
+ * *bad |= the overlap exceeds maxov x the smaller radius. */
+static inline __attribute__((always_inline)) int pair_kernel(const sps_side *A, vec3 xb, vec3 vb, vec3 wb, double rb,
+                                                             const dem_pair_law *law, const dem_pair_consts *pc,
+                                                             unsigned char *touch, vec3 *xip, double h, double maxov,
+                                                             vec3 *f, vec3 *ta, vec3 *tb, int *bad)
 {
-    sps_list *l = &s->pl;
-    int a = l->a[p], b = l->b[p];
-    double ra = s->rad[a], rb = s->rad[b], rs = ra + rb;
-    vec3 dx = v3_sub(s->x[b], s->x[a]);
+    double ra = A->r, rs = ra + rb;
+    vec3 dx = v3_sub(xb, A->x);
     double d2 = v3_norm2(dx);
     if (d2 >= rs * rs) {
-        l->touch[p] = 0;
+        *touch = 0;
         return 0;
     }
     double d = sqrt(d2);
@@ -568,8 +557,8 @@ static inline __attribute__((always_inline)) int pair_force(const lahar_dem_engi
      * = 1/sqrt(1 - u), u = (xi.n)^2 / |xi|^2. One division gives 1/d and 1/|xi|^2; for u <= 1e-5
      * (the normal turned by < 0.2 degrees since the last step) the scale is the series
      * 1 + u/2 + 3u^2/8 + 5u^3/16 (truncation < 3e-21): no square root on the way to the force */
-    vec3 xi = l->xi[p], n;
-    double m0 = l->touch[p] ? v3_norm2(xi) : 0.0;
+    vec3 xi = *xip, n;
+    double m0 = *touch ? v3_norm2(xi) : 0.0;
     if (!(d > 1e-12 * rs)) {
         n = v3(0.0, 0.0, 1.0);
         xi = m0 > 0.0 ? spring_rotate(xi, n) : v3(0.0, 0.0, 0.0);
@@ -591,23 +580,33 @@ static inline __attribute__((always_inline)) int pair_force(const lahar_dem_engi
     /* contact point in the middle of the overlap: cp = xa + la n = xb - lb n */
     double la = ra - 0.5 * delta, lb = rb - 0.5 * delta;
     /* v_b(cp) - v_a(cp) = vb - va - (lb wb + la wa) x n */
-    vec3 vr = v3_sub(v3_sub(s->v[b], s->v[a]), v3_cross(v3_axpy(la, s->w[a], v3_scale(s->w[b], lb)), n));
+    vec3 vr = v3_sub(v3_sub(vb, A->v), v3_cross(v3_axpy(la, A->w, v3_scale(wb, lb)), n));
     double vn = v3_dot(vr, n);
     vec3 vt = v3_axpy(-vn, n, vr);
-    const dem_pair_law *law = &e->laws[s->mat[a] * e->nmat + s->mat[b]];
     double ks, cn;
-    double fn = dem_normal_force_pc(law, &l->pc[p], delta, -vn, 1.0, &ks, &cn);
+    double fn = dem_normal_force_pc(law, pc, delta, -vn, 1.0, &ks, &cn);
     xi = v3_axpy(h, vt, xi);
     vec3 ft = dem_tangential_force(law, &xi, vt, fn, ks, cn);
     /* torques about the centres: (cp - xa) x (-f) = -la n x ft, (cp - xb) x f = -lb n x ft */
     vec3 c = v3_cross(n, ft);
-    l->touch[p] = 1;
-    l->xi[p] = xi;
-    *bad |= delta > e->max_overlap * (ra < rb ? ra : rb);
+    *touch = 1;
+    *xip = xi;
+    *bad |= delta > maxov * (ra < rb ? ra : rb);
     *f = v3_axpy(fn, n, ft);
     *ta = v3_scale(c, -la);
     *tb = v3_scale(c, -lb);
     return 1;
+}
+
+/* pair_kernel for listed pair p. */
+static inline int pair_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h, vec3 *f, vec3 *ta, vec3 *tb,
+                             int *bad)
+{
+    sps_list *l = &s->pl;
+    int a = l->a[p], b = l->b[p];
+    sps_side A = {s->x[a], s->v[a], s->w[a], s->rad[a]};
+    return pair_kernel(&A, s->x[b], s->v[b], s->w[b], s->rad[b], &e->laws[s->mat[a] * e->nmat + s->mat[b]], &l->pc[p],
+                       &l->touch[p], &l->xi[p], h, e->max_overlap, f, ta, tb, bad);
 }
 
 /* Sphere a against wall w: vertex-face when the centre projects inside the face, else the pair
@@ -696,47 +695,55 @@ static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h
 {
     sps_list *l = &s->pl, *wl = &s->wl;
     const int k0 = s->part[t], k1 = s->part[t + 1];
-    for (int k = k0; k < k1; k++) {
-        vec3 f = v3(0.0, 0.0, 0.0), tq = v3(0.0, 0.0, 0.0);
-        int m = 0;
-        for (int q = s->inc_start[k]; q < s->inc_mid[k]; q++) {
-            int p = s->inc[q];
-            if (l->a[p] >= k0) break;
-            if (!l->touch[p]) continue;
-            m++;
-            f = v3_add(f, l->f[p]);
-            tq = v3_add(tq, l->tb[p]);
-        }
-        s->sf[k] = f;
-        s->st[k] = tq;
-        s->scnt[k] = m;
+    memset(s->sf + k0, 0, sizeof(vec3) * (size_t)(k1 - k0));
+    memset(s->st + k0, 0, sizeof(vec3) * (size_t)(k1 - k0));
+    memset(s->scnt + k0, 0, sizeof(int) * (size_t)(k1 - k0));
+    for (int q = s->xinstart[t]; q < s->xinstart[t + 1]; q++) { /* by (b, a): each b's sum in ascending a */
+        int p = s->xin[q];
+        if (!l->touch[p]) continue;
+        int b = l->b[p];
+        s->sf[b] = v3_add(s->sf[b], l->f[p]);
+        s->st[b] = v3_add(s->st[b], l->tb[p]);
+        s->scnt[b]++;
     }
     int c = 0, bd = 0;
+    /* locals: the stores into the sums cannot alias them */
+    const vec3 *x = s->x, *v = s->v, *w = s->w;
+    const double *rad = s->rad, maxov = e->max_overlap;
+    const int *bl = l->b, *pstart = s->pstart, *mat = s->mat, nmat = e->nmat;
+    const dem_pair_consts *pc = l->pc;
+    unsigned char *touch = l->touch;
+    vec3 *xi = l->xi, *sf = s->sf, *st = s->st;
+    int *scnt = s->scnt;
     for (int a = k0; a < k1; a++) {
-        vec3 fa = s->sf[a], tqa = s->st[a];
-        int ma = s->scnt[a];
-        for (int p = s->pstart[a]; p < s->pstart[a + 1]; p++) {
-            int b = l->b[p];
+        vec3 fa = sf[a], tqa = st[a];
+        int ma = scnt[a];
+        const sps_side A = {x[a], v[a], w[a], rad[a]};
+        const dem_pair_law *laws = e->laws + mat[a] * nmat;
+        for (int p = pstart[a]; p < pstart[a + 1]; p++) {
+            int b = bl[p];
             if (b >= k1) { /* computed in phase 1 */
-                if (!l->touch[p]) continue;
+                if (!touch[p]) continue;
                 ma++;
                 fa = v3_sub(fa, l->f[p]);
                 tqa = v3_add(tqa, l->ta[p]);
                 continue;
             }
             vec3 f, ta, tb;
-            if (!pair_force(e, s, p, h, &f, &ta, &tb, &bd)) continue;
+            if (!pair_kernel(&A, x[b], v[b], w[b], rad[b], laws + mat[b], &pc[p], &touch[p], &xi[p], h, maxov, &f, &ta, &tb,
+                             &bd))
+                continue;
             c++;
             ma++;
             fa = v3_sub(fa, f);
             tqa = v3_add(tqa, ta);
-            s->sf[b] = v3_add(s->sf[b], f);
-            s->st[b] = v3_add(s->st[b], tb);
-            s->scnt[b]++;
+            sf[b] = v3_add(sf[b], f);
+            st[b] = v3_add(st[b], tb);
+            scnt[b]++;
         }
-        s->sf[a] = fa;
-        s->st[a] = tqa;
-        s->scnt[a] = ma;
+        sf[a] = fa;
+        st[a] = tqa;
+        scnt[a] = ma;
     }
     int nf = 0;
     for (int p = s->wstart[k0]; p < s->wstart[k1]; p++) {
@@ -815,6 +822,7 @@ oom:
 int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, int))
 {
     sp_spheres *s = e->sph;
+    if (s->nfall == 0) return 0;
     for (int p = 0; p < s->wl.n; p++)
         if (s->wl.fall[p] && add(e, s->body[s->wl.a[p]], s->wall_body[s->wl.b[p]])) return -1;
     return 0;
