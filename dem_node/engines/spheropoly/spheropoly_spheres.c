@@ -38,6 +38,7 @@ typedef struct {
     vec3 *f, *ta, *tb;    /* force on b (wall list: on the sphere), torque on a and on b; sphere list:
                              only the entries across two parts of the threaded loop */
     double *delta;        /* wall list: overlap */
+    int *ci;              /* sphere list: scratch of the force loop (the entries in contact) */
     dem_pair_consts *pc;  /* normal-law constants of the pair (m*, R* fixed) */
 } sps_list;
 
@@ -97,7 +98,7 @@ static int list_reserve(sps_list *l, int need)
     if (need <= l->cap) return 0;
     int c = l->cap > 0 ? l->cap : 256;
     while (c < need) c *= 2;
-    void *p[11];
+    void *p[12];
     p[0] = realloc(l->a, sizeof(int) * (size_t)c);
     if (p[0]) l->a = p[0];
     p[1] = realloc(l->b, sizeof(int) * (size_t)c);
@@ -120,7 +121,9 @@ static int list_reserve(sps_list *l, int need)
     if (p[9]) l->pc = p[9];
     p[10] = realloc(l->deep, (size_t)c);
     if (p[10]) l->deep = p[10];
-    for (int k = 0; k < 11; k++)
+    p[11] = realloc(l->ci, sizeof(int) * (size_t)c);
+    if (p[11]) l->ci = p[11];
+    for (int k = 0; k < 12; k++)
         if (!p[k]) return -1;
     l->cap = c;
     return 0;
@@ -134,6 +137,7 @@ static void list_free(sps_list *l)
     free(l->touch);
     free(l->fall);
     free(l->deep);
+    free(l->ci);
     free(l->f);
     free(l->ta);
     free(l->tb);
@@ -535,6 +539,12 @@ typedef struct {
     double r;
 } sps_side;
 
+static inline __attribute__((always_inline)) void contact_kernel(const sps_side *A, vec3 dx, double d2, vec3 vb, vec3 wb,
+                                                                 double rb, const dem_pair_law *law,
+                                                                 const dem_pair_consts *pc, unsigned char *touch, vec3 *xip,
+                                                                 double h, double maxov, vec3 *f, vec3 *ta, vec3 *tb,
+                                                                 int *bad);
+
 /* The force between sphere a and sphere b (b's state, the pair's law and constants, its spring and
  * contact flag) at the current positions: 1 in contact with the force on b in *f and the torques on
  * a and b in *ta, *tb (a gets -f), 0 out of contact. Updates the spring and the contact flag;
@@ -544,13 +554,25 @@ static inline __attribute__((always_inline)) int pair_kernel(const sps_side *A, 
                                                              unsigned char *touch, vec3 *xip, double h, double maxov,
                                                              vec3 *f, vec3 *ta, vec3 *tb, int *bad)
 {
-    double ra = A->r, rs = ra + rb;
+    double rs = A->r + rb;
     vec3 dx = v3_sub(xb, A->x);
     double d2 = v3_norm2(dx);
     if (d2 >= rs * rs) {
         *touch = 0;
         return 0;
     }
+    contact_kernel(A, dx, d2, vb, wb, rb, law, pc, touch, xip, h, maxov, f, ta, tb, bad);
+    return 1;
+}
+
+/* pair_kernel's force for a pair in contact (d2 = |dx|^2 < (ra + rb)^2, dx = xb - xa). */
+static inline __attribute__((always_inline)) void contact_kernel(const sps_side *A, vec3 dx, double d2, vec3 vb, vec3 wb,
+                                                                 double rb, const dem_pair_law *law,
+                                                                 const dem_pair_consts *pc, unsigned char *touch, vec3 *xip,
+                                                                 double h, double maxov, vec3 *f, vec3 *ta, vec3 *tb,
+                                                                 int *bad)
+{
+    double ra = A->r, rs = ra + rb;
     double d = sqrt(d2);
     double delta = rs - d;
     /* the spring onto the new tangent plane, magnitude kept: xi - (xi.n) n scaled by |xi| / |r|
@@ -595,7 +617,6 @@ static inline __attribute__((always_inline)) int pair_kernel(const sps_side *A, 
     *f = v3_axpy(fn, n, ft);
     *ta = v3_scale(c, -la);
     *tb = v3_scale(c, -lb);
-    return 1;
 }
 
 /* pair_kernel for listed pair p. */
@@ -715,35 +736,42 @@ static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h
     unsigned char *touch = l->touch;
     vec3 *xi = l->xi, *sf = s->sf, *st = s->st;
     int *scnt = s->scnt;
-    for (int a = k0; a < k1; a++) {
-        vec3 fa = sf[a], tqa = st[a];
-        int ma = scnt[a];
-        const sps_side A = {x[a], v[a], w[a], rad[a]};
-        const dem_pair_law *laws = e->laws + mat[a] * nmat;
-        for (int p = pstart[a]; p < pstart[a + 1]; p++) {
-            int b = bl[p];
+    const int *al = l->a;
+    int *ci = l->ci;
+    /* blocks of spheres: first the entries in contact, without a branch (the contact test is
+     * data-dependent: a mispredicted branch per pair), then their forces */
+    for (int a0 = k0; a0 < k1; a0 += 64) {
+        const int a1 = a0 + 64 < k1 ? a0 + 64 : k1, p0 = pstart[a0], p1 = pstart[a1];
+        int nc = p0;
+        for (int p = p0; p < p1; p++) {
+            int a = al[p], b = bl[p];
+            double rs = rad[a] + rad[b];
+            int in = v3_norm2(v3_sub(x[b], x[a])) < rs * rs, cross = b >= k1;
+            unsigned char tp = touch[p];
+            touch[p] = cross ? tp : (unsigned char)(tp & in); /* cross: phase 1 set it */
+            ci[nc] = p;
+            nc += cross ? tp : in;
+        }
+        for (int q = p0; q < nc; q++) {
+            int p = ci[q], a = al[p], b = bl[p];
             if (b >= k1) { /* computed in phase 1 */
-                if (!touch[p]) continue;
-                ma++;
-                fa = v3_sub(fa, l->f[p]);
-                tqa = v3_add(tqa, l->ta[p]);
+                scnt[a]++;
+                sf[a] = v3_sub(sf[a], l->f[p]);
+                st[a] = v3_add(st[a], l->ta[p]);
                 continue;
             }
-            vec3 f, ta, tb;
-            if (!pair_kernel(&A, x[b], v[b], w[b], rad[b], laws + mat[b], &pc[p], &touch[p], &xi[p], h, maxov, &f, &ta, &tb,
-                             &bd))
-                continue;
+            const sps_side A = {x[a], v[a], w[a], rad[a]};
+            vec3 dx = v3_sub(x[b], A.x), f, ta, tb;
+            contact_kernel(&A, dx, v3_norm2(dx), v[b], w[b], rad[b], e->laws + mat[a] * nmat + mat[b], &pc[p], &touch[p],
+                           &xi[p], h, maxov, &f, &ta, &tb, &bd);
             c++;
-            ma++;
-            fa = v3_sub(fa, f);
-            tqa = v3_add(tqa, ta);
+            scnt[a]++;
+            sf[a] = v3_sub(sf[a], f);
+            st[a] = v3_add(st[a], ta);
             sf[b] = v3_add(sf[b], f);
             st[b] = v3_add(st[b], tb);
             scnt[b]++;
         }
-        sf[a] = fa;
-        st[a] = tqa;
-        scnt[a] = ma;
     }
     int nf = 0;
     for (int p = s->wstart[k0]; p < s->wstart[k1]; p++) {
