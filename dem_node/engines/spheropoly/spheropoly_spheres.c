@@ -12,9 +12,14 @@
  * the last build (two spheres then closed at most `skin`). The spring of a pair lives in the list
  * entry; a rebuild hands the springs of the touching pairs over by merging the two sorted lists.
  * Each sphere sums its contacts in ascending partner order (pair index order of the sorted list),
- * so the result does not depend on when the list was built: a restart rebuilds the list and
- * continues bit for bit, and the per-pair and per-sphere loops run on OpenMP threads without
- * changing a bit (every thread writes only its own entries). */
+ * then its walls, so the result does not depend on when the list was built: a restart rebuilds the
+ * list and continues bit for bit. Threads take parts of consecutive spheres; the entries whose
+ * partner lies in a later part are computed first (phase 1) and enter both sums in their place in
+ * that order, so any thread count gives the same bits (every thread writes only its own spheres).
+ *
+ * The spheres' state (x, v, w, L, q) lives in compact arrays here; the engine's body states of the
+ * spheres are written only when the general path meets a sphere (sps_sync) and read through
+ * sps_state. */
 #include <float.h>
 #include <math.h>
 #include <omp.h>
