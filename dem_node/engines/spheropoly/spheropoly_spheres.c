@@ -81,6 +81,8 @@ struct sp_spheres {
     int *wstart;          /* per sphere its wall entries [wstart[k], wstart[k+1]) */
     int *pstart;          /* per sphere a its sphere-sphere entries as a: [pstart[a], pstart[a+1]) */
     vec3 *wunit;          /* per wall its unit normal (the one geom_point_polygon_inside uses) */
+    vec3 *wnrm, *wp0;     /* per wall its face normal and first vertex (world) */
+    double *wrad;         /* per wall its sweep radius */
     /* the force loop in parts of consecutive spheres [part[t], part[t+1]) of about equal work, one
      * per thread; xpair[xstart[t] .. xstart[t+1]) are the entries of part t whose partner is in a
      * later part (npart = 1: no thread team, no such entry); xin[xinstart[t] .. xinstart[t+1]) the
@@ -249,6 +251,9 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->scnt = malloc(sizeof(int) * (size_t)ns);
     s->pstart = calloc((size_t)ns + 1, sizeof(int));
     s->wunit = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
+    s->wnrm = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
+    s->wp0 = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
+    s->wrad = malloc(sizeof(double) * (size_t)(nb > 0 ? nb : 1));
     s->npart = ns >= SPS_PAR_MIN && e->nthr > 1 ? e->nthr : 1;
     s->part = calloc((size_t)s->npart + 1, sizeof(int));
     s->xstart = calloc((size_t)s->npart + 1, sizeof(int));
@@ -262,7 +267,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
     if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->q ||
         !s->bcount || !s->wstart || !s->sf || !s->st || !s->scnt ||
-        !s->pstart || !s->wunit || !s->part || !s->xstart || !s->xpair || !s->xin || !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
+        !s->pstart || !s->wunit || !s->wnrm || !s->wp0 || !s->wrad || !s->part || !s->xstart || !s->xpair || !s->xin || !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
     double rmin = DBL_MAX;
     for (int i = 0; i < nb; i++) {
@@ -353,6 +358,9 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->scnt);
     free(s->pstart);
     free(s->wunit);
+    free(s->wnrm);
+    free(s->wp0);
+    free(s->wrad);
     free(s->part);
     free(s->xstart);
     free(s->xpair);
@@ -456,7 +464,13 @@ static int build_lists(lahar_dem_engine *e)
     /* sphere-wall: walls whose plane is within the skin of the sphere's surface */
     sps_list *wl = &s->wl;
     wl->n = 0;
-    for (int w = 0; w < s->nwall; w++) s->wunit[w] = v3_normalize(e->nw[e->geo[s->wall_body[w]].f0]);
+    for (int w = 0; w < s->nwall; w++) {
+        const sp_geo *g = &e->geo[s->wall_body[w]];
+        s->wnrm[w] = e->nw[g->f0];
+        s->wunit[w] = v3_normalize(s->wnrm[w]);
+        s->wp0[w] = e->fw[e->fstart[g->fs0]];
+        s->wrad[w] = g->radius;
+    }
     for (int a = 0; a < n; a++) {
         s->wstart[a] = wl->n;
         for (int w = 0; w < s->nwall; w++) {
@@ -636,40 +650,50 @@ static inline int pair_force(const lahar_dem_engine *e, sp_spheres *s, int p, do
                        &l->touch[p], &l->xi[p], h, e->max_overlap, f, ta, tb, bad);
 }
 
-/* Sphere a against wall w: vertex-face when the centre projects inside the face, else the pair
- * goes to the general narrow phase (edges and corners of the face). Force on the sphere. An entry
- * whose centre was deep inside the face at the list build (`deep`: farther than the skin from every
- * edge) stays inside until the next build (a centre moves less than skin/2), so the polygon test is
- * skipped; the projection is the one of geom_point_polygon_inside (same bits). */
-static void wall_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h)
+/* The spring of the last step onto the tangent plane of normal n, magnitude kept: the series of
+ * the scale 1/sqrt(1 - u), u = (xi.n)^2/|xi|^2, for u <= 1e-5 (truncation < 3e-21; as the pair's),
+ * else the square root. */
+static inline vec3 spring_onto(vec3 xi, vec3 n)
+{
+    double m0 = v3_norm2(xi);
+    if (m0 == 0.0) return xi;
+    double pn = v3_dot(xi, n), p2 = pn * pn;
+    vec3 r = v3_axpy(-pn, n, xi);
+    if (p2 <= 1e-5 * m0) {
+        double u = p2 / m0;
+        return v3_scale(r, 1.0 + u * (0.5 + u * (0.375 + u * 0.3125)));
+    }
+    double m1 = v3_norm2(r);
+    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r;
+}
+
+/* Sphere a against wall w, the centre within the sum of the radii of the face's plane
+ * (dpl: signed distance along the wall's normal): vertex-face when the centre projects inside the
+ * face, else the pair goes to the general narrow phase (edges and corners of the face; fall = 1,
+ * returns 0). An entry whose centre was deep inside the face at the list build (`deep`: farther
+ * than the skin from every edge) stays inside until the next build (a centre moves less than
+ * skin/2), so the polygon test is skipped. The normal is the face's unit normal, towards the
+ * sphere. Force on the sphere. */
+static int wall_force(const lahar_dem_engine *e, sp_spheres *s, int p, double dpl, double h)
 {
     sps_list *l = &s->wl;
     int a = l->a[p], w = l->b[p], wb = s->wall_body[w];
     const sp_geo *gw = &e->geo[wb];
     const vec3 xa = s->x[a];
     double ra = s->rad[a], rs = ra + gw->radius;
-    int b0 = e->fstart[gw->fs0], m = e->fstart[gw->fs0 + 1] - b0;
-    vec3 nrm = e->nw[gw->f0];
-    double dpl = v3_dot(v3_sub(xa, e->fw[b0]), nrm);
-    l->fall[p] = 0;
-    if (fabs(dpl) >= rs) {
-        l->touch[p] = 0;
-        return;
-    }
-    vec3 c;
-    if (l->deep[p]) {
-        vec3 nn = s->wunit[w];
-        c = v3_axpy(-v3_dot(v3_sub(xa, e->fw[b0]), nn), nn, xa);
-    } else if (!geom_point_polygon_inside(xa, e->fw + b0, m, nrm, &c)) {
-        l->touch[p] = 0;
-        l->fall[p] = 1;
-        return;
+    vec3 nn = s->wunit[w], c = v3_axpy(-v3_dot(v3_sub(xa, s->wp0[w]), nn), nn, xa);
+    if (!l->deep[p]) {
+        int b0 = e->fstart[gw->fs0], m = e->fstart[gw->fs0 + 1] - b0;
+        if (!geom_point_polygon_inside(xa, e->fw + b0, m, e->nw[gw->f0], &c)) {
+            l->touch[p] = 0;
+            l->fall[p] = 1;
+            return 0;
+        }
     }
     double d = fabs(dpl);
-    vec3 n = dpl >= 0.0 ? nrm : v3_neg(nrm); /* from the wall to the sphere */
-    if (d > 1e-12 * rs) n = v3_scale(v3_sub(xa, c), 1.0 / d);
+    vec3 n = dpl >= 0.0 ? nn : v3_neg(nn); /* from the wall to the sphere */
     vec3 cp = v3_scale(v3_add(v3_axpy(gw->radius, n, c), v3_axpy(-ra, n, xa)), 0.5);
-    vec3 xi = l->touch[p] ? spring_rotate(l->xi[p], n) : v3(0.0, 0.0, 0.0);
+    vec3 xi = l->touch[p] ? spring_onto(l->xi[p], n) : v3(0.0, 0.0, 0.0);
     vec3 rpa = v3_sub(cp, xa);
     vec3 vr = v3_add(s->v[a], v3_cross(s->w[a], rpa)); /* the wall is fixed */
     double vn = v3_dot(vr, n);
@@ -686,6 +710,7 @@ static void wall_force(const lahar_dem_engine *e, sp_spheres *s, int p, double h
     l->ta[p] = v3_cross(rpa, f);
     l->tb[p] = v3_cross(v3_sub(cp, e->st[wb].x), v3_neg(f));
     l->delta[p] = delta;
+    return 1;
 }
 
 static int overlap_fault(lahar_dem_engine *e, int a, int b, double delta, double rmin, vec3 cp, char *err, size_t errlen)
@@ -779,11 +804,26 @@ static void forces_own(const lahar_dem_engine *e, sp_spheres *s, int t, double h
             scnt[b]++;
         }
     }
-    int nf = 0;
+    /* walls: the entries within reach of the plane first (no branch), then their forces */
+    int nf = 0, nw = s->wstart[k0];
+    int *wci = wl->ci;
+    double *wd = wl->delta; /* scratch: the signed distances to the plane, overwritten by the overlaps */
     for (int p = s->wstart[k0]; p < s->wstart[k1]; p++) {
-        wall_force(e, s, p, h);
-        nf += wl->fall[p];
-        if (!wl->touch[p]) continue;
+        int a = wl->a[p], w = wl->b[p];
+        double dpl = v3_dot(v3_sub(x[a], s->wp0[w]), s->wnrm[w]);
+        int in = fabs(dpl) < rad[a] + s->wrad[w];
+        wl->touch[p] = (unsigned char)(wl->touch[p] & in);
+        wl->fall[p] = 0;
+        wd[p] = dpl;
+        wci[nw] = p;
+        nw += in;
+    }
+    for (int q = s->wstart[k0]; q < nw; q++) {
+        int p = wci[q];
+        if (!wall_force(e, s, p, wd[p], h)) {
+            nf++;
+            continue;
+        }
         int a = wl->a[p];
         double ra = s->rad[a], rb = e->geo[s->wall_body[wl->b[p]]].radius;
         c++;
