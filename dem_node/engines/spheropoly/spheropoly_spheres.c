@@ -68,7 +68,7 @@ struct sp_spheres {
     /* the spheres' state (SoA by field, contiguous by sphere): the body states in e->st are stale
      * (sps_sync writes them, sps_state reads the state) */
     vec3 *x, *v, *w, *L;
-    quat *q;
+    double *qw, *qx, *qy, *qz; /* orientation, unit quaternion by component */
     int nfall;            /* wall entries of the last evaluation beyond the face's rim (general path) */
     int finite;           /* every centre, velocity and angular velocity finite, |x| <= 1e12 m */
     double worst;         /* largest squared displacement of a centre since the list build */
@@ -242,7 +242,10 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->v = malloc(sizeof(vec3) * (size_t)ns);
     s->w = malloc(sizeof(vec3) * (size_t)ns);
     s->L = malloc(sizeof(vec3) * (size_t)ns);
-    s->q = malloc(sizeof(quat) * (size_t)ns);
+    s->qw = malloc(sizeof(double) * (size_t)ns);
+    s->qx = malloc(sizeof(double) * (size_t)ns);
+    s->qy = malloc(sizeof(double) * (size_t)ns);
+    s->qz = malloc(sizeof(double) * (size_t)ns);
     s->x0 = malloc(sizeof(vec3) * (size_t)ns);
     s->bcount = calloc((size_t)ns + 1, sizeof(int));
     s->wstart = calloc((size_t)ns + 1, sizeof(int));
@@ -265,7 +268,7 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->order = malloc(sizeof(int) * (size_t)ns);
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
-    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->q ||
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->qw || !s->qx || !s->qy || !s->qz ||
         !s->bcount || !s->wstart || !s->sf || !s->st || !s->scnt ||
         !s->pstart || !s->wunit || !s->wnrm || !s->wp0 || !s->wrad || !s->part || !s->xstart || !s->xpair || !s->xin || !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
         goto oom;
@@ -349,7 +352,10 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->v);
     free(s->w);
     free(s->L);
-    free(s->q);
+    free(s->qw);
+    free(s->qx);
+    free(s->qy);
+    free(s->qz);
     free(s->x0);
     free(s->bcount);
     free(s->wstart);
@@ -964,40 +970,78 @@ void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads, do
 {
     sp_spheres *s = e->sph;
     const vec3 g = e->g;
-    const int two_d = e->dim == 2;
+    const int two_d = e->dim == 2, n = s->n;
+    const double ah = 0.5 * hdrift, uxy = two_d ? 0.0 : 1.0;
     int ok = 1;
-    double worst = 0.0;
-#pragma omp parallel for schedule(static) num_threads(e->nthr) if (s->n >= SPS_PAR_MIN) reduction(& : ok) reduction(max : worst)
-    for (int k = 0; k < s->n; k++) {
-        double m = s->mass[k];
-        vec3 f, t;
-        sphere_fc(e, s, k, &f, &t);
-        f = v3_axpy(m, g, f);
-        if (loads) {
-            int i = s->body[k];
-            f = v3_add(f, v3_load(loads[i].force));
-            t = v3_add(t, v3_load(loads[i].torque));
+    double worst = 0.0, p2max = 0.0;
+#pragma omp parallel num_threads(e->nthr) if (n >= SPS_PAR_MIN)
+    {
+#pragma omp for schedule(static) reduction(& : ok) reduction(max : worst, p2max)
+        for (int k = 0; k < n; k++) {
+            double m = s->mass[k];
+            vec3 f, t;
+            sphere_fc(e, s, k, &f, &t);
+            f = v3_axpy(m, g, f);
+            if (loads) {
+                int i = s->body[k];
+                f = v3_add(f, v3_load(loads[i].force));
+                t = v3_add(t, v3_load(loads[i].torque));
+            }
+            if (two_d) {
+                f.z = 0.0;
+                t.x = t.y = 0.0;
+            }
+            vec3 v = v3_axpy(half / m, f, s->v[k]), L = v3_axpy(half, t, s->L[k]);
+            vec3 w = two_d ? v3(0.0, 0.0, L.z / s->iner[k]) : v3_scale(L, s->inv_iner[k]); /* = L (1/I) */
+            s->v[k] = v;
+            s->L[k] = L;
+            s->w[k] = w;
+            vec3 x = s->x[k];
+            if (hdrift > 0.0) { /* the drift that follows the first kick */
+                x = v3_axpy(hdrift, v, x);
+                s->x[k] = x;
+                double d2 = v3_norm2(v3_sub(x, s->x0[k]));
+                worst = d2 > worst ? d2 : worst;
+                double a = ah * s->inv_iner[k], p2 = (uxy * (L.x * L.x + L.y * L.y) + L.z * L.z) * (a * a);
+                p2max = p2 > p2max ? p2 : p2max;
+            }
+            ok &= state_ok(x, v, w);
         }
-        if (two_d) {
-            f.z = 0.0;
-            t.x = t.y = 0.0;
+        /* the orientations turn by the angle h |L| / I about L (2D: about z): q <- exp(h/(2I) L) q.
+         * All angles small (the usual case): a loop without a branch (q_exp_scaled's series and
+         * q_renormalize's Newton step written out, q stays within 1e-15 of unit length); else
+         * q_exp_scaled and q_renormalize per sphere. p2max is final here (after the loop's barrier),
+         * so every thread takes the same branch. */
+        if (hdrift > 0.0 && p2max <= 1e-4) {
+            double *qw = s->qw, *qx = s->qx, *qy = s->qy, *qz = s->qz;
+            const double *Ld = &s->L[0].x, *ii = s->inv_iner;
+#pragma omp for simd schedule(static)
+            for (int k = 0; k < n; k++) {
+                double lx = uxy * Ld[3 * k], ly = uxy * Ld[3 * k + 1], lz = Ld[3 * k + 2], a = ah * ii[k];
+                double p2 = (lx * lx + ly * ly + lz * lz) * (a * a);
+                double c = 1.0 + p2 * (-1.0 / 2.0 + p2 * (1.0 / 24.0 + p2 * (-1.0 / 720.0)));
+                double sn = a * (1.0 + p2 * (-1.0 / 6.0 + p2 * (1.0 / 120.0 + p2 * (-1.0 / 5040.0))));
+                double rx = lx * sn, ry = ly * sn, rz = lz * sn, q0 = qw[k], q1 = qx[k], q2 = qy[k], q3 = qz[k];
+                double nw = c * q0 - rx * q1 - ry * q2 - rz * q3, nx = c * q1 + rx * q0 + ry * q3 - rz * q2;
+                double ny = c * q2 - rx * q3 + ry * q0 + rz * q1, nz = c * q3 + rx * q2 - ry * q1 + rz * q0;
+                double fq = 1.5 - 0.5 * (nw * nw + nx * nx + ny * ny + nz * nz);
+                qw[k] = nw * fq;
+                qx[k] = nx * fq;
+                qy[k] = ny * fq;
+                qz[k] = nz * fq;
+            }
+        } else if (hdrift > 0.0) {
+#pragma omp for schedule(static)
+            for (int k = 0; k < n; k++) {
+                vec3 L = s->L[k], u = two_d ? v3(0.0, 0.0, L.z) : L;
+                quat q = {s->qw[k], s->qx[k], s->qy[k], s->qz[k]};
+                q = q_renormalize(q_mul(q_exp_scaled(u, ah * s->inv_iner[k]), q));
+                s->qw[k] = q.w;
+                s->qx[k] = q.x;
+                s->qy[k] = q.y;
+                s->qz[k] = q.z;
+            }
         }
-        vec3 v = v3_axpy(half / m, f, s->v[k]), L = v3_axpy(half, t, s->L[k]);
-        vec3 w = two_d ? v3(0.0, 0.0, L.z / s->iner[k]) : v3_scale(L, s->inv_iner[k]); /* = L (1/I) */
-        s->v[k] = v;
-        s->L[k] = L;
-        s->w[k] = w;
-        vec3 x = s->x[k];
-        if (hdrift > 0.0) { /* the drift that follows the first kick */
-            x = v3_axpy(hdrift, v, x);
-            /* the orientation turns by the angle h |L| / I about L (2D: about z), exp(h/(2I) L) */
-            vec3 u = two_d ? v3(0.0, 0.0, L.z) : L;
-            if (v3_norm2(u) > 0.0) s->q[k] = q_renormalize(q_mul(q_exp_scaled(u, 0.5 * hdrift * s->inv_iner[k]), s->q[k]));
-            s->x[k] = x;
-            double d2 = v3_norm2(v3_sub(x, s->x0[k]));
-            worst = d2 > worst ? d2 : worst;
-        }
-        ok &= state_ok(x, v, w);
     }
     s->finite = ok;
     if (hdrift > 0.0) s->worst = worst;
@@ -1017,7 +1061,7 @@ void sps_sync(lahar_dem_engine *e)
         st->v = s->v[k];
         st->L = s->L[k];
         st->w = s->w[k];
-        st->q = s->q[k];
+        st->q = (quat){s->qw[k], s->qx[k], s->qy[k], s->qz[k]};
         e->vw[s->v0[k]] = s->x[k];
     }
 }
@@ -1033,7 +1077,14 @@ static void sps_load(lahar_dem_engine *e)
         s->v[k] = st->v;
         s->L[k] = st->L;
         s->w[k] = st->w;
-        s->q[k] = st->q;
+        /* unit length to 1e-8, which the kick's Newton step keeps (normalised here only if not:
+         * a restart continues with the same bits) */
+        quat q = st->q;
+        if (!(fabs(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z - 1.0) <= 1e-8)) q = q_normalize(q);
+        s->qw[k] = q.w;
+        s->qx[k] = q.x;
+        s->qy[k] = q.y;
+        s->qz[k] = q.z;
         ok &= state_ok(st->x, st->v, st->w);
     }
     s->finite = ok;
@@ -1068,7 +1119,7 @@ sp_state sps_state(const lahar_dem_engine *e, int i)
     st.v = s->v[k];
     st.L = s->L[k];
     st.w = s->w[k];
-    st.q = s->q[k];
+    st.q = (quat){s->qw[k], s->qx[k], s->qy[k], s->qz[k]};
     if (s->deferred) sphere_fc(e, s, k, &st.fc, &st.tc);
     return st;
 }
