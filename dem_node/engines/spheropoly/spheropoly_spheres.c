@@ -547,15 +547,21 @@ static int build_lists(lahar_dem_engine *e)
 /* ---------------------------------------------------------------------------------------------- */
 /* Forces                                                                                          */
 
-/* The spring of the last step rotated onto the current tangent plane, magnitude kept (as the
- * general path's contact_emit). */
-static inline vec3 spring_rotate(vec3 xi, vec3 n)
+/* The spring of the last step onto the tangent plane of normal n, magnitude kept: the series of
+ * the scale 1/sqrt(1 - u), u = (xi.n)^2/|xi|^2, for u <= 1e-5 (truncation < 3e-21; as the pair's),
+ * else the square root. */
+static inline vec3 spring_onto(vec3 xi, vec3 n)
 {
     double m0 = v3_norm2(xi);
     if (m0 == 0.0) return xi;
-    vec3 r = v3_axpy(-v3_dot(xi, n), n, xi);
+    double pn = v3_dot(xi, n), p2 = pn * pn;
+    vec3 r = v3_axpy(-pn, n, xi);
+    if (p2 <= 1e-5 * m0) {
+        double u = p2 / m0;
+        return v3_scale(r, 1.0 + u * (0.5 + u * (0.375 + u * 0.3125)));
+    }
     double m1 = v3_norm2(r);
-    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r; /* one square root: |xi| / |r| */
+    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r;
 }
 
 /* Sphere a of a pair: its state and radius (loaded once per run of a's entries). */
@@ -609,7 +615,7 @@ static inline __attribute__((always_inline)) void contact_kernel(const sps_side 
     double m0 = *touch ? v3_norm2(xi) : 0.0;
     if (!(d > 1e-12 * rs)) {
         n = v3(0.0, 0.0, 1.0);
-        xi = m0 > 0.0 ? spring_rotate(xi, n) : v3(0.0, 0.0, 0.0);
+        xi = m0 > 0.0 ? spring_onto(xi, n) : v3(0.0, 0.0, 0.0);
     } else if (m0 > 1e-200) {
         double r = 1.0 / (d2 * m0);
         n = v3_scale(dx, d * (r * m0));
@@ -623,7 +629,7 @@ static inline __attribute__((always_inline)) void contact_kernel(const sps_side 
         }
     } else {
         n = v3_scale(dx, 1.0 / d);
-        xi = m0 > 0.0 ? spring_rotate(xi, n) : v3(0.0, 0.0, 0.0);
+        xi = m0 > 0.0 ? spring_onto(xi, n) : v3(0.0, 0.0, 0.0);
     }
     /* contact point in the middle of the overlap: cp = xa + la n = xb - lb n */
     double la = ra - 0.5 * delta, lb = rb - 0.5 * delta;
@@ -654,23 +660,6 @@ static inline int pair_force(const lahar_dem_engine *e, sp_spheres *s, int p, do
     sps_side A = {s->x[a], s->v[a], s->w[a], s->rad[a]};
     return pair_kernel(&A, s->x[b], s->v[b], s->w[b], s->rad[b], &e->laws[s->mat[a] * e->nmat + s->mat[b]], &l->pc[p],
                        &l->touch[p], &l->xi[p], h, e->max_overlap, f, ta, tb, bad);
-}
-
-/* The spring of the last step onto the tangent plane of normal n, magnitude kept: the series of
- * the scale 1/sqrt(1 - u), u = (xi.n)^2/|xi|^2, for u <= 1e-5 (truncation < 3e-21; as the pair's),
- * else the square root. */
-static inline vec3 spring_onto(vec3 xi, vec3 n)
-{
-    double m0 = v3_norm2(xi);
-    if (m0 == 0.0) return xi;
-    double pn = v3_dot(xi, n), p2 = pn * pn;
-    vec3 r = v3_axpy(-pn, n, xi);
-    if (p2 <= 1e-5 * m0) {
-        double u = p2 / m0;
-        return v3_scale(r, 1.0 + u * (0.5 + u * (0.375 + u * 0.3125)));
-    }
-    double m1 = v3_norm2(r);
-    return m1 > 0.0 ? v3_scale(r, sqrt(m0 / m1)) : r;
 }
 
 /* Sphere a against wall w, the centre within the sum of the radii of the face's plane
