@@ -158,3 +158,15 @@ lahar_dem_engine *dem_test_engine(const lahar_case *c, const lahar_dem_engine_op
     }
     return e;
 }
+
+unsigned long long dem_test_digest(const lahar_dem_engine_ops *ops, const lahar_dem_engine *e)
+{
+    unsigned long long h = 1469598103934665603ull;
+    for (int i = 0; i < ops->nbody(e); i++) {
+        lahar_body_state st;
+        ops->get_state(e, i, &st);
+        const unsigned char *p = (const unsigned char *)&st;
+        for (size_t k = 0; k < sizeof st; k++) h = (h ^ p[k]) * 1099511628211ull;
+    }
+    return h;
+}

@@ -30,6 +30,8 @@ int dem_test_segment(lahar_case *c, const char *name, int mat, const double a[3]
 
 /* The spheropoly engine for case c; aborts the test with a message on failure. */
 lahar_dem_engine *dem_test_engine(const lahar_case *c, const lahar_dem_engine_ops **ops);
+/* FNV-1a over every body state (get_state): equal digests = bitwise equal runs (threads, optimisations). */
+unsigned long long dem_test_digest(const lahar_dem_engine_ops *ops, const lahar_dem_engine *e);
 
 /* Test bookkeeping: prints "ok"/"FAIL" lines, counts failures. */
 extern int dem_test_failures;

@@ -55,6 +55,34 @@ static inline quat q_axis_angle(vec3 unit_axis, double angle)
     quat r = {cos(0.5 * angle), unit_axis.x * s, unit_axis.y * s, unit_axis.z * s};
     return r;
 }
+/* Rotation by the angle 2 a |u| about u (a >= 0, u != 0): exp(a u) = (cos phi, u a sin(phi)/phi),
+ * phi = a |u|. Small angles (phi <= 0.01) by the Taylor series of cos and sin(phi)/phi to phi^6
+ * (truncation < 3e-21, below the last bit): no square root, division or sin/cos call; larger ones
+ * through q_axis_angle. */
+static inline quat q_exp_scaled(vec3 u, double a)
+{
+    double p2 = (u.x * u.x + u.y * u.y + u.z * u.z) * (a * a);
+    if (p2 <= 1e-4) {
+        double c = 1.0 + p2 * (-1.0 / 2.0 + p2 * (1.0 / 24.0 + p2 * (-1.0 / 720.0)));
+        double s = a * (1.0 + p2 * (-1.0 / 6.0 + p2 * (1.0 / 120.0 + p2 * (-1.0 / 5040.0))));
+        quat r = {c, u.x * s, u.y * s, u.z * s};
+        return r;
+    }
+    double un = sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+    vec3 axis = {u.x / un, u.y / un, u.z / un};
+    return q_axis_angle(axis, 2.0 * a * un);
+}
+/* q back to unit length: when |q|^2 is within 1e-8 of 1 (a product of unit quaternions) one Newton
+ * step for 1/|q| (relative error ~ (|q|^2 - 1)^2, below the last bit), no square root or division;
+ * else q_normalize. */
+static inline quat q_renormalize(quat a)
+{
+    double n2 = a.w * a.w + a.x * a.x + a.y * a.y + a.z * a.z;
+    if (!(fabs(n2 - 1.0) <= 1e-8)) return q_normalize(a);
+    double f = 1.5 - 0.5 * n2;
+    quat r = {a.w * f, a.x * f, a.y * f, a.z * f};
+    return r;
+}
 /* Body frame -> world frame: q v q*. */
 static inline vec3 q_rotate(quat q, vec3 v)
 {

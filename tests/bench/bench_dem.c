@@ -48,19 +48,6 @@ static double bench_cpu_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* FNV-1a over every body state: equal digests = bitwise equal runs (threads, optimisations). */
-static unsigned long long bench_digest(const lahar_dem_engine_ops *ops, const lahar_dem_engine *e)
-{
-    unsigned long long h = 1469598103934665603ull;
-    for (int i = 0; i < ops->nbody(e); i++) {
-        lahar_body_state st;
-        ops->get_state(e, i, &st);
-        const unsigned char *p = (const unsigned char *)&st;
-        for (size_t k = 0; k < sizeof st; k++) h = (h ^ p[k]) * 1099511628211ull;
-    }
-    return h;
-}
-
 /* Warm the scene up once (on the largest thread count), then time `meas` seconds on each thread
  * count from the same restart: the rows of one scene start from the same state, and their digests
  * must agree (the engine is bitwise independent of the thread count). */
@@ -123,7 +110,7 @@ static int bench_scene(const lahar_case *c, double warm, double meas, const int 
                 int nb = ops->nbody(e);
                 printf("| %-14s | %6d | %8d | %6.2f | %10.1f | %15.3f | %15.3f | %7d | %016llx |\n", label, nb,
                        ops->ncontacts(e), (double)ops->ncontacts(e) / nb, nsub / wall, 1e6 * wall / ((double)nsub * nb),
-                       1e6 * cpu / ((double)nsub * nb), thr[t], bench_digest(ops, e));
+                       1e6 * cpu / ((double)nsub * nb), thr[t], dem_test_digest(ops, e));
                 fflush(stdout);
             }
         }

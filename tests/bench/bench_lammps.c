@@ -229,6 +229,7 @@ typedef struct {
     double rate;        /* particle-steps per second of wall time */
     long contacts;      /* sphere-sphere contacts at the end */
     double ke0, ke1;    /* kinetic energy (translation + rotation) after the warm-up and at the end */
+    unsigned long long digest; /* lahar: state digest at the end (equal on any thread count) */
 } bl_result;
 
 /* The timed steps, a function of its own for
@@ -268,6 +269,7 @@ static int bl_run_lahar(const bl_data *d, const lahar_case *c, const bench_lammp
     double wall = omp_get_wtime() - t0;
     res->core_us = 1e6 * (cpu_seconds() - c0) / ((double)d->n * o->steps);
     res->ke1 = ops->kinetic_energy(e);
+    res->digest = dem_test_digest(ops, e);
     res->rate = (double)d->n * o->steps / wall;
     double *x = malloc(sizeof(double) * 3 * (size_t)d->n), *rad = malloc(sizeof(double) * (size_t)d->n), rmax = 0.0;
     if (!x || !rad) {
@@ -377,9 +379,10 @@ int bench_lammps_run(const bench_lammps_opts *o)
     printf("| code | threads | particle-steps/s (wall) | core-us per particle-step (CPU time) | sphere-sphere contacts per sphere | KE after warm-up (J) | KE at end (J) |\n");
     printf("|---|---|---|---|---|---|---|\n");
     bl_result lh = {0}, lm = {0};
-    int rc = 0, have_lmp = 0;
+    int rc = 0, have_lmp = 0, have_lahar = 0;
     if (bl_run_lahar(&d, &c, o, &lh)) rc = 2;
-    else
+    else have_lahar = 1;
+    if (have_lahar)
         printf("| lahar spheropoly | %d | %.3g | %.4f | %.3f | %.4e | %.4e |\n", o->threads, lh.rate, lh.core_us,
                (double)lh.contacts / d.n, lh.ke0, lh.ke1);
     fflush(stdout);
@@ -412,6 +415,7 @@ int bench_lammps_run(const bench_lammps_opts *o)
             if (!ok) rc = 1;
         }
     }
+    if (have_lahar) printf("lahar state digest at the end: %016llx (%d threads)\n", lh.digest, o->threads);
     dem_test_case_free(&c);
     bl_free(&d);
     return rc;

@@ -632,6 +632,7 @@ static int broad_phase(lahar_dem_engine *e)
 static int compute_forces(lahar_dem_engine *e, double h, char *err, size_t errlen)
 {
     if (e->sph && sps_forces(e, h, err, errlen)) return -1;
+    if (e->sph && sps_needs_sync(e)) sps_sync(e); /* the general path reads the spheres' body states */
     if (broad_phase(e)) {
         snprintf(err, errlen, "spheropoly: out of memory in the broad phase");
         return -1;
@@ -746,11 +747,12 @@ static void rotate_about_axis(quat *q, vec3 *pi, const double inertia[3], int k,
     else *pi = v3(c * pi->x + s * pi->y, -s * pi->x + c * pi->y, pi->z);
 }
 
-static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
+/* hdrift > 0: the spheres drift right after their kick (one pass; drift() leaves them out) */
+static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads, double hdrift)
 {
     /* each body only writes its own state: bitwise the same on any thread count */
     /* free spheres have their own loop (spheropoly_spheres.c), the others are listed in move_ids */
-    if (e->sph) sps_kick(e, half, loads);
+    if (e->sph) sps_kick(e, half, loads, hdrift);
     const int *ids = e->sph ? e->move_ids : e->free_ids;
     int nids = e->sph ? e->nmove_free : e->nfree;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
@@ -775,7 +777,6 @@ static void kick(lahar_dem_engine *e, double half, const lahar_body_load *loads)
 
 static void drift(lahar_dem_engine *e, double h)
 {
-    if (e->sph) sps_drift(e, h);
     int nids = e->sph ? e->nmove : e->nbody;
 #pragma omp parallel for schedule(static) num_threads(e->nthr) if (nids >= SP_PAR_MIN_BODIES)
     for (int k = 0; k < nids; k++) {
@@ -826,7 +827,7 @@ static int check_finite(lahar_dem_engine *e, char *err, size_t errlen)
     }
     for (int k = 0; k < e->nfree; k++) {
         int i = e->free_ids[k];
-        const sp_state *s = &e->st[i];
+        const sp_state st = sps_state(e, i), *s = &st;
         double sum = s->x.x + s->x.y + s->x.z + s->v.x + s->v.y + s->v.z + s->L.x + s->L.y + s->L.z + s->q.w;
         if (isfinite(sum) && fabs(s->x.x) <= 1e12 && fabs(s->x.y) <= 1e12 && fabs(s->x.z) <= 1e12) continue;
         double far = fmax(fabs(s->x.x), fmax(fabs(s->x.y), fabs(s->x.z)));
@@ -859,15 +860,16 @@ static int sp_advance(lahar_dem_engine *e, double dt, const lahar_body_load *loa
     if (average)
         for (int i = 0; i < e->nbody; i++) e->rep_f[i] = e->rep_t[i] = v3(0.0, 0.0, 0.0);
     for (int k = 0; k < n; k++) {
-        kick(e, 0.5 * h, loads);
+        kick(e, 0.5 * h, loads, h);
         drift(e, h);
         e->step++;
         if (check_finite(e, err, errlen) || compute_forces(e, h, err, errlen)) return -1;
-        kick(e, 0.5 * h, loads);
+        kick(e, 0.5 * h, loads, 0.0);
         if (check_finite(e, err, errlen)) return -1;
         if (!average) continue;
         for (int i = 0; i < e->nbody; i++) {
-            vec3 f = e->st[i].fc, t = e->st[i].tc;
+            vec3 f, t;
+            sps_fc(e, i, &f, &t);
             if (loads) {
                 f = v3_add(f, v3_load(loads[i].force));
                 t = v3_add(t, v3_load(loads[i].torque));
@@ -1288,7 +1290,7 @@ static long long sp_contacts_evaluated(const lahar_dem_engine *e) { return e->co
 
 static void sp_get_state(const lahar_dem_engine *e, int i, lahar_body_state *out)
 {
-    const sp_state *s = &e->st[i];
+    const sp_state st = sps_state(e, i), *s = &st;
     v3_store(s->x, out->x);
     q_store(s->q, out->q);
     v3_store(s->v, out->v);
@@ -1301,10 +1303,12 @@ static void sp_get_report(const lahar_dem_engine *e, int i, lahar_body_report *o
         v3_store(e->rep_f[i], out->force);
         v3_store(e->rep_t[i], out->torque);
     } else {
-        v3_store(e->st[i].fc, out->force);
-        v3_store(e->st[i].tc, out->torque);
+        vec3 f, t;
+        sps_fc(e, i, &f, &t);
+        v3_store(f, out->force);
+        v3_store(t, out->torque);
     }
-    out->ncontacts = e->ncontact_body[i];
+    out->ncontacts = sps_ncontact_of(e, i);
 }
 
 static double sp_kinetic_energy(const lahar_dem_engine *e)
@@ -1312,7 +1316,7 @@ static double sp_kinetic_energy(const lahar_dem_engine *e)
     double k = 0.0;
     for (int j = 0; j < e->nfree; j++) {
         int i = e->free_ids[j];
-        const sp_state *s = &e->st[i];
+        const sp_state st = sps_state(e, i), *s = &st;
         k += 0.5 * e->geo[i].mass * v3_norm2(s->v) + 0.5 * v3_dot(s->L, s->w);
     }
     return k;
@@ -1326,10 +1330,18 @@ static int sp_write_restart(const lahar_dem_engine *e, FILE *f)
     int ok = fwrite(sp_magic, 1, 8, f) == 8;
     ok = ok && fwrite(&e->nbody, sizeof(int), 1, f) == 1;
     ok = ok && fwrite(&e->step, sizeof(long), 1, f) == 1;
-    ok = ok && fwrite(e->st, sizeof(sp_state), (size_t)e->nbody, f) == (size_t)e->nbody;
+    /* the spheres' states and counts from the fast path (sps_state): the same bytes as body states
+     * kept up to date */
+    for (int i = 0; ok && i < e->nbody; i++) {
+        sp_state st = sps_state(e, i);
+        ok = fwrite(&st, sizeof st, 1, f) == 1;
+    }
     ok = ok && fwrite(&e->nprev, sizeof(int), 1, f) == 1;
     ok = ok && fwrite(e->prev, sizeof(sp_contact), (size_t)e->nprev, f) == (size_t)e->nprev;
-    ok = ok && fwrite(e->ncontact_body, sizeof(int), (size_t)e->nbody, f) == (size_t)e->nbody;
+    for (int i = 0; ok && i < e->nbody; i++) {
+        int m = sps_ncontact_of(e, i);
+        ok = fwrite(&m, sizeof m, 1, f) == 1;
+    }
     ok = ok && sps_write_restart(e, f) == 0;
     return ok ? 0 : -1;
 }

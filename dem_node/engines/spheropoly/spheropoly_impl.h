@@ -142,14 +142,25 @@ int sps_fallback_pairs(lahar_dem_engine *e, int (*add)(lahar_dem_engine *, int, 
  * contacts are added); sps_accumulate_walls adds the reactions to the fast walls. */
 void sps_accumulate(lahar_dem_engine *e);
 void sps_accumulate_walls(lahar_dem_engine *e);
-/* Instead of sps_accumulate: the next sps_kick takes the sums and writes the body states. */
+/* Instead of sps_accumulate (no general contact on a sphere): the forces stay in the fast path's
+ * sums, where the kicks and sps_fc / sps_state read them. */
 void sps_defer(lahar_dem_engine *e);
-/* Leap-frog kick (velocity and angular momentum by `half` of the step) and drift of the free spheres. */
-void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads);
-void sps_drift(lahar_dem_engine *e, double h);
-/* 1 when every sphere's centre, velocity and angular velocity are finite and |x| <= 1e12 m (on the
- * compact copy; 0 also when the copy is not up to date). */
+/* Leap-frog kick of the free spheres (velocity and angular momentum by `half` of the step), followed
+ * by their drift over hdrift when hdrift > 0. */
+void sps_kick(lahar_dem_engine *e, double half, const lahar_body_load *loads, double hdrift);
+/* 1 when every sphere's centre, velocity and angular velocity are finite and |x| <= 1e12 m (after
+ * the last kick). */
 int sps_finite(const lahar_dem_engine *e);
+/* The spheres' state lives in the fast path's arrays; the body states e->st of the spheres are
+ * stale. sps_needs_sync: the general path meets spheres this step (other free bodies, fixed bodies
+ * that are not fast walls, a sphere beyond a wall's rim); sps_sync writes their body states and
+ * world vertices. sps_state: the full state of any body i (a sphere's composed from the arrays, with
+ * its contact force); sps_fc its contact force and torque; sps_ncontact_of its contact count. */
+int sps_needs_sync(const lahar_dem_engine *e);
+void sps_sync(lahar_dem_engine *e);
+sp_state sps_state(const lahar_dem_engine *e, int i);
+void sps_fc(const lahar_dem_engine *e, int i, vec3 *f, vec3 *t);
+int sps_ncontact_of(const lahar_dem_engine *e, int i);
 int sps_ncontacts(const lahar_dem_engine *e);
 int sps_nspheres(const lahar_dem_engine *e);
 /* The fixed/prescribed bodies a sphere meets on the general path (not fast walls). */
