@@ -17,6 +17,7 @@ Sections (default: all three):
   overhead  the boulder pool (docs/bench/cases/boulder_pool_2d.yaml, free boulders sinking in
             water, >= 20,000 particles) run as separate processes over LCM and --in-process:
             wall-time ratio, per-node compute and wait time per step (OUT/overhead.csv, .md).
+            --engine lammps: the pool with segment walls and disc boulders on the LAMMPS engine.
   subcycle  the same pool with stiff boulders (kn 1e8) at a coarser dx: the DEM node subcycling
             inside the SPH step against the whole run forced down to the DEM's stable step
             (time.dt_max = dt_stable): OUT/subcycle.csv, .md.
@@ -607,15 +608,20 @@ def bench_overhead(args, outdir):
     >= 20,000 particles, and `floor` at dx 20 mm (about 400 particles), whose wall time per step is
     almost all protocol: the difference of the two modes there is the per-step cost of LCM over
     UDP multicast against the in-process queue."""
-    src = os.path.join(BENCH_CASES_DIR, "boulder_pool_2d.yaml")
+    # the native engine takes the pool with polygon and box boulders; another engine (--engine
+    # lammps) the same pool with what it can represent: segment walls, disc boulders
+    if args.engine == "spheropoly":
+        src = os.path.join(BENCH_CASES_DIR, "boulder_pool_2d.yaml")
+    else:
+        src = os.path.join(BENCH_CASES_DIR, "boulder_pool_discs_2d.yaml")
     dx, end = (0.004, 0.02) if args.quick else (0.0025, args.overhead_end)
     d = os.path.join(outdir, "runs", "overhead")
     sizes = {"large": (dx, end), "floor": (0.02, 0.1 if args.quick else 0.5)}
     rows = []
-    log(f"== overhead: {src} at dx {dx} (and {sizes['floor'][0]}), end {end} s, {args.repeat} pair(s) of runs")
+    log(f"== overhead ({args.engine} engine): {src} at dx {dx} (and {sizes['floor'][0]}), end {end} s, {args.repeat} pair(s) of runs")
     for size, (sdx, send) in sizes.items():
         case_path = os.path.join(d, f"pool_{size}.yaml")
-        case_override.override_case(src, case_path, {"sph.dx": sdx, "time.end": send})
+        case_override.override_case(src, case_path, {"sph.dx": sdx, "time.end": send, "dem.engine": args.engine})
         for rep in range(args.repeat):
             modes = ("processes", "in-process") if rep % 2 == 0 else ("in-process", "processes")
             for mode in modes:
@@ -775,6 +781,9 @@ def main(argv):
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds after which one run is stopped")
     ap.add_argument("--repeat", type=int, default=3, help="pairs of runs of the overhead section (median is used)")
     ap.add_argument("--overhead-end", type=float, default=0.02, help="simulated time of the overhead runs [s]")
+    ap.add_argument("--engine", default="spheropoly",
+                    help="DEM engine of the overhead runs (spheropoly: the boulder pool; lammps: the same pool "
+                         "with segment walls and disc boulders, docs/bench/cases/boulder_pool_discs_2d.yaml)")
     ap.add_argument("--subcycle-end", type=float, default=0.1, help="simulated time of the subcycling runs [s]")
     ap.add_argument("--cost", choices=("wall", "cpu"), default="wall",
                     help="what the Pareto plots and the summary call cheaper: wall time (default) or CPU time "
