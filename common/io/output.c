@@ -265,6 +265,32 @@ static int out_append_rows(hid_t id, hid_t mtype, int rank, hsize_t start, hsize
     return rc;
 }
 
+/* A snapshot's start, the same for particles, bodies and contacts: room for `need` bytes (what:
+ * for the message), the file reopened (*file), the group /snapshots/NNNNNN (nsnap) made with its
+ * time and step. Returns the group; H5I_INVALID_HID with *file < 0 when nothing was opened (the
+ * reason printed), H5I_INVALID_HID with *file open when the group or its attributes failed (the
+ * group is closed then; the caller closes the file). */
+static hid_t out_snapshot_open(const char *path, double need, const char *what, int64_t nsnap, int64_t step, double t,
+                               hid_t *file)
+{
+    *file = H5I_INVALID_HID;
+    if (out_room(path, need, what, step, t) != 0)
+        return H5I_INVALID_HID;
+    *file = out_file_open(path, H5F_ACC_RDWR, 0);
+    if (*file < 0) {
+        fprintf(stderr, "lahar: %s: cannot reopen for %s at step %" PRId64 "\n", path, what, step);
+        return H5I_INVALID_HID;
+    }
+    char name[48];
+    snprintf(name, sizeof name, "/snapshots/%06" PRId64, nsnap);
+    hid_t g = out_group(*file, name);
+    if (g >= 0 && (out_attr_double(g, "time", t) | out_attr_int64(g, "step", step)) != 0) {
+        H5Gclose(g);
+        g = H5I_INVALID_HID;
+    }
+    return g;
+}
+
 static double out_wall_seconds(void)
 {
     struct timespec ts;
@@ -794,20 +820,11 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
     }
     /* the snapshot's data, its object headers, and the XDMF text */
     double need = 8.0 * 13.0 * nb + 24.0 * (double)o->nmoving_vert + 6.0 * 1024.0 + OUT_XML_CAP;
-    if (out_room(o->h5path, need, "a body snapshot", step, t) != 0)
+    hid_t f, g = out_snapshot_open(o->h5path, need, "a body snapshot", o->nsnap, step, t, &f);
+    if (g == H5I_INVALID_HID && f < 0)
         return -1;
-    hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
-    if (f < 0) {
-        fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
-        return -1;
-    }
-    char name[48];
-    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
-    hid_t g = out_group(f, name);
     int rc = g < 0 ? -1 : 0;
     if (g >= 0) {
-        rc |= out_attr_double(g, "time", t);
-        rc |= out_attr_int64(g, "step", step);
         rc |= out_dataset(g, "position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, X);
         rc |= out_dataset(g, "quaternion", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 4, Q);
         rc |= out_dataset(g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, V);
@@ -985,21 +1002,12 @@ int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, doubl
     /* at most 17 values of 8 bytes per particle (position, velocity, density, pressure, phase,
      * id, stress), the datasets' headers and the XDMF text */
     double need = 17.0 * 8.0 * (double)(p->n > 0 ? p->n : 0) + 16.0 * 1024.0 + OUT_XML_CAP;
-    if (out_room(o->h5path, need, "a particle snapshot", step, t) != 0)
+    hid_t f, g = out_snapshot_open(o->h5path, need, "a particle snapshot", o->nsnap, step, t, &f);
+    if (g == H5I_INVALID_HID && f < 0)
         return -1;
-    hid_t f = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
-    if (f < 0) {
-        fprintf(stderr, "lahar: %s: cannot reopen for snapshot at step %" PRId64 "\n", o->h5path, step);
-        return -1;
-    }
-    char name[48];
-    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
-    hid_t g = out_group(f, name);
     int rc = g < 0 ? -1 : 0;
     hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
     if (g >= 0) {
-        rc |= out_attr_double(g, "time", t);
-        rc |= out_attr_int64(g, "step", step);
         rc |= out_attr_int64(g, "n", (int64_t)n);
         const struct {
             unsigned field;
@@ -1584,20 +1592,11 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         off += npoints[i];
     }
     double need = 48.0 * (double)off + 4096.0 * (o->nmarked + 1);
-    if (out_room(o->h5path, need, "the contact points", step, t) != 0)
+    hid_t file, g = out_snapshot_open(o->h5path, need, "the contact points", o->nsnap, step, t, &file);
+    if (g == H5I_INVALID_HID && file < 0)
         return -1;
-    hid_t file = out_file_open(o->h5path, H5F_ACC_RDWR, 0);
-    if (file < 0) {
-        fprintf(stderr, "lahar: %s: cannot reopen for contacts at step %" PRId64 "\n", o->h5path, step);
-        return -1;
-    }
-    char name[48];
-    snprintf(name, sizeof name, "/snapshots/%06" PRId64, o->nsnap);
-    hid_t g = out_group(file, name);
     int rc = g < 0 ? -1 : 0;
     if (g >= 0) {
-        rc |= out_attr_double(g, "time", t);
-        rc |= out_attr_int64(g, "step", step);
         for (int m = 0; m < o->nmarked && !rc; m++) {
             int b = o->marked[m], i = o->slot[b];
             hid_t bg = out_group(g, o->group[m]);
