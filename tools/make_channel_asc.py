@@ -20,8 +20,8 @@ from x = MASS_X0 = 19 m to MASS_X1 = 29 m on the 20 deg reach, its front 1 m abo
 NODATA top node as lying on the terrain: no material there).
 The grid: cellsize 1 m (default), nodes x = 0 .. 50, y = -6 .. 6; the slope break, the bed's and
 the banks' edges and the mass's ends lie on node lines, so the triangulated surface is exact (the
-SPH coupling's cost grows with the number of terrain features within a kernel support of each
-particle: 0.5 m cells cost about twice as much per step at dx = 0.3 m)."""
+SPH coupling visits the terrain features within a kernel support of each particle near it: coarser
+cells, fewer features; the channel needs no finer ones)."""
 import argparse
 import math
 import os
