@@ -310,10 +310,14 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     }
     r0 = r0 > 0 ? r0 - 1 : 0, c0 = c0 > 0 ? c0 - 1 : 0;
     r1 = r1 + 1 < bot->nrows ? r1 + 1 : r1, c1 = c1 + 1 < bot->ncols ? c1 + 1 : c1;
-    if (r1 == r0)
-        r1 < bot->nrows - 1 ? r1++ : r0--;
-    if (c1 == c0)
-        c1 < bot->ncols - 1 ? c1++ : c0--;
+    if (r1 == r0 && r1 < bot->nrows - 1) /* a one-row grid cannot hold a region (below) */
+        r1++;
+    else if (r1 == r0)
+        r0--;
+    if (c1 == c0 && c1 < bot->ncols - 1)
+        c1++;
+    else if (c1 == c0)
+        c0--;
     if (r0 < 0 || c0 < 0) {
         terr_err(err, errlen, "%s: the grid needs at least 2 x 2 nodes for a region", top_path);
         return -1;
