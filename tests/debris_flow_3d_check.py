@@ -21,10 +21,10 @@ RUN is the output folder of the run (its case: particles.h5's header case_path).
     probe when the force peaks, from the snapshot nearest to it) and --joukowsky-hi (default 2)
     x the acoustic (Joukowsky) pressure rho_w c0 u of a weakly compressible fluid stopped by a
     rigid wall; u the arriving flow's mean speed sqrt(2 E_K / M) in the control volume at its
-    largest momentum flux. The peak is of the order of rho_w c0 u (measured 0.96, 0.82, 1.35 x at
-    dx = 0.4, 0.3, 0.2 m: the front's local speed exceeds the mean, the peak sharpens with dx),
-    some 30 x the incompressible rho_w u^2: a wall model or a c0 that lost the acoustic impact,
-    or a dam the flow never reaches, fails it.
+    largest momentum flux. The peak is of the order of rho_w c0 u (measured 0.96, 0.82, 1.35, 0.37 x
+    at dx = 0.4, 0.3, 0.2, 0.1 m; the front's local speed exceeds the mean), 10-45 x the
+    incompressible rho_w u^2: a dam the flow never reaches, or a pressure far above the acoustic
+    one, fails it.
 Also printed (information): the dam's peak force (averaged over --window, default 0.02 s) against
 the momentum flux rho u^2 A = 2 E_K / L of the control volume just upstream of the dam (L its length
 along x; the hydrodynamic impact model F = alpha rho u^2 A) and against the hydrostatic thrust of
