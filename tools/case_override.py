@@ -9,7 +9,8 @@ PATH is a dotted key path into the case, VALUE is parsed as YAML:
     bodies.cylinder.radius=0.03      (a list element by its `name:`, or by its index: bodies.0)
     materials.rock.kn=1e8            (a missing map key is added)
     sph.delta=~                      (~ or null removes the key: the loader's default applies)
-Relative `file:` paths (STL blocks and bodies) and `hydrograph:` paths (inlets) are made absolute, so the copy may live anywhere.
+Relative `file:` paths (STL blocks and bodies, terrain), `hydrograph:` and `level_hydrograph:` paths (inlets)
+and `between: {top: FILE}` paths (terrain regions) are made absolute, so the copy may live anywhere.
 The copy starts with a comment naming the original and the overrides; everything else (the check:
 bounds included) is the original's. Comments and YAML anchors of the original are not kept (the
 anchors are expanded). Exit status 0, or 2 with a message naming the path that cannot be applied.
@@ -121,7 +122,8 @@ def get_path(doc, path, default=None):
 def _absolute_files(node, base):
     if isinstance(node, dict):
         for k, v in node.items():
-            if k in ("file", "hydrograph") and isinstance(v, str) and not os.path.isabs(v):
+            # `top:` of a between-region is a file when it is a string (2D: a CSV, 3D: an .asc)
+            if k in ("file", "hydrograph", "level_hydrograph", "top") and isinstance(v, str) and not os.path.isabs(v):
                 node[k] = os.path.normpath(os.path.join(base, v))
             else:
                 _absolute_files(v, base)

@@ -4,9 +4,9 @@
   tools/plot_gauges.py OUT [--tmax S] [--prefix NAME]
 
 Writes, for what the run has (OUT/gauges.h5, OUT/forces.h5):
-  OUT/trackers.png         per tracker (one row each) its velocity in x (left) and y (right) over t,
-                           as Trujillo-Vela et al. 2020 Fig. 18 and 25, and their paths over the
-                           initial and final particles in an extra panel
+  OUT/trackers.png         per tracker (one row each) its velocity in x (left) and y (right; z in
+                           3D) over t, as Trujillo-Vela et al. 2020 Fig. 18 and 25, and their paths
+                           over the initial and final particles in an extra panel (x-z in 3D)
   OUT/body_energy.png      per moving body its potential energy E_P (eq. 37; m g y_B, 0 at y = 0)
                            and kinetic energy E_K (eq. 38) over t, as Fig. 26
   OUT/control_volumes.png  per control volume its kinetic energy (eq. 39: particles and bodies
@@ -46,12 +46,14 @@ def clip(t, tmax):
 
 def plot_trackers(out, g, tmax):
     names = list(g.keys())
+    # 3D (z up): the velocity along the flow and the vertical one, paths in the x-z plane
+    up = "z" if any("vz" in g[n] for n in names) else "y"
     fig, ax = plt.subplots(len(names) + 1, 2, figsize=(10, 2.6 * (len(names) + 1)), squeeze=False)
     for k, n in enumerate(names):
         tr = g[n]
         t = tr["t"][:]
         m = clip(t, tmax)
-        for c, comp in enumerate(("vx", "vy")):
+        for c, comp in enumerate(("vx", "v" + up)):
             ax[k][c].plot(t[m], tr[comp][:][m], "b-")
             ax[k][c].set_ylabel("%s %s (%s)" % (n, comp, units(tr[comp])))
             ax[k][c].grid(alpha=0.3)
@@ -66,18 +68,18 @@ def plot_trackers(out, g, tmax):
         snaps = sorted(pf["snapshots"].keys())
         for s, col, lab in ((snaps[0], "0.75", "initial"), (snaps[-1], "tab:purple", "last snapshot")):
             sg = pf["snapshots"][s]
-            pa.plot(sg["x"][:], sg["y"][:], ".", ms=1, color=col, label="%s (t = %.3g s)" % (lab, sg.attrs["time"]))
+            pa.plot(sg["x"][:], sg[up][:], ".", ms=1, color=col, label="%s (t = %.3g s)" % (lab, sg.attrs["time"]))
         pf.close()
     for n in names:
         tr = g[n]
         m = clip(tr["t"][:], tmax)
-        pa.plot(tr["x"][:][m], tr["y"][:][m], "r--", lw=1)
+        pa.plot(tr["x"][:][m], tr[up][:][m], "r--", lw=1)
         if m.any():
-            pa.plot(tr["x"][0], tr["y"][0], "go")
-            pa.annotate(n, (tr["x"][0], tr["y"][0]))
+            pa.plot(tr["x"][0], tr[up][0], "go")
+            pa.annotate(n, (tr["x"][0], tr[up][0]))
     pa.set_aspect("equal", adjustable="datalim")
     pa.set_xlabel("x (m)")
-    pa.set_ylabel("y (m)")
+    pa.set_ylabel("%s (m)" % up)
     pa.set_title("tracker paths (red), start points (green)")
     pa.legend(fontsize=7, markerscale=8)
     ax[len(names)][1].axis("off")

@@ -272,16 +272,49 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
                  bot->x0, bot->y0);
         return -1;
     }
-    const int nc = bot->ncols, nr = bot->nrows;
-    for (int i = 0; i < nr; i++)
-        for (int j = 0; j < nc; j++)
+    for (int i = 0; i < bot->nrows; i++)
+        for (int j = 0; j < bot->ncols; j++)
             if (!lahar_heightmap_valid(bot, i, j)) {
                 lahar_errf(err, errlen, "%s: the terrain has no data at row %d from the north, column %d, inside the "
                          "grid of the region; a region between terrain and a surface needs the terrain everywhere "
-                         "on the grid", top_path, nr - i, j + 1);
+                         "on the grid", top_path, bot->nrows - i, j + 1);
                 return -1;
             }
-    /* vertices: bottom nodes 0 .. N-1, top nodes N .. 2N-1 */
+    /* The region is empty where the top is on (or below) the raised terrain: the mesh covers only
+     * the nodes' window [r0, r1] x [c0, c1] around the nodes with the top above it (one node more on
+     * each side, for the cells that taper to zero), so the lattice that fills it spans the region,
+     * not the whole grid (a small mass on a large terrain: the block's bounding box, and with it the
+     * lattice points tested against the mesh, scale with the mass). */
+    int r0 = bot->nrows, r1 = -1, c0 = bot->ncols, c1 = -1;
+    for (int i = 0; i < bot->nrows; i++)
+        for (int j = 0; j < bot->ncols; j++) {
+            int k = i * bot->ncols + j;
+            double zb = bot->z[k] + lift * grid_slope_factor(bot, i, j);
+            if (lahar_heightmap_valid(top, i, j) && top->z[k] > zb) {
+                r0 = i < r0 ? i : r0, r1 = i > r1 ? i : r1;
+                c0 = j < c0 ? j : c0, c1 = j > c1 ? j : c1;
+            }
+        }
+    if (r1 < 0) {
+        lahar_errf(err, errlen, "%s: the upper surface is nowhere above the terrain; the region is empty", top_path);
+        return -1;
+    }
+    r0 = r0 > 0 ? r0 - 1 : 0, c0 = c0 > 0 ? c0 - 1 : 0;
+    r1 = r1 + 1 < bot->nrows ? r1 + 1 : r1, c1 = c1 + 1 < bot->ncols ? c1 + 1 : c1;
+    if (r1 == r0 && r1 < bot->nrows - 1) /* a one-row grid cannot hold a region (below) */
+        r1++;
+    else if (r1 == r0)
+        r0--;
+    if (c1 == c0 && c1 < bot->ncols - 1)
+        c1++;
+    else if (c1 == c0)
+        c0--;
+    if (r0 < 0 || c0 < 0) {
+        lahar_errf(err, errlen, "%s: the grid needs at least 2 x 2 nodes for a region", top_path);
+        return -1;
+    }
+    /* vertices of the window (local node k = (i - r0) * nc + (j - c0)): bottom 0 .. N-1, top N .. 2N-1 */
+    const int nc = c1 - c0 + 1, nr = r1 - r0 + 1;
     const int N = nc * nr, nbound = 2 * (nc - 1) + 2 * (nr - 1);
     const int ntri = 4 * (nc - 1) * (nr - 1) + 2 * nbound;
     pb->vert = malloc((size_t)2 * N * sizeof *pb->vert);
@@ -292,15 +325,12 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
         lahar_errf(err, errlen, "out of memory for the region");
         return -1;
     }
-    int any = 0;
-    for (int i = 0; i < nr; i++)
-        for (int j = 0; j < nc; j++) {
-            int k = i * nc + j;
-            double zb = bot->z[k] + lift * grid_slope_factor(bot, i, j);
-            double zt = lahar_heightmap_valid(top, i, j) ? top->z[k] : zb;
-            if (zt > zb)
-                any = 1;
-            else
+    for (int i = r0; i <= r1; i++)
+        for (int j = c0; j <= c1; j++) {
+            int g = i * bot->ncols + j, k = (i - r0) * nc + (j - c0);
+            double zb = bot->z[g] + lift * grid_slope_factor(bot, i, j);
+            double zt = lahar_heightmap_valid(top, i, j) ? top->z[g] : zb;
+            if (!(zt > zb))
                 zt = zb;
             double x = bot->x0 + j * bot->cellsize, y = bot->y0 + i * bot->cellsize;
             pb->vert[k][0] = pb->vert[N + k][0] = x;
@@ -308,12 +338,6 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
             pb->vert[k][2] = zb;
             pb->vert[N + k][2] = zt;
         }
-    if (!any) {
-        free(pb->vert), free(pb->tri);
-        pb->vert = NULL, pb->tri = NULL;
-        lahar_errf(err, errlen, "%s: the upper surface is nowhere above the terrain; the region is empty", top_path);
-        return -1;
-    }
     int t = 0;
     for (int i = 0; i + 1 < nr; i++)
         for (int j = 0; j + 1 < nc; j++) {

@@ -38,7 +38,10 @@ int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *
  * (LAHAR_BLOCK_MESH: vert, tri, bounds). The terrain is raised by `lift` along its normal
  * (lift sqrt(1 + |grad z|^2) vertically at each node: the sweep radius plus the particles'
  * clearance dx/2). A top node below the raised terrain counts as on it (no soil there); a NODATA
- * top node also. Every bottom node must have data. 0, or -1 with a message naming top_path. */
+ * top node also. The mesh covers only the window of nodes around those with the top above the raised
+ * terrain (one node more on each side), so a small region on a large grid has a small bounding box
+ * (the lattice is cut from it). Every bottom node must have data. 0, or -1 with a message naming
+ * top_path. */
 int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
                           lahar_particle_block *pb, char *err, size_t errlen);
 
