@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "case_keys.h"
 #include "checkpoint.h"
 #include "instability.h"
 #include "lahar_body_state_t.h"
@@ -37,6 +38,7 @@
 #include "shape_build.h"
 #include "transport.h"
 #include "sph_inflow.h"
+#include "sph_soil_model.h"
 #include "sph_eos.h"
 #include "sph_probes.h"
 #include "vec.h"
@@ -173,6 +175,20 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
     for (int b = 0; b < c->nblock; b++) /* one soil material per case (the loader checks) */
         if (c->blocks[b].phase == SPH_SOIL_PHASE && c->blocks[b].material >= 0 && c->blocks[b].material < c->nmaterial) {
             const lahar_material *mt = &c->materials[c->blocks[b].material];
+            /* the constitutive model by its name in the key table (the case's choice) */
+            const lahar_key *ck = lahar_key_find(lahar_key_section_find("materials.NAME"), "constitutive");
+            int nchoice = 0;
+            while (ck && ck->choices[nchoice])
+                nchoice++;
+            const sph_soil_model *model = mt->constitutive >= 0 && mt->constitutive < nchoice
+                                              ? sph_soil_model_find(ck->choices[mt->constitutive])
+                                              : NULL;
+            if (!model) {
+                snprintf(err, errlen, "materials.%s.constitutive: model %d is not one this SPH node has (%s); "
+                         "update lahar-sph", mt->name, mt->constitutive,
+                         mt->constitutive >= 0 && mt->constitutive < nchoice ? ck->choices[mt->constitutive] : "?");
+                return -1;
+            }
             prm->soil = 1;
             prm->soil_mat = (sph_soil_material){.density = mt->density, .young = mt->young, .poisson = mt->poisson,
                                                 .phi = mt->friction_angle, .cohesion = mt->cohesion,
@@ -182,7 +198,8 @@ int lahar_sph_node_params(const lahar_case *c, sph_params *prm, char *err, size_
                                                 .gravity = {c->gravity[0], c->gravity[1], c->gravity[2]},
                                                 .g_ref = v3_norm(v3_load(c->gravity)) > 0.0
                                                              ? v3_norm(v3_load(c->gravity))
-                                                             : 9.81};
+                                                             : 9.81,
+                                                .model = model};
         }
     /* options of the case the solver core does not offer yet: refuse rather than ignore */
     if (o->halo > 0.0 && fabs(o->halo - 0.5 * c->sph_dx) > 1e-12 * c->sph_dx) {

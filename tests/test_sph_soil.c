@@ -31,7 +31,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include "shape_build.h"
+#include "case_keys.h"
 #include "sph_fluid.h"
+#include "sph_soil_model.h"
 
 #include "test_util.h"
 
@@ -56,6 +58,7 @@ static void test_return(void)
     sph_soil s;
     memset(&s, 0, sizeof s);
     s.mat = sand(30.0, 100.0);
+    s.model = sph_soil_model_find("drucker_prager"); /* what sph_soil_init picks for this material */
     sph_soil_constants(&s.mat, &s.G, &s.K, &s.cs, &s.alpha_phi, &s.kc, &s.alpha_psi);
     CHECK(fabs(s.alpha_phi - 0.1601281538) < 1e-9 && fabs(s.kc - 83.20502943) < 1e-6,
           "plane-strain constants alpha_phi %.10f k_c %.8f", s.alpha_phi, s.kc);
@@ -475,8 +478,24 @@ static void test_wall_gradient(void)
     lahar_shape_free(&plate.shape);
 }
 
+/* The constitutive models the case can name (materials.NAME.constitutive, common/io/case_keys.c)
+ * are the SPH node's (sph_soil_models.c), and a material without one is Drucker-Prager: the
+ * loader's index and the node's lookup agree, and sph_soil_init picks the same functions. */
+static void test_models(void)
+{
+    const lahar_key *k = lahar_key_find(lahar_key_section_find("materials.NAME"), "constitutive");
+    CHECK(k && k->choices && k->choices[0], "materials.NAME.constitutive: no choices in the key table");
+    for (int i = 0; k && k->choices && k->choices[i]; i++)
+        CHECK(sph_soil_model_find(k->choices[i]) != NULL, "constitutive model '%s' of the key table is not in "
+              "sph_soil_models.c", k->choices[i]);
+    CHECK(sph_soil_model_find("no_such_model") == NULL, "an unknown model name was found");
+    const sph_soil_model *dp = sph_soil_model_find("drucker_prager");
+    CHECK(dp && !strcmp(k ? k->def : "", "drucker_prager"), "the default model is not drucker_prager");
+}
+
 int main(void)
 {
+    test_models();
     test_return();
     test_elastic_rate();
     test_jaumann_and_uniform();

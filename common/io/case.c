@@ -62,6 +62,7 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
                       "it (the soil-DEM contact uses the SPH coupling's K_n, Trujillo-Vela et al. 2020 eq. 15)");
     /* the table (case_keys.c, materials.NAME) gives the defaults and ranges; the soil's own are
      * its Poisson ratio (0.3) and mu_phi = tan(friction_angle) */
+    mat->constitutive = rd_key_choice(m, "constitutive");
     mat->young = rd_key_num_req(m, "young", 1, NAN);
     mat->poisson = rd_key_num_def(m, "poisson", 0.3);
     double phi = rd_key_num_req(m, "friction_angle", 1, NAN);
@@ -92,8 +93,8 @@ static void read_soil_material(rmap *m, lahar_material *mat, const char *const *
 
 static void read_materials(reader *r, yaml_node_t *n, lahar_case *c)
 {
-    static const char *const soil_only[] = {"friction_angle", "cohesion", "dilatancy", "permeability", "damping",
-                                            "av_alpha", "av_beta", NULL};
+    static const char *const soil_only[] = {"constitutive", "friction_angle", "cohesion", "dilatancy", "permeability",
+                                            "damping", "av_alpha", "av_beta", NULL};
     static const char *const dem_only[] = {"kn", "kt_ratio", "restitution", NULL};
     rmap top;
     if (rmap_open(r, n, "materials", &top) != 0)

@@ -44,6 +44,8 @@ static const lahar_key time_keys[] = {
     END};
 
 static const char *const material_models[] = {"linear", "hertz", "soil", NULL};
+/* the soil's constitutive models: the names of sph_node/soil/sph_soil_models.c, in lahar_material.constitutive's order */
+static const char *const constitutive_models[] = {"drucker_prager", NULL};
 static const lahar_key material_keys[] = {
     {"density", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "kg/m^3", "density (bodies: their mass properties come from it, soil: bulk density)", NULL},
     {"model", LAHAR_KEY_CHOICE, 0, "hertz", 0, 0, 0, material_models, "", "DEM contact law (linear, hertz) or an SPH soil (soil)", NULL},
@@ -53,6 +55,7 @@ static const lahar_key material_keys[] = {
     {"kt_ratio", LAHAR_KEY_NUMBER, 0, "2/7", LOX, 0, 0, NULL, "", "tangential / normal stiffness (DEM); 2/7 is the usual choice", NULL},
     {"restitution", LAHAR_KEY_NUMBER, 0, NULL, LOX | HI, 0, 1, NULL, "", "normal coefficient of restitution (required for DEM materials); 1 is elastic, small values are very dissipative", NULL},
     {"friction", LAHAR_KEY_NUMBER, 0, "soil: tan(friction_angle)", LO, 0, 0, NULL, "", "Coulomb friction coefficient (DEM: required, soil: the soil-DEM mu_phi); 0 is frictionless", NULL},
+    {"constitutive", LAHAR_KEY_CHOICE, 0, "drucker_prager", 0, 0, 0, constitutive_models, "", "soil: the constitutive model (drucker_prager: Trujillo-Vela et al. 2020 eq. 6-7, sph_node/soil/)", NULL},
     {"friction_angle", LAHAR_KEY_NUMBER, 0, NULL, LO | HIX, 0, 90, NULL, "degrees", "soil: Mohr-Coulomb friction angle (required for soil); sands are about 30", NULL},
     {"cohesion", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Pa", "soil: cohesion; 0 for a dry sand", NULL},
     {"dilatancy", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "degrees", "soil: dilatancy angle (<= friction_angle); 0 is usual", NULL},

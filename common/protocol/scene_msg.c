@@ -23,7 +23,7 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 #define SPH_ARRAY_FIELDS(X) X(body_force) X(lo) X(hi)
 #define MATERIAL_NUM_FIELDS(X) X(density) X(young) X(poisson) X(kn) X(kt_ratio) X(restitution) X(friction) \
     X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
-#define MATERIAL_CODE_FIELDS(X) X(model)
+#define MATERIAL_CODE_FIELDS(X) X(model) X(constitutive)
 
 
 /* The kernel string points into from (keep it alive while to is used). */

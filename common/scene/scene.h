@@ -33,6 +33,8 @@ typedef struct {
     double permeability;    /* k_h, Darcy hydraulic conductivity, m/s (0: no seepage) */
     double damping;         /* c_d, 1/s: velocity damping -c_d v of the soil (quasi-static start; 0 = off) */
     double av_alpha, av_beta; /* Monaghan artificial viscosity of the soil (Trujillo-Vela et al. 2020 section 5.3: 1, 1) */
+    int constitutive;       /* soil: the constitutive model, the index of its name in the choices of
+                               materials.NAME.constitutive (common/io/case_keys.c; 0 drucker_prager) */
 } lahar_material;
 
 /* A sphero-polyhedron: a convex (or, for fixed bodies, any) set of vertices, edges and faces

@@ -72,13 +72,15 @@ typedef struct {
     double g_ref;          /* g of k = k_h mu / (rho_w g), m/s^2 */
     double gravity[3];     /* m/s^2: the soil's body force (sph.body_force drives the water only) */
     double rho_water;      /* rho_w of the same, kg/m^3 */
+    const struct sph_soil_model *model; /* the constitutive model (sph_soil_model.h); NULL: Drucker-Prager */
 } sph_soil_material;
 
-typedef struct {
+typedef struct sph_soil {
     sph_soil_material mat;
+    const struct sph_soil_model *model; /* the constitutive model in use (never NULL after init) */
     int dim;
     double G, K, cs;               /* shear and bulk modulus, P-wave speed */
-    double alpha_phi, kc, alpha_psi; /* Drucker-Prager constants (plane-strain match) */
+    double alpha_phi, kc, alpha_psi; /* the model's constants (Drucker-Prager's plane-strain match) */
     double w_dx;                   /* W(dx), the artificial stress's reference */
     int64_t cap;
     double *dsig[SPH_NSTRESS];     /* stress rate of the last evaluation (sorted order) */
@@ -96,7 +98,8 @@ typedef struct {
                                     * velocity gradient L_ab (index 3a + b) of the last pass 1 */
 } sph_soil;
 
-/* Derived constants (G, K, c_s, alpha_phi, k_c, alpha_psi) of a material. */
+/* Derived constants (G, K, c_s, alpha_phi, k_c, alpha_psi) of a Drucker-Prager material
+ * (sph_soil_dp.c). */
 void sph_soil_constants(const sph_soil_material *m, double *G, double *K, double *cs, double *alpha_phi,
                         double *kc, double *alpha_psi);
 
@@ -123,8 +126,8 @@ int sph_soil_keep_gradient(sph_soil *s);
  * (sph_coupling.h, sph_coupling_set_soil_wall). */
 void sph_soil_wall_gradient(sph_soil *s, const sph_particles *p, int64_t i, const double Lw[9]);
 
-/* Tension cracking and the return to the yield surface (Bui 2008 section 3.3) of one stress
- * (xx, xy, xz, yy, yz, zz), in place. */
+/* The model's return to its admissible stresses (Drucker-Prager: tension cracking and the return
+ * to the yield surface, Bui 2008 section 3.3) of one stress (xx, xy, xz, yy, yz, zz), in place. */
 void sph_soil_return(const sph_soil *s, double sig[SPH_NSTRESS]);
 
 /* Seepage (sph_soil.h, Trujillo-Vela et al. 2020 eq. 8-10) on the water particles: their reaction to every soil
