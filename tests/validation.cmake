@@ -3,8 +3,8 @@
 # exits 0 (every metric of the case within its bound) and, where the issue asks more than the
 # case's metrics state, when the extra check.json values hold too (tests/validation_check.sh).
 # The bounds are the cases' own (the issue's); only dx, the duration and the cylinder's solid
-# fraction are overridden. Measured values and the full-resolution runs: cases/README.md,
-# "Validation results". Run them all: ctest -L validation.
+# fraction are overridden. Measured values and the full-resolution runs: docs/bench/validation.md.
+# Run them all: ctest -L validation.
 set(LAHAR_VALIDATION_DIR ${CMAKE_CURRENT_BINARY_DIR}/validation)
 
 # name, script arguments after LAHAR CASE OUT
@@ -33,8 +33,7 @@ lahar_validation_test(floating_box_2d floating_box_2d dx=0.01 "draft_spread_rel<
 # Cylinder array (Trujillo-Vela et al. 2020, section 5.2; K = rho a L^2 / (mu U_s), U_s the superficial velocity, within
 # 5 % of Sangani & Acrivos) at 50 x 50 (dx = 4 mm) for c = 0.05, 0.1 and 0.4, 200 s with the case's
 # particle shifting (c = 0.05 measured 2.3 %; 14 % without shifting, which this test would fail);
-# the full sweep (c = 0.05 ... 0.4 at 100 x 100, all within 2.5 %) on demand: cases/README.md,
-# "Validation results".
+# the full sweep (c = 0.05 ... 0.4 at 100 x 100, all within 2.5 %) on demand: docs/bench/validation.md.
 lahar_validation_test(cylinder_array_2d_c0.05 cylinder_array_2d dx=0.004 c=0.05)
 # Sinking disc: lahar check's floor_penetration = 0, and what its metrics cannot state: the disc
 # sinks most of the way (its bottom starts 0.1275 m above the floor), turns, stops (speed < 5 % of
@@ -46,7 +45,7 @@ lahar_validation_test(cylinder_array_2d_c0.4 cylinder_array_2d dx=0.004 c=0.4)
 # (sph.body_layers), c0 = 0.2: the issue's 5 % and steady within the case's 1 % over the last
 # quarter, each run about 8-20 Darcy times. c = 0.064 and 0.125 on the case's 20^3 lattice (a/dx =
 # 5.0, 6.2; 30 and 20 s), c = 0.216 on 24^3 (a/dx = 8.9, 16 s: at 20^3 it reads -4.9 %, too close
-# to the bound to guard anything). Measured (cases/README.md, "Sphere array"): K -3.85 %, -3.81 %, -3.36 %,
+# to the bound to guard anything). Measured (docs/bench/validation.md, "Sphere array"): K -3.85 %, -3.81 %, -3.36 %,
 # U_change_rel 0.58 %, 0.20 %, 0.18 %. With the plain lattice cut by the sphere (body_layers: 0)
 # the first row's count drifts and K with it (c = 0.125 at 20^3, 20 s: K +2.9 %, U_change_rel 1.9 %,
 # fails).
@@ -56,7 +55,7 @@ lahar_validation_test(sphere_array_3d_c0.216 sphere_array_3d c=0.216 dx=0.008333
 lahar_validation_test(sinking_disc_2d sinking_disc_2d dx=0.005
   "sink_distance>=0.1" "rotation_deg>=10" "final_speed_rel<=0.05" "rest_gap_rel<=1")
 
-# Hydrostatic tank (cases/README.md "Validation results"): side wall force within 1 % of
+# Hydrostatic tank (docs/bench/validation.md): side wall force within 1 % of
 # rho g h^2 / 2 (x width in 3D) and particle pressures within 1 % (L2) of rho g (h - y), at dx =
 # 10 mm (20 rows), 2 s in 2D and 1 s in 3D (the tanks start at rest on their lattice, so this is
 # settled: max speed < 1 % of sqrt(g h)); also the free surface level within 5 % of h.
@@ -77,7 +76,7 @@ lahar_validation_test(lid_driven_cavity_2d lid_driven_cavity_2d dx=0.025 threads
 # density within 2 % (max over snapshots 1.0 %), and bitwise the same particles.h5 on 1 and 2
 # threads (tests/validation_taylor_green.sh). At 100 x 100, the case as it is (~25 s CPU): the
 # case's 1 % (measured 0.61 %), L2 <= 0.20 (0.143), mean density within 1.5 % (0.91 %).
-# cases/README.md "Taylor-Green vortex".
+# docs/bench/validation.md "Taylor-Green vortex".
 lahar_test(validation_taylor_green_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_taylor_green.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/taylor_green_2d.yaml ${LAHAR_VALIDATION_DIR}/taylor_green_2d ${LAHAR_OUTPUT_PYTHON}
   LABELS validation slow TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
 lahar_validation_test(taylor_green_2d_100 taylor_green_2d "velocity_l2_rel_error<=0.20"

@@ -59,7 +59,7 @@ void sph_fluid_shift(sph_fluid *f)
          * It follows the summation density of the moved particles to first order (test_sph_fluid).
          * Without it the densities keep the history of a particle arrangement the shift has
          * undone: in a closed box the total volume sum m/rho fell by 9.6 % in 30 s of the
-         * lid-driven cavity (cases/README.md), with it by < 0.1 %. rhoh is free between steps. */
+         * lid-driven cavity (docs/bench/validation.md), with it by < 0.1 %. rhoh is free between steps. */
 #pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
         for (int64_t i = 0; i < n; i++) {
             double s = 0.0;
