@@ -78,6 +78,17 @@ static int load_material(const char *key, const char *value, lahar_case *c, char
     return lahar_case_load_mem("keys.yaml", text, (size_t)len, c, err, n);
 }
 
+/* A value of key k just outside its range (below lo, else above hi) as text, and the table's
+ * message for it. */
+static void outside(const lahar_key *k, char value[64], char want[512])
+{
+    double bad = k->range & LAHAR_KEY_LO ? k->lo - 1.0 : k->hi + 1.0;
+    if (k->range & LAHAR_KEY_LO_OPEN && k->range & LAHAR_KEY_LO)
+        bad = k->lo;
+    snprintf(value, 64, "%.17g", bad);
+    lahar_key_range_error(k, bad, want, 512);
+}
+
 int main(void)
 {
     static const char *const checked[] = {"time", "dem", "stability", "checkpoint", "sph"};
@@ -126,13 +137,8 @@ int main(void)
                   k->name, err);
             if (!(k->range & (LAHAR_KEY_LO | LAHAR_KEY_HI)))
                 continue;
-            /* just outside the range (below lo, else above hi) */
-            double bad = k->range & LAHAR_KEY_LO ? k->lo - 1.0 : k->hi + 1.0;
-            if (k->range & LAHAR_KEY_LO_OPEN && k->range & LAHAR_KEY_LO)
-                bad = k->lo;
             char value[64], want[512], path[96];
-            snprintf(value, sizeof value, "%.17g", bad);
-            lahar_key_range_error(k, bad, want, sizeof want);
+            outside(k, value, want);
             snprintf(path, sizeof path, "%s.%s: ", checked[s], k->name);
             int rc = load_with(checked[s], k->name, value, &c, err, sizeof err);
             if (rc == 0)
@@ -149,12 +155,8 @@ int main(void)
     for (const lahar_key *k = ms ? ms->keys : NULL; k && k->name; k++) {
         if (k->type != LAHAR_KEY_NUMBER || !(k->range & (LAHAR_KEY_LO | LAHAR_KEY_HI)))
             continue;
-        double bad = k->range & LAHAR_KEY_LO ? k->lo - 1.0 : k->hi + 1.0;
-        if (k->range & LAHAR_KEY_LO_OPEN && k->range & LAHAR_KEY_LO)
-            bad = k->lo;
         char value[64], want[512], path[96];
-        snprintf(value, sizeof value, "%.17g", bad);
-        lahar_key_range_error(k, bad, want, sizeof want);
+        outside(k, value, want);
         snprintf(path, sizeof path, "materials.m.%s: ", k->name);
         int rc = load_material(k->name, value, &c, err, sizeof err);
         if (rc == 0)
