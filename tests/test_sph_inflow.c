@@ -69,6 +69,22 @@ static void wall(lahar_body *b, const double lo[3], const double hi[3])
     b->q[0] = 1.0;
 }
 
+/* The water of every test here: 2D, Wendland C2 with h = 1.41 dx, rho0 = 1000, mu = 1e-3,
+ * Monaghan alpha 0.02, delta-SPH 0.1. */
+static void water_params(sph_params *prm, double dx, double c0)
+{
+    sph_params_default(prm);
+    prm->dim = 2;
+    prm->dx = dx;
+    snprintf(prm->opt.kernel, sizeof prm->opt.kernel, "%s", "wendland2");
+    prm->opt.h_over_dx = 1.41;
+    prm->rho0 = 1000.0;
+    prm->opt.c0 = c0;
+    prm->opt.mu = 1e-3;
+    prm->opt.alpha = 0.02;
+    prm->opt.delta = 0.1;
+}
+
 typedef struct {
     sph_fluid f;
     sph_inflow fl;
@@ -83,16 +99,7 @@ static int channel_open(channel *ch, double dx, double h, double L, double c0, l
     memset(ch, 0, sizeof *ch);
     ch->dx = dx, ch->h = h;
     sph_params prm;
-    sph_params_default(&prm);
-    prm.dim = 2;
-    prm.dx = dx;
-    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
-    prm.opt.h_over_dx = 1.41;
-    prm.rho0 = 1000.0;
-    prm.opt.c0 = c0;
-    prm.opt.mu = 1e-3;
-    prm.opt.alpha = 0.02;
-    prm.opt.delta = 0.1;
+    water_params(&prm, dx, c0);
     prm.body_force[1] = -G;
     const double g[3] = {0.0, -G, 0.0};
     in->x0[0] = 0.0, in->x0[1] = 0.0, in->x0[2] = 0.0;
@@ -556,16 +563,7 @@ static void test_soil_outflow(void)
     const double dx = 0.01, H = 0.1, W = 0.1, L = 0.15, u = 1.0, rho_s = 2000.0, rho_w = 1000.0;
     const int ni = (int)(W / dx + 0.5), nj = (int)(H / dx + 0.5);
     sph_params prm;
-    sph_params_default(&prm);
-    prm.dim = 2;
-    prm.dx = dx;
-    snprintf(prm.opt.kernel, sizeof prm.opt.kernel, "%s", "wendland2");
-    prm.opt.h_over_dx = 1.41;
-    prm.rho0 = rho_w;
-    prm.opt.c0 = 10.0;
-    prm.opt.mu = 1e-3;
-    prm.opt.alpha = 0.02;
-    prm.opt.delta = 0.1;
+    water_params(&prm, dx, 10.0); /* rho0 = rho_w */
     prm.soil = 1;
     prm.soil_mat = (sph_soil_material){.density = rho_s, .young = 1e6, .poisson = 0.3, .phi = 30.0 * 3.14159265358979323846 / 180.0,
                                        .cohesion = 0.0, .psi = 0.0, .mu_phi = 0.5, .av_alpha = 0.1, .g_ref = G,

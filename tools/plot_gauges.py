@@ -44,6 +44,15 @@ def clip(t, tmax):
     return np.ones(len(t), bool) if tmax is None else t <= tmax
 
 
+def save(fig, out, name):
+    """Lay out, write OUT/name at 110 dpi, close; the path."""
+    fig.tight_layout()
+    path = os.path.join(out, name)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot_trackers(out, g, tmax):
     names = list(g.keys())
     # 3D (z up): the velocity along the flow and the vertical one, paths in the x-z plane
@@ -83,11 +92,7 @@ def plot_trackers(out, g, tmax):
     pa.set_title("tracker paths (red), start points (green)")
     pa.legend(fontsize=7, markerscale=8)
     ax[len(names)][1].axis("off")
-    fig.tight_layout()
-    path = os.path.join(out, "trackers.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, out, "trackers.png")
 
 
 def plot_body_energy(out, f, tmax):
@@ -112,11 +117,7 @@ def plot_body_energy(out, f, tmax):
         a.set_ylabel("%s (%s)" % (lab, units(f["energy"])))
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
-    fig.tight_layout()
-    path = os.path.join(out, "body_energy.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, out, "body_energy.png")
 
 
 def plot_control_volumes(out, g, tmax):
@@ -146,11 +147,7 @@ def plot_control_volumes(out, g, tmax):
         a.legend(fontsize=8)
     for c in range(2):
         ax[-1][c].set_xlabel("t (s)")
-    fig.tight_layout()
-    path = os.path.join(out, "control_volumes.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, out, "control_volumes.png")
 
 
 def main():
