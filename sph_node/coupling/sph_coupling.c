@@ -1,5 +1,6 @@
 /* SPH-DEM coupling (sph_coupling.h; Trujillo-Vela et al. 2020 section 4). */
 #include "sph_coupling.h"
+#include "soa_alloc.h"
 #include "sph_riemann.h"
 #include "sph_wall_ghost.h"
 #include <float.h>
@@ -43,10 +44,10 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->torque = calloc((size_t)nb, sizeof *c->torque);
     c->body_start = calloc((size_t)nb + 1, sizeof *c->body_start);
     c->body_fill = calloc((size_t)nb, sizeof *c->body_fill);
-    c->slot_n = calloc((size_t)c->pcap, sizeof *c->slot_n);
-    c->near = calloc((size_t)c->pcap, sizeof *c->near);
-    c->slot_body = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot_body);
-    c->slot = calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
+    c->slot_n = lahar_soa_calloc((size_t)c->pcap, sizeof *c->slot_n);
+    c->near = lahar_soa_calloc((size_t)c->pcap, sizeof *c->near);
+    c->slot_body = lahar_soa_calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot_body);
+    c->slot = lahar_soa_calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
     c->contacts_cap = 1024;
     c->contacts = calloc((size_t)c->contacts_cap, sizeof *c->contacts);
     if (!c->bound || !c->box || !c->grid || !c->has_grid || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
@@ -124,10 +125,10 @@ void sph_coupling_free(sph_coupling *c)
     free(c->torque);
     free(c->body_start);
     free(c->body_fill);
-    free(c->slot_n);
-    free(c->near);
-    free(c->slot_body);
-    free(c->slot);
+    lahar_soa_free(c->slot_n);
+    lahar_soa_free(c->near);
+    lahar_soa_free(c->slot_body);
+    lahar_soa_free(c->slot);
     free(c->contacts);
     free(c->soil_hist_body);
     free(c->soil_hist_d);

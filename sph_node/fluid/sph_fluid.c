@@ -1,5 +1,6 @@
 /* WCSPH solver core (sph_fluid.h). */
 #include "sph_fluid.h"
+#include "soa_alloc.h"
 #include "sph_eos.h"
 #include "sph_riemann.h"
 #include "sph_pair_terms.h"
@@ -45,11 +46,11 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
         sph_particles_free(&f->p);
         return -1;
     }
-    f->prho2 = calloc((size_t)f->p.cap, sizeof(double));
-    f->vol = calloc((size_t)f->p.cap, sizeof(double));
+    f->prho2 = lahar_soa_calloc((size_t)f->p.cap, sizeof(double));
+    f->vol = lahar_soa_calloc((size_t)f->p.cap, sizeof(double));
     if (!f->prho2 || !f->vol) {
-        free(f->prho2);
-        free(f->vol);
+        lahar_soa_free(f->prho2);
+        lahar_soa_free(f->vol);
         sph_cells_free(&f->cells);
         sph_particles_free(&f->p);
         snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)cap);
@@ -57,10 +58,10 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
     }
     if (o->sps) {
         /* nu_t and the six stress components in one block, only when SPS is on */
-        double *buf = calloc((size_t)f->p.cap * 7, sizeof(double));
+        double *buf = lahar_soa_calloc((size_t)f->p.cap * 7, sizeof(double));
         if (!buf) {
-            free(f->prho2);
-            free(f->vol);
+            lahar_soa_free(f->prho2);
+            lahar_soa_free(f->vol);
             sph_cells_free(&f->cells);
             sph_particles_free(&f->p);
             snprintf(err, (size_t)errlen, "out of memory for the SPS stress of %lld particles", (long long)cap);
@@ -71,12 +72,12 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
             f->sps_tau[a] = buf + (size_t)f->p.cap * (size_t)(a + 1);
     }
     if (o->transport_velocity) { /* v~ - v per particle, and the background-pressure acceleration */
-        double *buf = calloc((size_t)f->p.cap * 3, sizeof(double));
+        double *buf = lahar_soa_calloc((size_t)f->p.cap * 3, sizeof(double));
         if (!buf || sph_particles_alloc_transport(&f->p) != 0) {
-            free(buf);
-            free(f->sps_nut);
-            free(f->prho2);
-            free(f->vol);
+            lahar_soa_free(buf);
+            lahar_soa_free(f->sps_nut);
+            lahar_soa_free(f->prho2);
+            lahar_soa_free(f->vol);
             sph_cells_free(&f->cells);
             sph_particles_free(&f->p);
             snprintf(err, (size_t)errlen, "out of memory for the transport velocity of %lld particles", (long long)cap);
@@ -88,10 +89,10 @@ int sph_fluid_init(sph_fluid *f, const sph_params *prm, int64_t cap, char *err, 
     }
     if (p->soil) { /* stress arrays only when the scene has soil */
         if (sph_soil_init(&f->soil, &p->soil_mat, p->dim, &f->k, p->dx, &f->p) != 0) {
-            free(f->sps_nut);
-            free(f->tv_bx);
-            free(f->prho2);
-            free(f->vol);
+            lahar_soa_free(f->sps_nut);
+            lahar_soa_free(f->tv_bx);
+            lahar_soa_free(f->prho2);
+            lahar_soa_free(f->vol);
             sph_cells_free(&f->cells);
             sph_particles_free(&f->p);
             snprintf(err, (size_t)errlen, "out of memory for the soil stress of %lld particles", (long long)cap);
@@ -157,10 +158,10 @@ void sph_fluid_free(sph_fluid *f)
 {
     if (f->has_bodies)
         sph_coupling_free(&f->cpl);
-    free(f->sps_nut);
-    free(f->tv_bx);
-    free(f->prho2);
-    free(f->vol);
+    lahar_soa_free(f->sps_nut);
+    lahar_soa_free(f->tv_bx);
+    lahar_soa_free(f->prho2);
+    lahar_soa_free(f->vol);
     if (f->has_soil)
         sph_soil_free(&f->soil);
     sph_cells_free(&f->cells);

@@ -1,5 +1,6 @@
 /* Open boundaries of the SPH fluid (sph_inflow.h). */
 #include "sph_inflow.h"
+#include "soa_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -198,7 +199,7 @@ static int inlet_rows(sph_inflow *fl, sph_fluid *f, int k, double t, char *err, 
 int sph_inflow_start(sph_inflow *fl, sph_fluid *f, double t, char *err, int errlen)
 {
     sph_particles *p = &f->p;
-    if (sph_particles_alloc_inlet(p) != 0 || !(fl->drop = calloc((size_t)p->cap, 1))) {
+    if (sph_particles_alloc_inlet(p) != 0 || !(fl->drop = lahar_soa_calloc((size_t)p->cap, 1))) {
         snprintf(err, (size_t)errlen, "out of memory for %lld particles", (long long)p->cap);
         return -1;
     }
@@ -320,6 +321,6 @@ void sph_inflow_free(sph_inflow *fl)
     for (int k = 0; k < fl->ninlet; k++)
         free(fl->in[k].slot), free(fl->in[k].slot_s);
     free(fl->in);
-    free(fl->drop);
+    lahar_soa_free(fl->drop);
     memset(fl, 0, sizeof *fl);
 }

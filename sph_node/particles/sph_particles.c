@@ -1,5 +1,6 @@
 /* SPH particle storage and cell lists (sph_particles.h). */
 #include "sph_particles.h"
+#include "soa_alloc.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,12 +24,12 @@ int sph_particles_init(sph_particles *p, int64_t cap)
     particle_doubles(p, a);
     int ok = 1;
     for (int k = 0; k < SPH_NDOUBLE; k++)
-        ok &= (*a[k] = calloc((size_t)cap, sizeof(double))) != NULL;
-    ok &= (p->scratch_d = calloc((size_t)cap, sizeof(double))) != NULL;
-    ok &= (p->id = calloc((size_t)cap, sizeof *p->id)) != NULL;
-    ok &= (p->scratch_i = calloc((size_t)cap, sizeof *p->scratch_i)) != NULL;
-    ok &= (p->phase = calloc((size_t)cap, sizeof *p->phase)) != NULL;
-    ok &= (p->scratch_p = calloc((size_t)cap, sizeof *p->scratch_p)) != NULL;
+        ok &= (*a[k] = lahar_soa_calloc((size_t)cap, sizeof(double))) != NULL;
+    ok &= (p->scratch_d = lahar_soa_calloc((size_t)cap, sizeof(double))) != NULL;
+    ok &= (p->id = lahar_soa_calloc((size_t)cap, sizeof *p->id)) != NULL;
+    ok &= (p->scratch_i = lahar_soa_calloc((size_t)cap, sizeof *p->scratch_i)) != NULL;
+    ok &= (p->phase = lahar_soa_calloc((size_t)cap, sizeof *p->phase)) != NULL;
+    ok &= (p->scratch_p = lahar_soa_calloc((size_t)cap, sizeof *p->scratch_p)) != NULL;
     if (!ok) {
         sph_particles_free(p);
         return -1;
@@ -43,12 +44,12 @@ int sph_particles_alloc_stress(sph_particles *p)
         return 0;
     int ok = 1;
     for (int k = 0; k < SPH_NSTRESS; k++) {
-        ok &= (p->sig[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
-        ok &= (p->sigh[k] = calloc((size_t)p->cap, sizeof(double))) != NULL;
+        ok &= (p->sig[k] = lahar_soa_calloc((size_t)p->cap, sizeof(double))) != NULL;
+        ok &= (p->sigh[k] = lahar_soa_calloc((size_t)p->cap, sizeof(double))) != NULL;
     }
     if (!ok) {
         for (int k = 0; k < SPH_NSTRESS; k++) {
-            free(p->sig[k]), free(p->sigh[k]);
+            lahar_soa_free(p->sig[k]), lahar_soa_free(p->sigh[k]);
             p->sig[k] = p->sigh[k] = NULL;
         }
         return -1;
@@ -60,11 +61,11 @@ int sph_particles_alloc_transport(sph_particles *p)
 {
     if (p->tvx)
         return 0;
-    p->tvx = calloc((size_t)p->cap, sizeof(double));
-    p->tvy = calloc((size_t)p->cap, sizeof(double));
-    p->tvz = calloc((size_t)p->cap, sizeof(double));
+    p->tvx = lahar_soa_calloc((size_t)p->cap, sizeof(double));
+    p->tvy = lahar_soa_calloc((size_t)p->cap, sizeof(double));
+    p->tvz = lahar_soa_calloc((size_t)p->cap, sizeof(double));
     if (!p->tvx || !p->tvy || !p->tvz) {
-        free(p->tvx), free(p->tvy), free(p->tvz);
+        lahar_soa_free(p->tvx), lahar_soa_free(p->tvy), lahar_soa_free(p->tvz);
         p->tvx = p->tvy = p->tvz = NULL;
         return -1;
     }
@@ -75,7 +76,7 @@ int sph_particles_alloc_inlet(sph_particles *p)
 {
     if (p->inlet)
         return 0;
-    if (!(p->inlet = malloc((size_t)p->cap * sizeof *p->inlet)))
+    if (!(p->inlet = lahar_soa_calloc((size_t)p->cap, sizeof *p->inlet)))
         return -1;
     for (int64_t i = 0; i < p->cap; i++)
         p->inlet[i] = -1;
@@ -113,19 +114,19 @@ int64_t sph_particles_remove(sph_particles *p, const unsigned char *drop)
 
 void sph_particles_free(sph_particles *p)
 {
-    free(p->inlet);
-    free(p->tvx), free(p->tvy), free(p->tvz);
+    lahar_soa_free(p->inlet);
+    lahar_soa_free(p->tvx), lahar_soa_free(p->tvy), lahar_soa_free(p->tvz);
     for (int k = 0; k < SPH_NSTRESS; k++)
-        free(p->sig[k]), free(p->sigh[k]);
+        lahar_soa_free(p->sig[k]), lahar_soa_free(p->sigh[k]);
     double **a[SPH_NDOUBLE];
     particle_doubles(p, a);
     for (int k = 0; k < SPH_NDOUBLE; k++)
-        free(*a[k]);
-    free(p->scratch_d);
-    free(p->id);
-    free(p->scratch_i);
-    free(p->phase);
-    free(p->scratch_p);
+        lahar_soa_free(*a[k]);
+    lahar_soa_free(p->scratch_d);
+    lahar_soa_free(p->id);
+    lahar_soa_free(p->scratch_i);
+    lahar_soa_free(p->phase);
+    lahar_soa_free(p->scratch_p);
     memset(p, 0, sizeof *p);
 }
 
@@ -205,8 +206,8 @@ int sph_cells_init(sph_cells *c, int dim, double support, const int periodic[3],
     c->ncell_cap = 1024;
     c->start = calloc((size_t)c->ncell_cap + 1, sizeof *c->start);
     c->count = calloc((size_t)c->ncell_cap, sizeof *c->count);
-    c->cell_of = calloc((size_t)c->pcap, sizeof *c->cell_of);
-    c->perm = calloc((size_t)c->pcap, sizeof *c->perm);
+    c->cell_of = lahar_soa_calloc((size_t)c->pcap, sizeof *c->cell_of);
+    c->perm = lahar_soa_calloc((size_t)c->pcap, sizeof *c->perm);
     if (!c->start || !c->count || !c->cell_of || !c->perm) {
         sph_cells_free(c);
         snprintf(err, (size_t)errlen, "out of memory");
@@ -219,8 +220,8 @@ void sph_cells_free(sph_cells *c)
 {
     free(c->start);
     free(c->count);
-    free(c->cell_of);
-    free(c->perm);
+    lahar_soa_free(c->cell_of);
+    lahar_soa_free(c->perm);
     memset(c, 0, sizeof *c);
 }
 

@@ -1,5 +1,6 @@
 /* SPH soil: Drucker-Prager stress, its rates and the soil momentum (sph_soil.h). */
 #include "sph_soil.h"
+#include "soa_alloc.h"
 #include "sph_soil_model.h"
 #include <math.h>
 #include <stdlib.h>
@@ -22,18 +23,18 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
         return -1;
     int ok = 1;
     for (int a = 0; a < SPH_NSTRESS; a++) {
-        ok &= (s->dsig[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
-        ok &= (s->rart[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
-        ok &= (s->sig_rho2[a] = calloc((size_t)s->cap, sizeof(double))) != NULL;
+        ok &= (s->dsig[a] = lahar_soa_calloc((size_t)s->cap, sizeof(double))) != NULL;
+        ok &= (s->rart[a] = lahar_soa_calloc((size_t)s->cap, sizeof(double))) != NULL;
+        ok &= (s->sig_rho2[a] = lahar_soa_calloc((size_t)s->cap, sizeof(double))) != NULL;
     }
-    ok &= (s->tensile = calloc((size_t)s->cap, 1)) != NULL;
+    ok &= (s->tensile = lahar_soa_calloc((size_t)s->cap, 1)) != NULL;
     /* soil neighbours of pass 1 for pass 2: room for 1.5 x the lattice's count plus 16 (a soil
      * compressed beyond that walks the cells again, particle by particle) */
     const double sr = k->support / dx;
     const double nominal = dim == 3 ? 4.0 / 3.0 * M_PI * sr * sr * sr : M_PI * sr * sr;
     s->nb_stride = (int)(1.5 * nominal) + 16;
-    ok &= (s->nb_n = calloc((size_t)s->cap, sizeof *s->nb_n)) != NULL;
-    ok &= (s->nb_j = malloc((size_t)s->cap * (size_t)s->nb_stride * sizeof *s->nb_j)) != NULL;
+    ok &= (s->nb_n = lahar_soa_calloc((size_t)s->cap, sizeof *s->nb_n)) != NULL;
+    ok &= (s->nb_j = lahar_soa_calloc((size_t)s->cap * (size_t)s->nb_stride, sizeof *s->nb_j)) != NULL;
     if (!ok) {
         sph_soil_free(s);
         return -1;
@@ -44,11 +45,11 @@ int sph_soil_init(sph_soil *s, const sph_soil_material *m, int dim, const kernel
 void sph_soil_free(sph_soil *s)
 {
     for (int a = 0; a < SPH_NSTRESS; a++)
-        free(s->dsig[a]), free(s->rart[a]), free(s->sig_rho2[a]);
-    free(s->tensile);
-    free(s->nb_n), free(s->nb_j);
+        lahar_soa_free(s->dsig[a]), lahar_soa_free(s->rart[a]), lahar_soa_free(s->sig_rho2[a]);
+    lahar_soa_free(s->tensile);
+    lahar_soa_free(s->nb_n), lahar_soa_free(s->nb_j);
     for (int a = 0; a < 9; a++)
-        free(s->grad[a]);
+        lahar_soa_free(s->grad[a]);
     memset(s, 0, sizeof *s);
 }
 
@@ -119,7 +120,7 @@ static void soil_stress_rate(sph_soil *s, const sph_particles *p, int64_t i, con
 int sph_soil_keep_gradient(sph_soil *s)
 {
     for (int a = 0; a < 9; a++)
-        if (!s->grad[a] && !(s->grad[a] = calloc((size_t)s->cap, sizeof(double))))
+        if (!s->grad[a] && !(s->grad[a] = lahar_soa_calloc((size_t)s->cap, sizeof(double))))
             return -1;
     return 0;
 }
