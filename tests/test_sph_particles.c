@@ -1,17 +1,55 @@
 /* The SPH node's initial particles: the blocks of a scene give the analytic count of lattice
  * particles with centres half a spacing inside each block, and lattice points inside a body are
  * left out (counted independently here) and those within its coupling halo dx/2 moved out to it,
- * so no particle starts inside a DEM body or overlapping it. */
+ * so no particle starts inside a DEM body or overlapping it. And the particle arrays start on
+ * different cache-line offsets within their pages (common/memory/soa_alloc.h): with glibc's calloc
+ * every large array starts at offset 16 and the hot loops evict their own lines. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include "shape_build.h"
+#include "soa_alloc.h"
 #include "sph_node.h"
 
 #include "test_util.h"
 
+/* The particle arrays a pass streams at one index: distinct cache lines modulo the page, and zeroed. */
+static void check_staggered(void)
+{
+    sph_particles p;
+    CHECK(sph_particles_init(&p, 100000) == 0, "100,000 particles");
+    const double *a[] = {p.x, p.y, p.z, p.vx, p.vy, p.vz, p.rho, p.p, p.m, p.ax, p.ay, p.az, p.drho, p.vhx, p.vhy, p.vhz, p.rhoh, p.scratch_d};
+    const int na = (int)(sizeof a / sizeof a[0]);
+    unsigned line[sizeof a / sizeof a[0]];
+    for (int k = 0; k < na; k++) {
+        uintptr_t off = (uintptr_t)a[k] % 4096u;
+        CHECK(off % 64u == 0, "array %d at page offset %u: not on a cache line", k, (unsigned)off);
+        line[k] = (unsigned)(off / 64u);
+        for (int j = 0; j < k; j++)
+            CHECK(line[j] != line[k], "arrays %d and %d both start at page offset %u", j, k, line[k] * 64u);
+        CHECK(a[k][0] == 0.0 && a[k][99999] == 0.0, "array %d not zeroed", k);
+    }
+    sph_particles_free(&p);
+    /* the allocator itself: LAHAR_SOA_COLOURS consecutive arrays, all offsets distinct; an
+     * impossible size refused */
+    void *b[LAHAR_SOA_COLOURS];
+    unsigned seen[64] = {0};
+    for (int k = 0; k < LAHAR_SOA_COLOURS; k++) {
+        b[k] = lahar_soa_calloc(1000, 8);
+        CHECK(b[k] != NULL, "allocation %d", k);
+        unsigned l = (unsigned)((uintptr_t)b[k] % 4096u / 64u);
+        CHECK(l > 0 && !seen[l], "allocation %d at line %u of its page (0 or taken)", k, l);
+        seen[l] = 1;
+    }
+    for (int k = 0; k < LAHAR_SOA_COLOURS; k++)
+        lahar_soa_free(b[k]);
+    CHECK(lahar_soa_calloc(SIZE_MAX / 4, 8) == NULL, "an overflowing size must give NULL");
+}
+
 int main(void)
 {
+    check_staggered();
     const double dx = 0.01;
     lahar_particle_block blocks[2] = {
         {.name = "a", .lo = {0, 0, 0}, .hi = {0.1, 0.05, 0.2}, .v = {0, 0, 0}},
