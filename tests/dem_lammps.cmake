@@ -41,9 +41,9 @@ if(NOT LAHAR_HAVE_LAMMPS)
 endif()
 
 # Benchmark (not a test): per-substep cost of the lammps engine against spheropoly on a pile of
-# spheres in a box of planes; `cmake --build <dir> --target bench_dem_lammps`, then run
+# spheres in a box of planes (built with everything, so that it cannot rot); run
 # <dir>/bin/bench_dem_lammps (docs/bench/dem_lammps.md).
-add_executable(bench_dem_lammps EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
+add_executable(bench_dem_lammps ${LAHAR_TEST_DIR}/bench/bench_dem_lammps.c ${LAHAR_TEST_DIR}/dem_test_util.c)
 target_include_directories(bench_dem_lammps PRIVATE ${LAHAR_TEST_DIR})
 target_link_libraries(bench_dem_lammps PRIVATE lahar_dem)
 

@@ -1,7 +1,8 @@
 # SPH speed.
 # The SPH benchmark (tests/bench/bench_sph.c): 80k-particle 2D and 100k-particle 3D dam breaks on
 # 1 and 2 threads, run by the `bench` target after the DEM table (never a pass/fail; it prints a table).
-add_executable(bench_sph EXCLUDE_FROM_ALL ${LAHAR_TEST_DIR}/bench/bench_sph.c)
+# Built with everything (not EXCLUDE_FROM_ALL), so that -Werror and every refactoring see it.
+add_executable(bench_sph ${LAHAR_TEST_DIR}/bench/bench_sph.c)
 target_link_libraries(bench_sph PRIVATE lahar_sph)
 add_custom_target(bench_sph_table COMMAND bench_sph DEPENDS bench_sph WORKING_DIRECTORY ${CMAKE_SOURCE_DIR} USES_TERMINAL
   COMMENT "bench_sph: SPH step cost, 80k 2D and 100k 3D dam breaks on 1 and 2 threads")

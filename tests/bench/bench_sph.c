@@ -110,7 +110,7 @@ static void params(const bench_case *c, sph_params *prm)
 {
     sph_params_default(prm);
     prm->dim = c->dim;
-    prm->opt.kernel = "wendland2";
+    snprintf(prm->opt.kernel, sizeof prm->opt.kernel, "%s", "wendland2");
     prm->dx = c->dx;
     prm->opt.h_over_dx = 1.41;
     prm->rho0 = 1000.0;
