@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "spheropoly_impl.h"
+#include "soa_alloc.h"
 
 /* Skin: this fraction of the smallest sphere radius (LAMMPS's bench uses 0.1 d). */
 #define SPS_SKIN_FRACTION 0.2
@@ -229,30 +230,30 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     int nb = e->nbody;
     s->of_body = malloc(sizeof(int) * (size_t)nb);
     s->wall_of_body = malloc(sizeof(int) * (size_t)nb);
-    s->body = malloc(sizeof(int) * (size_t)ns);
+    s->body = lahar_soa_calloc((size_t)ns, sizeof(int));
     s->wall_body = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
     s->gen_large = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
-    s->rad = malloc(sizeof(double) * (size_t)ns);
-    s->mass = malloc(sizeof(double) * (size_t)ns);
-    s->mat = malloc(sizeof(int) * (size_t)ns);
-    s->iner = malloc(sizeof(double) * (size_t)ns);
-    s->inv_iner = malloc(sizeof(double) * (size_t)ns);
-    s->v0 = malloc(sizeof(int) * (size_t)ns);
-    s->x = malloc(sizeof(vec3) * (size_t)ns);
-    s->v = malloc(sizeof(vec3) * (size_t)ns);
-    s->w = malloc(sizeof(vec3) * (size_t)ns);
-    s->L = malloc(sizeof(vec3) * (size_t)ns);
-    s->qw = malloc(sizeof(double) * (size_t)ns);
-    s->qx = malloc(sizeof(double) * (size_t)ns);
-    s->qy = malloc(sizeof(double) * (size_t)ns);
-    s->qz = malloc(sizeof(double) * (size_t)ns);
-    s->x0 = malloc(sizeof(vec3) * (size_t)ns);
-    s->bcount = calloc((size_t)ns + 1, sizeof(int));
-    s->wstart = calloc((size_t)ns + 1, sizeof(int));
-    s->sf = malloc(sizeof(vec3) * (size_t)ns);
-    s->st = malloc(sizeof(vec3) * (size_t)ns);
-    s->scnt = malloc(sizeof(int) * (size_t)ns);
-    s->pstart = calloc((size_t)ns + 1, sizeof(int));
+    s->rad = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->mass = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->mat = lahar_soa_calloc((size_t)ns, sizeof(int));
+    s->iner = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->inv_iner = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->v0 = lahar_soa_calloc((size_t)ns, sizeof(int));
+    s->x = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->v = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->w = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->L = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->qw = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->qx = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->qy = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->qz = lahar_soa_calloc((size_t)ns, sizeof(double));
+    s->x0 = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->bcount = lahar_soa_calloc((size_t)ns + 1, sizeof(int));
+    s->wstart = lahar_soa_calloc((size_t)ns + 1, sizeof(int));
+    s->sf = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->st = lahar_soa_calloc((size_t)ns, sizeof(vec3));
+    s->scnt = lahar_soa_calloc((size_t)ns, sizeof(int));
+    s->pstart = lahar_soa_calloc((size_t)ns + 1, sizeof(int));
     s->wunit = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
     s->wnrm = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
     s->wp0 = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
@@ -264,8 +265,8 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->xpair = malloc(sizeof(int) * (size_t)s->xcap);
     s->xin = malloc(sizeof(int) * (size_t)s->xcap);
     s->xinstart = calloc((size_t)s->npart + 1, sizeof(int));
-    s->cell_of = malloc(sizeof(int) * (size_t)ns);
-    s->order = malloc(sizeof(int) * (size_t)ns);
+    s->cell_of = lahar_soa_calloc((size_t)ns, sizeof(int));
+    s->order = lahar_soa_calloc((size_t)ns, sizeof(int));
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
     if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->qw || !s->qx || !s->qy || !s->qz ||
@@ -339,30 +340,30 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->wh.xi);
     free(s->of_body);
     free(s->wall_of_body);
-    free(s->body);
+    lahar_soa_free(s->body);
     free(s->wall_body);
     free(s->gen_large);
-    free(s->rad);
-    free(s->mass);
-    free(s->mat);
-    free(s->iner);
-    free(s->inv_iner);
-    free(s->v0);
-    free(s->x);
-    free(s->v);
-    free(s->w);
-    free(s->L);
-    free(s->qw);
-    free(s->qx);
-    free(s->qy);
-    free(s->qz);
-    free(s->x0);
-    free(s->bcount);
-    free(s->wstart);
-    free(s->sf);
-    free(s->st);
-    free(s->scnt);
-    free(s->pstart);
+    lahar_soa_free(s->rad);
+    lahar_soa_free(s->mass);
+    lahar_soa_free(s->mat);
+    lahar_soa_free(s->iner);
+    lahar_soa_free(s->inv_iner);
+    lahar_soa_free(s->v0);
+    lahar_soa_free(s->x);
+    lahar_soa_free(s->v);
+    lahar_soa_free(s->w);
+    lahar_soa_free(s->L);
+    lahar_soa_free(s->qw);
+    lahar_soa_free(s->qx);
+    lahar_soa_free(s->qy);
+    lahar_soa_free(s->qz);
+    lahar_soa_free(s->x0);
+    lahar_soa_free(s->bcount);
+    lahar_soa_free(s->wstart);
+    lahar_soa_free(s->sf);
+    lahar_soa_free(s->st);
+    lahar_soa_free(s->scnt);
+    lahar_soa_free(s->pstart);
     free(s->wunit);
     free(s->wnrm);
     free(s->wp0);
@@ -372,8 +373,8 @@ void sps_destroy(lahar_dem_engine *e)
     free(s->xpair);
     free(s->xin);
     free(s->xinstart);
-    free(s->cell_of);
-    free(s->order);
+    lahar_soa_free(s->cell_of);
+    lahar_soa_free(s->order);
     free(s->cell_start);
     free(s->cand);
     free(s);
