@@ -779,7 +779,9 @@ def main(argv):
     ap.add_argument("--cases", default=",".join(BENCH), help="comma list of the cases of the pareto section")
     ap.add_argument("--threads", type=int, default=2, help="OpenMP threads per node (default 2)")
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds after which one run is stopped")
-    ap.add_argument("--repeat", type=int, default=3, help="pairs of runs of the overhead section (median is used)")
+    ap.add_argument("--repeat", type=int, default=9,
+                    help="pairs of runs of the overhead section (median is used; on a 2-core VM one pair varies by "
+                         "+-20 %% and a median of 9 by about +-5 %%, docs/bench/cosim_overhead.md)")
     ap.add_argument("--overhead-end", type=float, default=0.02, help="simulated time of the overhead runs [s]")
     ap.add_argument("--engine", default="spheropoly",
                     help="DEM engine of the overhead runs (spheropoly: the boulder pool; lammps: the same pool "
