@@ -130,24 +130,24 @@ void sph_coupling_free(sph_coupling *c)
     lahar_soa_free(c->slot_body);
     lahar_soa_free(c->slot);
     free(c->contacts);
-    free(c->soil_hist_body);
-    free(c->soil_hist_d);
+    lahar_soa_free(c->soil_hist_body);
+    lahar_soa_free(c->soil_hist_d);
     free(c->wtab);
     free(c->qtab);
-    free(c->soil_lw);
-    free(c->soil_lw_on);
+    lahar_soa_free(c->soil_lw);
+    lahar_soa_free(c->soil_lw_on);
     memset(c, 0, sizeof *c);
 }
 
 int sph_coupling_enable_soil(sph_coupling *c, double mu_phi)
 {
     const size_t n = (size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE;
-    free(c->soil_hist_body);
-    free(c->soil_hist_d);
-    c->soil_hist_body = malloc(n * sizeof *c->soil_hist_body);
-    c->soil_hist_d = calloc(n, sizeof *c->soil_hist_d);
+    lahar_soa_free(c->soil_hist_body);
+    lahar_soa_free(c->soil_hist_d);
+    c->soil_hist_body = lahar_soa_calloc(n, sizeof *c->soil_hist_body);
+    c->soil_hist_d = lahar_soa_calloc(n, sizeof *c->soil_hist_d);
     if (!c->soil_hist_body || !c->soil_hist_d) {
-        free(c->soil_hist_body), free(c->soil_hist_d);
+        lahar_soa_free(c->soil_hist_body), lahar_soa_free(c->soil_hist_d);
         c->soil_hist_body = NULL, c->soil_hist_d = NULL;
         return -1;
     }

@@ -3,6 +3,7 @@
  * body's surface, tabulated once per case, and the accelerations and continuity rates they give a
  * particle near a wall, an edge or a curved surface. sph_coupling_apply calls them per contact. */
 #include "sph_coupling.h"
+#include "soa_alloc.h"
 #include "sph_wall_ghost.h"
 #include <float.h>
 #include <math.h>
@@ -193,9 +194,9 @@ int sph_coupling_set_soil_wall(sph_coupling *c, lahar_sph_wall_pressure mode, co
     if (mode != LAHAR_SPH_WALL_PRESSURE_GHOST)
         return 0;
     if (!c->soil_lw)
-        c->soil_lw = calloc((size_t)c->pcap, sizeof *c->soil_lw);
+        c->soil_lw = lahar_soa_calloc((size_t)c->pcap, sizeof *c->soil_lw);
     if (!c->soil_lw_on)
-        c->soil_lw_on = calloc((size_t)c->pcap, 1);
+        c->soil_lw_on = lahar_soa_calloc((size_t)c->pcap, 1);
     if (!c->soil_lw || !c->soil_lw_on || ghost_tables(c, dx) != 0) {
         c->soil_pressure = LAHAR_SPH_WALL_PRESSURE_PENALTY;
         return -1;
