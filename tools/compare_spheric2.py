@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Compare a run of cases/dam_break_obstacle_3d.yaml with SPHERIC Test 2 (Kleefsman et al. 2005).
 
-  tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE]
+  tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE] [--no-plot]
+                            [--check [--impact-tol F] [--level-tol M] [--p1-mean-band LO HI]]
 
 Reads OUT/gauges.h5 (probes P1..P8 on the obstacle, level gauges H1..H4) and
 docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m). Metrics
@@ -14,7 +15,12 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
              the floor, where the water's kernel fraction falls to 1/2, sph_node/probes/sph_probes.h)
-The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment."""
+The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment. Runs of the 2D centre plane
+(cases/dam_break_obstacle_plane_2d.yaml) are read the same way (its probes and gauges have the
+3D case's names).
+With --check: exit 1 unless |impact - 0.394 s| / 0.394 s <= --impact-tol (default 0.05), every
+gauge's mean |h_run - h_exp| <= --level-tol (default 0.02 m) and, when --p1-mean-band LO HI is
+given, P1's largest 10 ms mean is within [LO, HI] x the experiment's (10.1 kPa)."""
 import argparse
 import json
 import os
@@ -54,6 +60,12 @@ def main():
     ap.add_argument("--window", type=float, default=10.0, help="window of the mean peak, ms")
     ap.add_argument("-o", "--output")
     ap.add_argument("--json")
+    ap.add_argument("--no-plot", action="store_true", help="write no PNG")
+    ap.add_argument("--check", action="store_true", help="exit 1 when a bound below is not met")
+    ap.add_argument("--impact-tol", type=float, default=0.05, help="bound on |impact - experiment| / experiment")
+    ap.add_argument("--level-tol", type=float, default=0.02, help="bound on each gauge's mean |h - h_exp|, m")
+    ap.add_argument("--p1-mean-band", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="bounds on P1's largest window mean / the experiment's (not checked unless given)")
     a = ap.parse_args()
     tau = a.window * 1e-3
     with open(os.path.join(a.out, "summary.json")) as fh:
@@ -95,7 +107,7 @@ def main():
         arr_exp = next((te[i] for i in range(len(te)) if abs(he[i] - he[0]) >= 0.02), float("nan"))
         m["levels"][g] = {"change_run": float(arr_run), "change_exp": float(arr_exp),
                           "mean_abs_diff_m": float(np.mean(np.abs(hr - np.interp(tg, te, he))))}
-    print("first impact on P1 (>= 1 kPa): t = %.4f s (experiment %.4f s, %+.1f %%)" % (
+    print("first impact on P1 (>= 1 kPa): t = %.4f s (experiment %.4f s, %+.2f %%)" % (
         ti_run, ti_exp, 100 * m["impact"]["rel"]))
     for n, s in m["peaks"].items():
         print("%s: peak %.0f Pa (exp %.0f), %g ms mean %.0f Pa (exp %.0f)" % (
@@ -103,8 +115,39 @@ def main():
     for g, d in m["levels"].items():
         print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
             g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
+    ok, failed = check(m, a)
     with open(a.json or os.path.join(a.out, "spheric2.json"), "w") as fh:
         json.dump(m, fh, indent=1)
+    if not a.no_plot:
+        plot(a, te, e, head, run_p, tls, hs, dx, tau)
+    if a.check and not ok:
+        print("FAIL:", ", ".join(failed))
+        return 1
+    return 0
+
+
+def check(m, a):
+    """Fills m["bounds"], m["pass"], m["failed"]; returns (pass, failed names)."""
+    failed = []
+    if not abs(m["impact"]["rel"]) <= a.impact_tol:  # a run that never hits P1 has rel nan: fails
+        failed.append("impact")
+    for g, d in m["levels"].items():
+        if not d["mean_abs_diff_m"] <= a.level_tol:
+            failed.append(g + ".level")
+    if a.p1_mean_band:
+        s = m["peaks"]["P1"]
+        ratio = s["peak_mean"] / s["peak_mean_exp"]
+        s["ratio_mean"] = ratio
+        if not a.p1_mean_band[0] <= ratio <= a.p1_mean_band[1]:
+            failed.append("P1.peak_mean")
+    m["bounds"] = {"impact_tol": a.impact_tol, "level_tol_m": a.level_tol, "p1_mean_band": a.p1_mean_band}
+    m["pass"] = not failed
+    m["failed"] = failed
+    return not failed, failed
+
+
+def plot(a, te, e, head, run_p, tls, hs, dx, tau):
+    tl = tls["H1"]
     fig, axes = plt.subplots(4, 2, figsize=(12, 10), sharex=True)
     for k, n in enumerate(["P1", "P3", "P5", "P7"]):
         ax = axes[k, 0]
@@ -132,7 +175,6 @@ def main():
     png = a.output or os.path.join(a.out, "spheric2.png")
     fig.savefig(png, dpi=90)
     print("wrote", png)
-    return 0
 
 
 if __name__ == "__main__":
