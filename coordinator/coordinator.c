@@ -48,7 +48,9 @@
 #define COORD_HELLO_PERIOD_MS 100
 #define COORD_STOP_WAIT 3.0      /* s the nodes get to exit after STOP */
 #define COORD_SETUP_POLL_MS 100  /* set-up: how often Ctrl-C and the progress line are looked at */
-#define COORD_SETUP_SHOW 2.0     /* s of set-up after which a progress line is shown (terminal only) */
+#define COORD_SETUP_SHOW 2.0     /* s of set-up after which a progress line is shown */
+enum { COORD_PROGRESS_TERMINAL = 1, /* one line rewritten in place (\r), at most 4 Hz */
+       COORD_PROGRESS_LOG = 2 };    /* stderr is a file or a pipe: whole lines, one per --progress-every s */
 #define COORD_SETUP_STOP_WAIT 0.3 /* s a node interrupted in set-up gets to exit before it is killed */
 #define COORD_STEP_RESEND_MS 250 /* re-publish STEP(k) while STATUS(k) is missing */
 #define COORD_DEATH_POLL_MS 50   /* while STATUS(k) is missing, the started nodes are reaped this often */
@@ -101,7 +103,7 @@ typedef struct {
     int has_inst;
     const char *inst_node;   /* who caught it: "dem", "sph" or "coordinator" */
     int exit_status;
-    int progress;           /* progress line on stderr */
+    int progress;           /* progress on stderr: 0 none, COORD_PROGRESS_TERMINAL, COORD_PROGRESS_LOG */
     double last_progress;
     int setup_shown;        /* a set-up progress line is on the terminal (ended by a newline) */
     double stop_wait;       /* s the nodes get to exit after STOP (0: COORD_STOP_WAIT) */
@@ -551,12 +553,17 @@ static int coord_setup_wait(coord *co, const coord_node *n)
         return 1;
     }
     double waited = lahar_now() - co->wall0;
-    if (co->progress && waited > COORD_SETUP_SHOW && lahar_now() - co->last_progress >= 1.0) {
+    if (co->progress == COORD_PROGRESS_TERMINAL && waited > COORD_SETUP_SHOW && lahar_now() - co->last_progress >= 1.0) {
         co->last_progress = lahar_now();
         fprintf(stderr, "\r  setting up: waiting for the %s (filling particles, first rates) %.0f s   ",
                 lahar_link_role_name(n->role), waited);
         fflush(stderr);
         co->setup_shown = 1;
+    } else if (co->progress == COORD_PROGRESS_LOG && lahar_now() - co->last_progress >= co->o->progress_every_s) {
+        co->last_progress = lahar_now();
+        fprintf(stderr, "lahar: setting up: waiting for the %s (filling particles, first rates) %.0f s\n",
+                lahar_link_role_name(n->role), waited);
+        fflush(stderr);
     }
     return 0;
 }
@@ -671,12 +678,25 @@ static int coord_collect_status(coord *co, int64_t k)
     return LAHAR_EXIT_OK;
 }
 
+/* A duration for a person: seconds up to 2 min, minutes up to 2 h, then hours. */
+static const char *coord_duration(double s, char *buf, size_t n)
+{
+    if (s < 120.0)
+        snprintf(buf, n, "%.0f s", s);
+    else if (s < 7200.0)
+        snprintf(buf, n, "%.1f min", s / 60.0);
+    else
+        snprintf(buf, n, "%.1f h", s / 3600.0);
+    return buf;
+}
+
 static void coord_progress(coord *co, int final)
 {
-    if (!co->progress)
+    if (!co->progress || (final && co->progress == COORD_PROGRESS_LOG)) /* a log ends with "finished" */
         return;
     double now = lahar_now();
-    if (!final && now - co->last_progress < 0.25)
+    const double every = co->progress == COORD_PROGRESS_LOG ? co->o->progress_every_s : 0.25;
+    if (!final && now - co->last_progress < every)
         return;
     co->last_progress = now;
     double wall = now - co->wall0;
@@ -684,10 +704,18 @@ static void coord_progress(coord *co, int final)
     double t0 = co->resumed ? co->resume_t : 0.0; /* this invocation's share of the run */
     double frac = co->c->t_end > t0 ? (co->sim_time - t0) / (co->c->t_end - t0) : 1.0;
     double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
-    fprintf(stderr, "\r  t = %.4g / %.4g s   step %lld   %.0f steps/s   ETA %.0f s   ", co->sim_time, co->c->t_end,
-            (long long)co->steps, rate, eta);
-    if (final)
-        fputc('\n', stderr);
+    char eta_s[32], wall_s[32];
+    coord_duration(eta, eta_s, sizeof eta_s);
+    if (co->progress == COORD_PROGRESS_LOG) {
+        fprintf(stderr, "lahar: t = %.4g / %.4g s (%.0f %%)   step %lld   %.0f steps/s   %s elapsed   ETA %s\n",
+                co->sim_time, co->c->t_end, 100.0 * frac, (long long)co->steps, rate,
+                coord_duration(wall, wall_s, sizeof wall_s), eta_s);
+    } else {
+        fprintf(stderr, "\r  t = %.4g / %.4g s   step %lld   %.0f steps/s   ETA %s   ", co->sim_time, co->c->t_end,
+                (long long)co->steps, rate, eta_s);
+        if (final)
+            fputc('\n', stderr);
+    }
     fflush(stderr);
 }
 
@@ -1595,7 +1623,9 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
         return LAHAR_EXIT_SETUP;
     }
     co.run_id = coord_random_run_id();
-    co.progress = !o->quiet && isatty(STDERR_FILENO);
+    co.progress = o->quiet ? 0
+                  : isatty(STDERR_FILENO) ? COORD_PROGRESS_TERMINAL
+                  : o->progress_every_s > 0 ? COORD_PROGRESS_LOG : 0;
     co.last_progress = co.wall0;
 
     struct sigaction sa;

@@ -12,6 +12,8 @@ typedef struct {
     int in_process;        /* nodes as threads over memq:// */
     int no_spawn;          /* nodes are started by the user */
     int quiet;
+    double progress_every_s; /* stderr not a terminal (a log file, a pipe): a progress line every this
+                                many seconds of wall time; 0: none (on a terminal one line is rewritten) */
     double join_wait_s;    /* how long to wait for the nodes' hello (default 30 s) */
     const char *auth_key_path; /* authenticated run across machines (common/protocol/auth.h); NULL: $LAHAR_AUTH_KEY */
     int overwrite;         /* 1: remove an earlier run's files in outdir first (else such an outdir is refused) */

@@ -59,6 +59,10 @@ static void usage(FILE *f)
             "                     that is silent but still using CPU is waited for up to 120 s more\n"
             "                     (an overloaded machine); a node whose process ended is lost at once\n"
             "  -q, --quiet        no progress line and no closing hints\n"
+            "  --progress-every S when stderr is not a terminal (a log file, a pipe, a batch job): a\n"
+            "                     progress line (sim time, %% done, steps/s, elapsed, ETA) every S seconds\n"
+            "                     of wall time (default 60; 0: none). On a terminal one line is updated\n"
+            "                     in place instead\n"
             "  --allow-large      run a case whose estimated memory (`lahar validate` prints it) exceeds\n"
             "                     this machine's; without it such a run is refused (exit 2)\n"
             "  --time-end T       (resume) end the resumed run at T s instead of the case's time.end\n"
@@ -251,6 +255,7 @@ int main(int argc, char **argv)
     }
     lahar_coord_options o = {0};
     o.argv0 = argv[0];
+    o.progress_every_s = 60.0;
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"threads", required_argument, NULL, 't'},
         {"in-process", no_argument, NULL, 'i'},   {"no-spawn", no_argument, NULL, 'n'},
@@ -259,6 +264,7 @@ int main(int argc, char **argv)
         {"evaluate-only", no_argument, NULL, 'e'}, {"allow-large", no_argument, NULL, 'L'},
         {"node-timeout", required_argument, NULL, 'T'}, {"overwrite", no_argument, NULL, 'O'},
         {"auth-key", required_argument, NULL, 'K'}, {"time-end", required_argument, NULL, 'E'},
+        {"progress-every", required_argument, NULL, 'P'},
         {NULL, 0, NULL, 0},
     };
     optind = 2;
@@ -278,6 +284,16 @@ int main(int argc, char **argv)
                 return 2;
             break;
         case 'q': o.quiet = 1; break;
+        case 'P': {
+            char *end;
+            if (strtod(optarg, &end) == 0.0 && end != optarg && *end == '\0') { /* 0: no progress lines */
+                o.progress_every_s = 0.0;
+                break;
+            }
+            if (parse_seconds_option(cmd, "--progress-every", optarg, 0.0, 86400.0, &o.progress_every_s) != 0)
+                return 2;
+            break;
+        }
         case 'e': evaluate_only = 1; break;
         case 'L': allow_large = 1; break;
         case 'O': o.overwrite = 1; break;

@@ -29,6 +29,10 @@ lahar_test(cli_bad_args COMMAND sh ${LAHAR_TEST_DIR}/cli_bad_args.sh $<TARGET_FI
 # as processes (these in a private namespace: label netns)
 lahar_test(cli_interrupt_setup COMMAND sh ${LAHAR_TEST_DIR}/cli_interrupt.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/tools/case_override.py ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/cli_interrupt
   LABELS slow netns TIMEOUT 120)
+# Progress into a log file or a pipe: whole lines every --progress-every s, none with -q / 0 / a
+# short run at the default 60 s, a bad value refused (tests/cli_progress.sh)
+lahar_test(cli_progress_log COMMAND sh ${LAHAR_TEST_DIR}/cli_progress.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/tools/case_override.py ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/cli_progress
+  LABELS fast netns TIMEOUT 120)
 
 # The key table (common/io/case_keys.c) drives the loader: keys accepted, defaults, range messages
 lahar_test(case_keys PROGRAM test_case_keys SOURCES test_case_keys.c LABELS fast)
