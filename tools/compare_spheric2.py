@@ -11,6 +11,8 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              difference
   peak       P1 and P3: the largest sample, and the largest mean over --window ms (default 10),
              within 0.2 s of P1's impact
+  plateau    P1 and P3: the mean over 50-150 ms after P1's first impact (the run's and the
+             experiment's each from its own impact), the sustained load; nan when the run ends earlier
   levels     H1-H4 at (x, y) = (1.488, 0.5), (0.992, 0.5), (0.496, 0.5), (2.638, 0.5) m: the time
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
@@ -41,6 +43,7 @@ import yaml  # noqa: E402
 GAUGES = [("H1", 1.488, 0.5), ("H2", 0.992, 0.5), ("H3", 0.496, 0.5), ("H4", 2.638, 0.5)]
 IMPACT_PA = 1000.0
 SPAN = 0.2
+PLATEAU = (0.05, 0.15)  # s after the first impact on P1: the window of the sustained load
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "references-data",
                     "kleefsman_2005_test2.csv")
 
@@ -90,6 +93,13 @@ def main():
         sel, sele = (t >= ti_run) & (t <= ti_run + SPAN), (te >= ti_exp) & (te <= ti_exp + SPAN)
         m["peaks"][n] = {"peak": float(p[sel].max()), "peak_exp": float(pe[sele].max()),
                          "peak_mean": window_peak(t, p, ti_run, tau), "peak_mean_exp": window_peak(te, pe, ti_exp, tau)}
+        # the sustained load after the impact, each series from its own first impact on P1 (so that
+        # the run's timing error does not enter); nan when the run ends before the window does
+        lo, hi = PLATEAU
+        w, we = (t >= ti_run + lo) & (t <= ti_run + hi), (te >= ti_exp + lo) & (te <= ti_exp + hi)
+        covered = len(t) and t[-1] >= ti_run + hi
+        m["peaks"][n]["plateau"] = float(p[w].mean()) if covered else float("nan")
+        m["peaks"][n]["plateau_exp"] = float(pe[we].mean())
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
         if missing:
@@ -110,8 +120,9 @@ def main():
     print("first impact on P1 (>= 1 kPa): t = %.4f s (experiment %.4f s, %+.2f %%)" % (
         ti_run, ti_exp, 100 * m["impact"]["rel"]))
     for n, s in m["peaks"].items():
-        print("%s: peak %.0f Pa (exp %.0f), %g ms mean %.0f Pa (exp %.0f)" % (
-            n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"]))
+        print("%s: peak %.0f Pa (exp %.0f), %g ms mean %.0f Pa (exp %.0f), mean 50-150 ms after the impact %.0f Pa "
+              "(exp %.0f)" % (n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"], s["plateau"],
+                              s["plateau_exp"]))
     for g, d in m["levels"].items():
         print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
             g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
