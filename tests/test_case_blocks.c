@@ -10,9 +10,11 @@
  *    and points whose ray leaves through an edge or a corner are still inside;
  *  - a closed, non-convex, star-shaped mesh (perturbed icosphere, 1280 triangles, ASCII STL):
  *    N dx^3 against the mesh's own volume (divergence theorem) within 1 %, and within the
- *    boundary-shell bound A sqrt(3) dx;
+ *    boundary-shell bound A sqrt(3) dx; its lattice walk (triangles binned by their shadow) keeps
+ *    exactly the points the per-point inside test keeps;
  *  - cut-out: a water box around a fixed disc, a free 2D box turned by 30 degrees and a 3D
- *    sphere loses exactly the lattice points an independent distance test puts inside them;
+ *    sphere loses exactly the lattice points an independent distance test puts inside them, and
+ *    so does a fixed wavy bed of 119 features (cut through its feature grid);
  *  - every sph: default is the documented value (c0 = 10 sqrt(2 g H) computed independently);
  *  - sph.body_layers: around a sphere in a periodic cube (3D) and a disc in a closed box (2D) the
  *    points within N dx of the surface lie on the layers R + (l + 1/2) dx to 1e-9 dx, the inner
@@ -26,6 +28,7 @@
 #include <string.h>
 
 #include "case.h"
+#include "geometry.h"
 #include "shape_build.h"
 #include "vec.h"
 
@@ -284,6 +287,26 @@ static void test_meshes(const char *tmp)
         dent[0] = 0.5 * 0.2 * 0.9 * cos(-M_PI / 6);
         dent[1] = 0.5 * 0.2 * 0.9 * sin(-M_PI / 6);
         dent[2] = 0.0;
+        /* more than GEOM_FEATURE_GRID_MIN triangles: the lattice walk bins them by their shadow
+         * along the ray; it must keep exactly the points the per-point test keeps, in order */
+        int64_t nb[3], brute = 0, same = 0;
+        for (int a = 0; a < 3; a++)
+            nb[a] = (int64_t)floor((b->hi[a] - b->lo[a]) / dx + 1e-9);
+        double (*pts)[3] = malloc((size_t)(n > 0 ? n : 1) * sizeof *pts);
+        lahar_particle_block_lattice(b, 3, dx, pts, n);
+        for (int64_t i = 0; i < nb[0]; i++)
+            for (int64_t j = 0; j < nb[1]; j++)
+                for (int64_t k = 0; k < nb[2]; k++) {
+                    double x[3] = {b->lo[0] + (i + 0.5) * dx, b->lo[1] + (j + 0.5) * dx, b->lo[2] + (k + 0.5) * dx};
+                    if (!lahar_particle_block_contains(b, 3, x))
+                        continue;
+                    same += brute < n && memcmp(pts[brute], x, sizeof x) == 0;
+                    brute++;
+                }
+        free(pts);
+        CHECK(b->ntri > GEOM_FEATURE_GRID_MIN, "star mesh: %d triangles take the binned path", b->ntri);
+        CHECK(brute == n && same == n, "star mesh: the binned lattice walk keeps %lld points, the per-point test "
+              "%lld (%lld the same, in order)", (long long)n, (long long)brute, (long long)same);
         CHECK(lahar_particle_block_contains(b, 3, between), "star mesh: centre inside");
         CHECK(!lahar_particle_block_contains(b, 3, dent), "star mesh: a point in a dent (0.9 R > 0.75 R) is outside");
         lahar_case_free(&c);
@@ -360,6 +383,59 @@ static void test_cutout(const char *tmp)
         lahar_case_free(&c);
     } else
         CHECK(0, "3D cut-out case does not load");
+}
+
+/* A fixed body with more than GEOM_FEATURE_GRID_MIN features (a wavy bed, one polyline of 60
+ * vertices, 119 features) is cut out through its feature grid: exactly the lattice points an
+ * independent distance test (to the nearest of its 59 segments, < radius) puts inside it. */
+static void test_cutout_big_body(const char *tmp)
+{
+    enum { NV = 60 };
+    char path[4096], verts[NV * 64] = "";
+    double vx[NV], vy[NV];
+    for (int i = 0; i < NV; i++) {
+        vx[i] = 0.4 * i / (NV - 1);
+        vy[i] = 0.05 + 0.02 * sin(9.0 * vx[i]) + 0.01 * cos(37.0 * vx[i]);
+        char v[64];
+        snprintf(v, sizeof v, "%s[%.17g, %.17g]", i ? ", " : "", vx[i], vy[i]);
+        strcat(verts, v);
+    }
+    snprintf(path, sizeof path, "%s/blocks_cut_bed.yaml", tmp);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        CHECK(0, "cannot write %s", path);
+        return;
+    }
+    fprintf(f, "dimensions: 2\ntime: {end: 1}\n"
+               "materials: {rock: {density: 2650, model: linear, kn: 1e6, restitution: 0.5, friction: 0.5}}\n"
+               "bodies:\n  - {name: bed, shape: polyline, motion: fixed, material: rock, radius: 0.0043,\n"
+               "     vertices: [%s]}\n"
+               "sph:\n  dx: 0.002\n  blocks:\n    - {name: water, box: {lo: [0, 0], hi: [0.4, 0.12]}}\n", verts);
+    fclose(f);
+    lahar_case c;
+    if (lahar_case_load(path, &c) == 0) {
+        const lahar_shape *s = &c.bodies[0].shape;
+        const double dx = 0.002, R = 0.0043;
+        int64_t total = 200 * 60, inside = 0;
+        for (int i = 0; i < 200; i++)
+            for (int j = 0; j < 60; j++) {
+                double x = (i + 0.5) * dx, y = (j + 0.5) * dx, best = INFINITY;
+                for (int e = 0; e + 1 < NV; e++) {
+                    double ax = vx[e], ay = vy[e], bx = vx[e + 1] - ax, by = vy[e + 1] - ay;
+                    double t = fmin(1.0, fmax(0.0, ((x - ax) * bx + (y - ay) * by) / (bx * bx + by * by)));
+                    best = fmin(best, hypot(x - ax - t * bx, y - ay - t * by));
+                }
+                inside += best < R;
+            }
+        int64_t n = lahar_case_block_lattice(&c, 0, NULL, 0);
+        CHECK(s->nv + s->ne + s->nf > GEOM_FEATURE_GRID_MIN, "wavy bed: %d features take the feature grid",
+              s->nv + s->ne + s->nf);
+        CHECK(n == total - inside, "wavy bed cut-out: %lld particles, expected %lld - %lld within the sweep radius",
+              (long long)n, (long long)total, (long long)inside);
+        printf("wavy bed cut-out: %lld of %lld lattice points outside the bed's sweep\n", (long long)n, (long long)total);
+        lahar_case_free(&c);
+    } else
+        CHECK(0, "wavy bed case does not load");
 }
 
 /* The documented defaults of sph: (cases/dem_drop_3d.yaml) are the loaded values. */
@@ -495,6 +571,7 @@ int main(int argc, char **argv)
     test_polygons();
     test_meshes(argv[1]);
     test_cutout(argv[1]);
+    test_cutout_big_body(argv[1]);
     test_body_layers(argv[1]);
     printf("%d checks, %d failures\n", checks, failures);
     return failures ? 1 : 0;

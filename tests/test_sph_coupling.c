@@ -268,7 +268,7 @@ int main(void)
         sph_fluid_free(&f);
         lahar_shape_free(&box.shape);
     }
-    /* 4b. a big shape (feature grid path, > SPH_COUPLING_GRID_FEATURES features): a 2D polygon of
+    /* 4b. a big shape (feature grid path, > GEOM_FEATURE_GRID_MIN features): a 2D polygon of
      * 120 vertices; the force equals the brute-force closest point's K_n (eps - d) n */
     {
         lahar_body poly;

@@ -100,6 +100,10 @@ typedef struct {
     int query;
 } geom_feature_query;
 
+/* Shapes with more features (vertices + edges + faces) than this are worth a grid: below it a
+ * plain scan of every feature is as fast (boxes, boulders). */
+#define GEOM_FEATURE_GRID_MIN 64
+
 /* Build the grid of shape s (features inflated by its sweep radius). Returns 0 or -1 (no memory). */
 int geom_feature_grid_build(geom_feature_grid *g, const lahar_shape *s);
 void geom_feature_grid_free(geom_feature_grid *g);

@@ -31,6 +31,11 @@
 typedef struct {
     const lahar_case *c;
     double *reach;
+    /* per body: a feature grid for a fixed or prescribed body with more than GEOM_FEATURE_GRID_MIN
+     * features (a terrain, an STL flume), whose inside test then visits only the features near the
+     * point (geom_point_body_core_near); has_grid[m] = 0: every feature is scanned */
+    geom_feature_grid *grid;
+    int *has_grid;
     double eps;
     double zone;  /* sph.body_layers > 0: the lattice leaves out the points within zone = body_layers dx
                      of a round body's surface (case_block_layers fills them); else 0 */
@@ -108,6 +113,7 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
                 bd->shape.radius + k->zone - tol)
             return 0; /* within the layers of sph.body_layers (case_block_layers) */
     }
+    int moved = 0;
     for (int m = 0; m < k->c->nbody; m++) {
         const lahar_body *bd = &k->c->bodies[m];
         double d2 = 0;
@@ -115,19 +121,27 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
             d2 += (x[a] - bd->x[a]) * (x[a] - bd->x[a]);
         if (d2 > k->reach[m] * k->reach[m])
             continue;
-        if (lahar_body_contains(bd, k->c->dim, x))
-            return 0;
+        /* inside = lahar_body_contains: core distance < R, or in the core. Through the grid only
+         * the features within R are visited; the distance is the same when one is (the same
+         * per-feature tests), and DBL_MAX (not inside the sweep) when none is. */
         vec3 p = v3_load(x), cp;
         int feat;
-        const double R = bd->shape.radius, dc = geom_point_body_core(&bd->shape, bd->x, bd->q, p, &cp, &feat);
-        /* in the halo of a free body: out to d = eps along the normal */
+        const double R = bd->shape.radius;
+        const double dc = k->has_grid[m]
+                              ? geom_point_body_core_near(&k->grid[m], &bd->shape, bd->x, bd->q, p, R, &cp, &feat)
+                              : geom_point_body_core(&bd->shape, bd->x, bd->q, p, &cp, &feat);
+        if (dc < R || geom_point_in_core(&bd->shape, bd->convex, k->c->dim, bd->x, bd->q, p))
+            return 0;
+        /* in the halo of a free body (never gridded): out to d = eps along the normal */
         if (bd->motion == LAHAR_MOTION_FREE && dc - R < k->eps - tol && dc > 0.0) {
             vec3 q = v3_axpy((R + k->eps) / dc, v3_sub(p, cp), cp);
             x[0] = q.x, x[1] = q.y, x[2] = k->c->dim == 2 ? 0.0 : q.z;
+            moved = 1;
         }
     }
-    /* a point moved out of one body's halo may have landed in another's solid */
-    for (int m = 0; m < k->c->nbody; m++)
+    /* a point moved out of one body's halo may have landed in another's solid (a point not moved
+     * was tested against every body that can hold it above) */
+    for (int m = 0; m < k->c->nbody && moved; m++)
         if (lahar_body_contains(&k->c->bodies[m], k->c->dim, x))
             return 0;
     return 1;
@@ -218,24 +232,38 @@ static int64_t case_block_layers(const lahar_case *c, int block, case_lattice_cu
 static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[3], int64_t cap, int first_only)
 {
     /* the halo is dx/2 (the only value sph.halo accepts) */
-    case_lattice_cut k = {c, malloc((size_t)(c->nbody > 0 ? c->nbody : 1) * sizeof(double)), 0.5 * c->sph_dx, 0.0};
-    if (!k.reach)
-        return -1;
+    const size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
+    case_lattice_cut k = {c, malloc(nb * sizeof(double)), calloc(nb, sizeof(geom_feature_grid)), calloc(nb, sizeof(int)),
+                          0.5 * c->sph_dx, 0.0};
+    int64_t count = -1;
+    if (!k.reach || !k.grid || !k.has_grid)
+        goto done;
     for (int m = 0; m < c->nbody; m++) {
         const lahar_body *bd = &c->bodies[m];
+        if (bd->motion != LAHAR_MOTION_FREE && bd->shape.nv + bd->shape.ne + bd->shape.nf > GEOM_FEATURE_GRID_MIN) {
+            if (geom_feature_grid_build(&k.grid[m], &bd->shape) != 0)
+                goto done;
+            k.has_grid[m] = 1;
+        }
         k.reach[m] = 0.0;
         for (int v = 0; v < bd->shape.nv; v++)
             k.reach[m] = fmax(k.reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
         k.reach[m] += bd->shape.radius + k.eps;
     }
     k.zone = c->sph.body_layers * c->sph_dx;
-    int64_t count = lahar_particle_block_lattice_keep(&c->blocks[block], c->dim, c->sph_dx, case_lattice_outside_bodies,
-                                                      &k, first_only ? 1 : -1, out, cap);
+    count = lahar_particle_block_lattice_keep(&c->blocks[block], c->dim, c->sph_dx, case_lattice_outside_bodies, &k,
+                                              first_only ? 1 : -1, out, cap);
     if (k.zone > 0.0 && !(first_only && count > 0)) {
         k.zone = 0.0; /* the layers themselves: only the bodies' solids (and free bodies' halos) cut them */
         count = case_block_layers(c, block, &k, count, first_only ? 1 : -1, out, cap);
     }
+done:
+    for (int m = 0; m < c->nbody && k.grid; m++)
+        if (k.has_grid && k.has_grid[m])
+            geom_feature_grid_free(&k.grid[m]);
     free(k.reach);
+    free(k.grid);
+    free(k.has_grid);
     return count;
 }
 

@@ -73,7 +73,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
                 c->box[b][3 + a] = fmax(c->box[b][3 + a], v3_get(w, a) + s->radius);
             }
         }
-        if (s->nv + s->ne + s->nf > SPH_COUPLING_GRID_FEATURES) {
+        if (s->nv + s->ne + s->nf > GEOM_FEATURE_GRID_MIN) {
             if (geom_feature_grid_build(&c->grid[b], s) != 0) {
                 sph_coupling_free(c);
                 return -1;

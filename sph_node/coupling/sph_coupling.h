@@ -146,9 +146,6 @@ typedef struct {
     double (*soil_hist_d)[3];
 } sph_coupling;
 
-/* Shapes with more features than this get a feature grid (geom_point_body_core_near). */
-#define SPH_COUPLING_GRID_FEATURES 64
-
 /* Set up the coupling with nbody bodies (borrowed; shapes must stay valid), halo eps = dx/2,
  * m_min = min(particle mass m_sph, masses of free bodies) (eq. 15), dynamic viscosity mu, for
  * particle_cap particles. Returns 0 or -1 (out of memory). */
