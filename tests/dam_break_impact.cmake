@@ -21,10 +21,10 @@ lahar_test(sph_dam_break_lobovsky_2d_riemann COMMAND ${LAHAR_OUTPUT_PYTHON} ${LA
 # the first impact on P1 within 6 % of the experiment's 0.394 s (measured +5.04 %; +4.6 % at the
 # case's dx 5 mm, the 3D case at dx 10 mm +4.86 %), every level gauge within 15 mm (mean |dh|,
 # measured 9 / 2 / 1 / 5 mm). The pressures after the impact are not checked in the plane (the
-# water cannot go round the box there).
+# water cannot go round the box there). --depths: the H1/H2 depths against Ritter are printed and kept in the JSON.
 lahar_test(sph_dam_break_obstacle_plane_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/spheric2_plane_2d ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_plane_2d.yaml compare_spheric2.py sph.dx=0.01
-  -- --impact-tol 0.06 --level-tol 0.015
+  -- --impact-tol 0.06 --level-tol 0.015 --depths
   LABELS sph validation slow TIMEOUT 300)
 # The 3D case as it is (dx 40 mm, 9750 particles) to 0.5 s (26 s of CPU): it guards the 3D path
 # (plane walls, probes on a 3D box, level gauges) at the error of this coarse resolution, which is

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Compare a run of cases/dam_break_obstacle_3d.yaml with SPHERIC Test 2 (Kleefsman et al. 2005).
 
-  tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE] [--no-plot]
+  tools/compare_spheric2.py OUT [--window MS] [-o FILE.png] [--json FILE] [--no-plot] [--depths]
                             [--check [--impact-tol F] [--level-tol M] [--p1-mean-band LO HI]]
 
 Reads OUT/gauges.h5 (probes P1..P8 on the obstacle, level gauges H1..H4) and
@@ -17,6 +17,10 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
              the floor, where the water's kernel fraction falls to 1/2, sph_node/probes/sph_probes.h)
+  depths     (--depths) H1 and H2 every 50 ms from 0.25 s: the run, the experiment and Ritter's
+             (1892) shallow-water dam-break depth h = (4/9g) (sqrt(g H0) - x/2t)^2 for the
+             instantaneous release of the case's column (H0 its height, x the distance from its
+             downstream face): how much water arrives in front of the box
 The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment. Runs of the 2D centre plane
 (cases/dam_break_obstacle_plane_2d.yaml) are read the same way (its probes and gauges have the
 3D case's names).
@@ -64,6 +68,8 @@ def main():
     ap.add_argument("-o", "--output")
     ap.add_argument("--json")
     ap.add_argument("--no-plot", action="store_true", help="write no PNG")
+    ap.add_argument("--depths", action="store_true",
+                    help="print H1 and H2 every 50 ms against the experiment and Ritter's solution")
     ap.add_argument("--check", action="store_true", help="exit 1 when a bound below is not met")
     ap.add_argument("--impact-tol", type=float, default=0.05, help="bound on |impact - experiment| / experiment")
     ap.add_argument("--level-tol", type=float, default=0.02, help="bound on each gauge's mean |h - h_exp|, m")
@@ -74,7 +80,9 @@ def main():
     with open(os.path.join(a.out, "summary.json")) as fh:
         case = json.load(fh)["case"]
     with open(case) as fh:
-        dx = float(yaml.safe_load(fh)["sph"]["dx"])
+        sph = yaml.safe_load(fh)["sph"]
+    dx = float(sph["dx"])
+    column = sph["blocks"][0]["box"]  # the water column: x from its downstream face, height on the last axis
     with open(DATA) as fh:
         lines = [ln for ln in fh if not ln.startswith("#")]
     head = lines[0].strip().split(",")
@@ -126,6 +134,8 @@ def main():
     for g, d in m["levels"].items():
         print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
             g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
+    if a.depths:
+        m["depths"] = depths(te, e, head, tls, hs, float(column["lo"][0]), float(column["hi"][-1]))
     ok, failed = check(m, a)
     with open(a.json or os.path.join(a.out, "spheric2.json"), "w") as fh:
         json.dump(m, fh, indent=1)
@@ -135,6 +145,29 @@ def main():
         print("FAIL:", ", ".join(failed))
         return 1
     return 0
+
+
+def ritter_depth(distance, t, h0, g=9.81):
+    """Depth at `distance` downstream of an instantaneously released column of height h0 at time t
+    (Ritter 1892, shallow water on a dry bed)."""
+    c = np.sqrt(g * h0)
+    s = distance / t
+    return 0.0 if s >= 2.0 * c else 4.0 / (9.0 * g) * (c - 0.5 * s) ** 2
+
+
+def depths(te, e, head, tls, hs, gate_x, h0):
+    """H1 and H2 every 50 ms from 0.25 s to the run's end: run, experiment, Ritter (m)."""
+    rows = []
+    print("depth (mm)   t:  H1 run / exp / Ritter    H2 run / exp / Ritter")
+    for t in np.arange(0.25, tls["H1"][-1] + 1e-9, 0.05):
+        row = {"t": float(t)}
+        for g, x, _ in GAUGES[:2]:
+            row[g] = {"run": float(np.interp(t, tls[g], hs[g])), "exp": float(np.interp(t, te, e[:, head.index(g)])),
+                      "ritter": float(ritter_depth(gate_x - x, t, h0))}
+        rows.append(row)
+        print("         %.2f s:  %4.0f / %4.0f / %4.0f          %4.0f / %4.0f / %4.0f" % (
+            t, *(1e3 * row[g][k] for g in ("H1", "H2") for k in ("run", "exp", "ritter"))))
+    return rows
 
 
 def check(m, a):
