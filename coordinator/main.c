@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +14,7 @@
 #include "coordinator.h"
 #include "dem_engine.h"
 #include "estimate.h"
+#include "shape_build.h"
 #include "auth.h"
 #include "netns.h"
 #include "output.h"
@@ -24,7 +26,8 @@ static void usage(FILE *f)
             "usage: lahar run CASE.yaml -o OUT [options]     simulate the case, output in OUT\n"
             "       lahar check CASE.yaml -o OUT [options]   simulate, then evaluate the case's check: section\n"
             "       lahar validate CASE.yaml                 load and validate the case only; prints the particle\n"
-            "                                                and body count, memory and cost estimates\n"
+            "                                                and body count, memory and cost estimates, and a\n"
+            "                                                note on each box block dx does not divide\n"
             "       lahar bench -o OUT [--quick] [options]   run time against error of the validation cases,\n"
             "                                                co-simulation overhead, DEM subcycling: CSV, PNG\n"
             "                                                and OUT/summary.md (`lahar bench --help`)\n"
@@ -167,6 +170,35 @@ static void print_estimate(const lahar_case *cs, const lahar_estimate *e)
         printf("  cost: at least %.3g steps to t = %g s (SPH step <= %.3g s by the CFL limit), %.3g particle-steps "
                "(about %.2g core-hours at 1e6 particle-steps/s)\n",
                e->steps, cs->t_end, e->dt, e->particle_steps, e->particle_steps / 1e6 / 3600.0);
+}
+
+/* A box block whose sides are not whole multiples of sph.dx holds less than it says (the lattice
+ * takes whole spacings per side): a note for each one short by more than 1 % of its volume, with
+ * the dx that would fill each short side. To stdout for `validate`, stderr otherwise. */
+static void note_block_fill(FILE *out, const lahar_case *cs)
+{
+    const double dx = cs->sph_dx;
+    for (int i = 0; i < cs->nblock; i++) {
+        const lahar_particle_block *b = &cs->blocks[i];
+        double filled[3];
+        const double fraction = lahar_particle_block_box_filled(b, cs->dim, dx, filled);
+        if (b->kind != LAHAR_BLOCK_BOX || !(fraction < 0.99))
+            continue;
+        char side[96] = "", fill[96] = "", hint[256] = "";
+        for (int a = 0; a < cs->dim; a++) {
+            const double L = b->hi[a] - b->lo[a];
+            snprintf(side + strlen(side), sizeof side - strlen(side), "%s%g", a ? " x " : "", L);
+            snprintf(fill + strlen(fill), sizeof fill - strlen(fill), "%s%g", a ? " x " : "", filled[a]);
+            if (filled[a] < (1.0 - 1e-9) * L) {
+                const double n = ceil(L / dx - 1e-9);
+                snprintf(hint + strlen(hint), sizeof hint - strlen(hint), "%s%c %g = %.0f x %.5g", hint[0] ? ", " : "",
+                         "xyz"[a], L, n, L / n);
+            }
+        }
+        fprintf(out, "%s: note: sph.blocks[%d] '%s' is %s m, but at dx = %g its particles fill %s m, %.1f %% of its "
+                     "volume (the lattice takes whole spacings per side). A dx that divides a side fills it: %s\n",
+                cs->path, i, b->name, side, dx, fill, 100.0 * fraction, hint);
+    }
 }
 
 /* A run whose estimated memory exceeds the machine's is refused (exit 2) unless --allow-large. */
@@ -368,9 +400,12 @@ int main(int argc, char **argv)
         printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,
                cs.t_end);
         print_estimate(&cs, &est);
+        note_block_fill(stdout, &cs);
     } else if (!evaluate_only && !o.no_spawn && !allow_large && check_memory(cmd, &cs, &est) != 0) {
         status = LAHAR_EXIT_BAD_INPUT;
     } else {
+        if (!evaluate_only)
+            note_block_fill(stderr, &cs);
         status = evaluate_only ? 0 : lahar_coord_run(&cs, &o);
         if (is_check && status == 0) {
             if (!cs.check.enabled) {

@@ -34,6 +34,12 @@ lahar_test(cli_interrupt_setup COMMAND sh ${LAHAR_TEST_DIR}/cli_interrupt.sh $<T
 lahar_test(cli_progress_log COMMAND sh ${LAHAR_TEST_DIR}/cli_progress.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/tools/case_override.py ${CMAKE_SOURCE_DIR}/cases ${CMAKE_CURRENT_BINARY_DIR}/cli_progress
   LABELS fast netns TIMEOUT 120)
 
+# A box block whose sides are not multiples of sph.dx: `lahar validate` notes what its lattice fills
+# (SPHERIC's column 1.228 x 1 x 0.55 m at dx 0.04: 1.2 x 1 x 0.52 m, 30 x 25 x 13 = 9750 particles,
+# 92.4 %) and the dx that fills each short side; a case whose blocks are filled gets no note
+lahar_test(cli_block_fill_note COMMAND sh -c "out=$(\"$1\" validate \"$2\") && echo \"$out\" && echo \"$out\" | grep -q '^  9750 particles' && echo \"$out\" | grep -q \"note: sph.blocks\\[0\\] 'column' is 1.228 x 1 x 0.55 m, but at dx = 0.04 its particles fill 1.2 x 1 x 0.52 m, 92.4 % of its volume\" && echo \"$out\" | grep -q 'x 1.228 = 31 x 0.039613, z 0.55 = 14 x 0.039286' && ! \"$1\" validate \"$3\" | grep note" sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_3d.yaml ${CMAKE_SOURCE_DIR}/cases/dam_break_lobovsky_2d.yaml
+  LABELS fast)
+
 # The key table (common/io/case_keys.c) drives the loader: keys accepted, defaults, range messages
 lahar_test(case_keys PROGRAM test_case_keys SOURCES test_case_keys.c LABELS fast)
 # cases/reference.yaml is what `lahar keys --yaml` prints (regenerate: build/bin/lahar keys --yaml > cases/reference.yaml)

@@ -1399,6 +1399,19 @@ static void block_lattice_dims(const lahar_particle_block *b, int dim, double dx
     }
 }
 
+double lahar_particle_block_box_filled(const lahar_particle_block *b, int dim, double dx, double filled[3])
+{
+    double n[3], fraction = 1.0;
+    block_lattice_dims(b, dim, dx, n);
+    for (int a = 0; a < 3; a++) {
+        double side = b->hi[a] - b->lo[a];
+        filled[a] = a < dim ? n[a] * dx : side;
+        if (a < dim && b->kind == LAHAR_BLOCK_BOX && side > 0.0)
+            fraction *= filled[a] / side;
+    }
+    return fraction;
+}
+
 double lahar_particle_block_lattice_size(const lahar_particle_block *b, int dim, double dx)
 {
     double n[3];
