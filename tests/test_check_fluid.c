@@ -15,7 +15,8 @@
  *  - floating_box: box 0.2 x 0.1 m, density 500 -> draft 0.05 m; raised 2 mm -> error 0.04;
  *  - sinking_disc: a disc settles on the floor; a particle inside the floor's layer fails;
  *  - dam_break: a column spreading to the far wall; a particle out of the tank, one deep inside a
- *    fixed box's core and a front that steps back fail;
+ *    fixed box's core, one in the sweep of a 79-feature ledge (the feature-grid path) and a front
+ *    that steps back fail;
  *  - dam_break against Martin & Moyce 1952 (n^2 = 2): a front on their data passes, 10 % ahead
  *    gives front_rel_error 0.1;
  *  - missing particles / fields -> status 2.
@@ -642,6 +643,14 @@ static void dam_run(const char *dir, int escape, int regress)
     /* as the case loader places fixed bodies: world-frame vertices, x = 0, identity q */
     const double I3[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, at[3] = {0.8, 0.7, 0.0};
     lahar_shape_transform(&bodies[ob].shape, I3, at, 1.0);
+    /* a fixed wavy ledge above the water, 40 vertices (79 features: the check's feature-grid path);
+     * escape == 4 puts a particle on its 21st vertex, inside its sweep */
+    int ledge = add_body("ledge", LAHAR_MOTION_FIXED, 0);
+    double lv[40][3];
+    for (int i = 0; i < 40; i++)
+        lv[i][0] = 0.1 + 0.6 * i / 39.0, lv[i][1] = 0.6 + 0.02 * sin(17.0 * lv[i][0]), lv[i][2] = 0.0;
+    lahar_shape_make_polyline(&bodies[ledge].shape, lv, 40, 0, R, NULL, 0);
+    bodies[ledge].convex = 0;
     metric("escaped_particles", 0.0);
     metric("mass_change", 0.0);
     metric("front_regression", 1.0);
@@ -666,6 +675,8 @@ static void dam_run(const char *dir, int escape, int regress)
             px[5] = 0.8, py[5] = 0.7;
         if (escape == 3 && k == 7)
             px[5] = 0.5, py[5] = 1.0; /* a splash above the walls (top 0.8): not escaped */
+        if (escape == 4 && k == 7)
+            px[5] = lv[20][0], py[5] = lv[20][1] + 0.5 * R;
         memset(reports, 0, sizeof reports);
         lahar_body_output_forces(o.bo, k, t, reports);
         run_snapshot(&o, k, t);
@@ -697,6 +708,10 @@ static void test_dam_break(const char *base)
     dam_run(dir, 3, 0);
     v = evaluate(dir, 0, "escaped_particles");
     CHECK(v == 0.0, "dam break splash above the walls: escaped_particles %g (0)", v);
+    snprintf(dir, sizeof dir, "%s/dam_ledge", base);
+    dam_run(dir, 4, 0);
+    v = evaluate(dir, 1, "escaped_particles");
+    CHECK(v == 1.0, "dam break particle in the sweep of a 79-feature ledge: escaped_particles %g (1)", v);
     snprintf(dir, sizeof dir, "%s/dam_regress", base);
     dam_run(dir, 0, 1);
     v = evaluate(dir, 1, "front_regression");

@@ -12,6 +12,7 @@
  *    directions; the level is the mean of the column tops plus dx/2 (a particle stands for a
  *    cell of size dx; the lattice of a block puts its top row dx/2 below the block's top). */
 #include <inttypes.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,6 +96,22 @@ static double fluid_depth(const lahar_case *c, const lahar_check_data *d, int j,
 {
     double dist = fluid_core_dist(c, d, j, k, p, NULL), R = c->bodies[j].shape.radius;
     return fluid_inside_core(c, d, j, k, p) ? R + dist : R - dist;
+}
+
+/* fluid_depth(c, d, j, k, p) > level, for a body with a feature grid visiting only the features
+ * within R - level of p: the same answer (the nearest feature is among them whenever the depth
+ * can exceed the level), for the tests every particle of every snapshot makes against a terrain. */
+static int fluid_deeper_than(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p, double level)
+{
+    const double R = c->bodies[j].shape.radius;
+    if (!d->has_grid || !d->has_grid[j] || fluid_inside_core(c, d, j, k, p))
+        return fluid_depth(c, d, j, k, p) > level;
+    if (!(R - level > 0.0))
+        return 0; /* outside the core the depth is R - distance <= R */
+    double x[3], q[4];
+    fluid_pose(c, d, j, k, x, q);
+    const double dist = geom_point_body_core_near(&d->grid[j], &c->bodies[j].shape, x, q, p, R - level, NULL, NULL);
+    return dist != DBL_MAX && R - dist > level;
 }
 
 /* Unit vector "up" (against gravity) and horizontal unit vectors e1 (and e2 in 3D). */
@@ -916,7 +933,7 @@ static int fluid_pressure_zero_level(const lahar_case *c, const lahar_check_data
             continue;
         int near = 0;
         for (int j = 0; j < c->nbody && !near; j++)
-            near = fluid_depth(c, d, j, c->bodies[j].motion == LAHAR_MOTION_FIXED ? -1 : kb, x) > -3.0 * dx;
+            near = fluid_deeper_than(c, d, j, c->bodies[j].motion == LAHAR_MOTION_FIXED ? -1 : kb, x, -3.0 * dx);
         if (near)
             continue;
         sh += hgt, sp += p->pressure[i], shh += hgt * hgt, shp += hgt * p->pressure[i], n++;
@@ -1237,7 +1254,7 @@ int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_
                 int fixed = c->bodies[j].motion == LAHAR_MOTION_FIXED;
                 if (!fixed && kb < 0)
                     continue;
-                out |= fluid_depth(c, d, j, fixed ? -1 : kb, x) > 0.0;
+                out |= fluid_deeper_than(c, d, j, fixed ? -1 : kb, x, 0.0);
             }
             esc += out;
         }
