@@ -127,15 +127,17 @@ static int parse_int_option(const char *cmd, const char *opt, const char *s, lon
     return 0;
 }
 
-/* A number in (lo, hi] of seconds for option `opt`, or exit 2. */
-static int parse_seconds_option(const char *cmd, const char *opt, const char *s, double lo, double hi, double *out)
+/* A number in (lo, hi] of seconds for option `opt` (or 0 when zero_off: the option turned off), or
+ * -1 with the message. */
+static int parse_seconds_option(const char *cmd, const char *opt, const char *s, double lo, double hi, int zero_off,
+                                double *out)
 {
     char *end;
     errno = 0;
     double v = strtod(s, &end);
-    if (errno || end == s || *end != '\0' || !(v > lo && v <= hi)) {
-        fprintf(stderr, "lahar %s: %s takes a number of seconds above %g and at most %g (got '%s')\n", cmd, opt, lo,
-                hi, s);
+    if (errno || end == s || *end != '\0' || !((v > lo && v <= hi) || (zero_off && v == 0.0))) {
+        fprintf(stderr, "lahar %s: %s takes a number of seconds above %g and at most %g%s (got '%s')\n", cmd, opt, lo,
+                hi, zero_off ? ", or 0 for none" : "", s);
         return -1;
     }
     *out = v;
@@ -312,20 +314,14 @@ int main(int argc, char **argv)
         case 'n': o.no_spawn = 1; break;
         case 'u': o.lcm_url = optarg; break;
         case 'w':
-            if (parse_seconds_option(cmd, "--wait", optarg, 0.0, 86400.0, &o.join_wait_s) != 0)
+            if (parse_seconds_option(cmd, "--wait", optarg, 0.0, 86400.0, 0, &o.join_wait_s) != 0)
                 return 2;
             break;
         case 'q': o.quiet = 1; break;
-        case 'P': {
-            char *end;
-            if (strtod(optarg, &end) == 0.0 && end != optarg && *end == '\0') { /* 0: no progress lines */
-                o.progress_every_s = 0.0;
-                break;
-            }
-            if (parse_seconds_option(cmd, "--progress-every", optarg, 0.0, 86400.0, &o.progress_every_s) != 0)
+        case 'P': /* 0: no progress lines */
+            if (parse_seconds_option(cmd, "--progress-every", optarg, 0.0, 86400.0, 1, &o.progress_every_s) != 0)
                 return 2;
             break;
-        }
         case 'e': evaluate_only = 1; break;
         case 'L': allow_large = 1; break;
         case 'O': o.overwrite = 1; break;
@@ -336,11 +332,11 @@ int main(int argc, char **argv)
                         cmd);
                 return 2;
             }
-            if (parse_seconds_option(cmd, "--time-end", optarg, 0.0, 1e12, &o.resume_t_end) != 0)
+            if (parse_seconds_option(cmd, "--time-end", optarg, 0.0, 1e12, 0, &o.resume_t_end) != 0)
                 return 2;
             break;
         case 'T':
-            if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, &o.node_timeout_s) != 0)
+            if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, 0, &o.node_timeout_s) != 0)
                 return 2;
             break;
         case 'h': usage(stdout); return 0;
