@@ -39,13 +39,13 @@ static double soil_sound_speed(const lahar_case *c)
     return cs;
 }
 
-void lahar_estimate_case(const lahar_case *c, lahar_estimate *e)
+void lahar_estimate_case(const lahar_case *c, double count_max, lahar_estimate *e)
 {
     *e = (lahar_estimate){.bodies = c->nbody, .exact = 1};
     double lattice = 0.0;
     for (int b = 0; b < c->nblock; b++)
         lattice += block_lattice_points(&c->blocks[b], c->dim, c->sph_dx);
-    e->exact = lattice <= LAHAR_ESTIMATE_COUNT_MAX;
+    e->exact = lattice <= count_max;
     for (int b = 0; b < c->nblock; b++) {
         int64_t n = e->exact ? lahar_case_block_lattice(c, b, NULL, 0)
                              : (int64_t)block_lattice_points(&c->blocks[b], c->dim, c->sph_dx);

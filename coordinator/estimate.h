@@ -17,10 +17,16 @@ typedef struct {
     double particle_steps; /* particles x steps */
 } lahar_estimate;
 
-/* Fills *e for case c. Counting point by point is skipped above LAHAR_ESTIMATE_COUNT_MAX lattice
- * points (the count of the blocks' lattices is given instead, an upper bound). */
-#define LAHAR_ESTIMATE_COUNT_MAX 250000
-void lahar_estimate_case(const lahar_case *c, lahar_estimate *e);
+/* Fills *e for case c, counting the particles point by point (the bodies cut out, as the SPH node
+ * fills them) up to count_max lattice points in all; above it the count of the blocks' lattices
+ * is given instead, an upper bound (a terrain case's blocks may hold 8 x fewer). Counting costs
+ * about 1 us per lattice point (a terrain's features through its grid), so `lahar validate` counts
+ * up to LAHAR_ESTIMATE_COUNT_MAX (a few seconds), and `lahar run`, which only needs an upper bound
+ * for its memory check, up to LAHAR_ESTIMATE_COUNT_RUN, counting further only before it would
+ * refuse a case. */
+#define LAHAR_ESTIMATE_COUNT_MAX 4000000.0
+#define LAHAR_ESTIMATE_COUNT_RUN 250000.0
+void lahar_estimate_case(const lahar_case *c, double count_max, lahar_estimate *e);
 
 /* The machine's physical memory in bytes (0 if unknown). */
 double lahar_estimate_machine_bytes(void);

@@ -204,16 +204,21 @@ static void note_block_fill(FILE *out, const lahar_case *cs)
 }
 
 /* A run whose estimated memory exceeds the machine's is refused (exit 2) unless --allow-large. */
-static int check_memory(const char *cmd, const lahar_case *cs, const lahar_estimate *e)
+static int check_memory(const char *cmd, const lahar_case *cs, lahar_estimate *e)
 {
     double machine = lahar_estimate_machine_bytes();
     if (machine <= 0.0 || e->bytes <= machine)
         return 0;
+    if (!e->exact) { /* the lattice's upper bound is over: count the particles before refusing */
+        lahar_estimate_case(cs, LAHAR_ESTIMATE_COUNT_MAX, e);
+        if (e->bytes <= machine)
+            return 0;
+    }
     char mem[32], mach[32];
-    fprintf(stderr, "lahar %s: %s needs about %s of memory (%lld particles) but this machine has %s; use a larger "
+    fprintf(stderr, "lahar %s: %s needs about %s of memory (%s%lld particles) but this machine has %s; use a larger "
                     "sph.dx (memory falls as dx^-%d), or --allow-large to run it anyway\n", cmd, cs->path,
-            human_bytes(e->bytes, mem, sizeof mem), (long long)e->particles, human_bytes(machine, mach, sizeof mach),
-            cs->dim);
+            human_bytes(e->bytes, mem, sizeof mem), e->exact ? "" : "at most ", (long long)e->particles,
+            human_bytes(machine, mach, sizeof mach), cs->dim);
     return -1;
 }
 
@@ -391,7 +396,7 @@ int main(int argc, char **argv)
     int status = 0;
     lahar_estimate est;
     if (is_validate || !evaluate_only)
-        lahar_estimate_case(&cs, &est);
+        lahar_estimate_case(&cs, is_validate ? LAHAR_ESTIMATE_COUNT_MAX : LAHAR_ESTIMATE_COUNT_RUN, &est);
     if (is_validate) {
         printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,
                cs.t_end);

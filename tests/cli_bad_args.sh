@@ -45,8 +45,17 @@ else
     echo "FAIL validate dam_break_2d.yaml does not state its 3200 particles, memory and cost:"; sed 's/^/    /' "$work/validate.txt"
     fail=$((fail + 1))
 fi
+# a terrain case: 907200 lattice points, of which the two blocks between the terrain and the
+# debris surface hold 108496 (the count, not the lattice's bound, drives memory and cost)
+"$lahar" validate "$fixtures/../../cases/debris_flow_3d.yaml" > "$work/validate3d.txt" 2>&1
+if grep -q "^  108496 particles (54248 soil), 6 bodies$" "$work/validate3d.txt"; then
+    pass=$((pass + 1)); echo "ok   validate debris_flow_3d.yaml: $(sed -n 2p "$work/validate3d.txt")"
+else
+    echo "FAIL validate debris_flow_3d.yaml does not count its 108496 particles:"; sed 's/^/    /' "$work/validate3d.txt"
+    fail=$((fail + 1))
+fi
 python3 "$fixtures/../../tools/case_override.py" "$fixtures/../../cases/dam_break_3d.yaml" "$work/giant.yaml" sph.dx=0.0002 >/dev/null
-expect 2 "giant.yaml needs about [0-9.]* [GT]B of memory \(1875000000 particles\) but this machine has .*--allow-large" -- \
+expect 2 "giant.yaml needs about [0-9.]* [GT]B of memory \(at most 1875000000 particles\) but this machine has .*--allow-large" -- \
     run "$work/giant.yaml" -o "$work/giant" --in-process
 [ ! -e "$work/giant" ] || { echo "FAIL an output directory was created for a refused case"; fail=$((fail + 1)); }
 # an OUT with an earlier run's files is refused; --overwrite removes them first (a water run's
