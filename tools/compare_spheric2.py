@@ -21,7 +21,8 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              (1892) shallow-water dam-break depth h = (4/9g) (sqrt(g H0) - x/2t)^2 for the
              instantaneous release of the case's column (H0 its height, x the distance from its
              downstream face): how much water arrives in front of the box
-The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment. Runs of the 2D centre plane
+The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment (and Ritter's depth at the gauges
+before the box). Runs of the 2D centre plane
 (cases/dam_break_obstacle_plane_2d.yaml) are read the same way (its probes and gauges have the
 3D case's names).
 With --check: exit 1 unless |impact - 0.394 s| / 0.394 s <= --impact-tol (default 0.05), every
@@ -45,6 +46,7 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 GAUGES = [("H1", 1.488, 0.5), ("H2", 0.992, 0.5), ("H3", 0.496, 0.5), ("H4", 2.638, 0.5)]
+BOX_FACE_X = 0.8245  # the obstacle's face towards the water: Ritter's depth is drawn for the gauges before it
 IMPACT_PA = 1000.0
 SPAN = 0.2
 PLATEAU = (0.05, 0.15)  # s after the first impact on P1: the window of the sustained load
@@ -140,7 +142,7 @@ def main():
     with open(a.json or os.path.join(a.out, "spheric2.json"), "w") as fh:
         json.dump(m, fh, indent=1)
     if not a.no_plot:
-        plot(a, te, e, head, run_p, tls, hs, dx, tau)
+        plot(a, te, e, head, run_p, tls, hs, dx, tau, column)
     if a.check and not ok:
         print("FAIL:", ", ".join(failed))
         return 1
@@ -148,11 +150,16 @@ def main():
 
 
 def ritter_depth(distance, t, h0, g=9.81):
-    """Depth at `distance` downstream of an instantaneously released column of height h0 at time t
-    (Ritter 1892, shallow water on a dry bed)."""
+    """Depth at `distance` downstream (negative: upstream, in the reservoir) of an instantaneously
+    released column of height h0 at time t (Ritter 1892, shallow water on a dry bed; until the
+    rarefaction comes back from the reservoir's end wall)."""
     c = np.sqrt(g * h0)
-    s = distance / t
-    return 0.0 if s >= 2.0 * c else 4.0 / (9.0 * g) * (c - 0.5 * s) ** 2
+    s = distance / t if t > 0.0 else (np.inf if distance > 0.0 else -np.inf)
+    if s >= 2.0 * c:
+        return 0.0
+    if s <= -c:
+        return h0
+    return 4.0 / (9.0 * g) * (c - 0.5 * s) ** 2
 
 
 def depths(te, e, head, tls, hs, gate_x, h0):
@@ -190,7 +197,7 @@ def check(m, a):
     return not failed, failed
 
 
-def plot(a, te, e, head, run_p, tls, hs, dx, tau):
+def plot(a, te, e, head, run_p, tls, hs, dx, tau, column):
     tl = tls["H1"]
     fig, axes = plt.subplots(4, 2, figsize=(12, 10), sharex=True)
     for k, n in enumerate(["P1", "P3", "P5", "P7"]):
@@ -208,6 +215,14 @@ def plot(a, te, e, head, run_p, tls, hs, dx, tau):
         ax = axes[k, 1]
         ax.plot(te, e[:, head.index(g)], "k", lw=1.0, label="experiment")
         ax.plot(tls[g], hs[g], lw=0.8, label="lahar, level gauge")
+        # Ritter's depth, for the gauges before the box, until the rarefaction reflected at the
+        # reservoir's end wall arrives
+        gate, back, h0 = float(column["lo"][0]), float(column["hi"][0]), float(column["hi"][-1])
+        t_end = min(tls[g][-1], (back - gate + back - xg) / np.sqrt(9.81 * h0))
+        if xg > BOX_FACE_X:
+            tr = np.linspace(1e-3, t_end, 400)
+            ax.plot(tr, [ritter_depth(gate - xg, t, h0) for t in tr], "--", color="0.5", lw=0.8,
+                    label="Ritter 1892 (instantaneous release, shallow water)")
         ax.set_ylabel("%s (x = %g m), m" % (g, xg))
         ax.grid(alpha=0.3)
         if k == 0:
