@@ -13,6 +13,8 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              within 0.2 s of P1's impact
   plateau    P1 and P3: the mean over 50-150 ms after P1's first impact (the run's and the
              experiment's each from its own impact), the sustained load; nan when the run ends earlier
+  noise      P1 and P3: the rms of p about its --window running mean over that same window: how
+             far the signal swings about the load a structure feels
   levels     H1-H4 at (x, y) = (1.488, 0.5), (0.992, 0.5), (0.496, 0.5), (2.638, 0.5) m: the time
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
@@ -57,6 +59,12 @@ DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "r
 def first_at_or_above(t, p, level):
     i = np.flatnonzero(p >= level)
     return float(t[i[0]]) if len(i) else float("nan")
+
+
+def running_mean(t, p, tau):
+    """p averaged over a centred window of tau (samples assumed about evenly spaced)."""
+    w = max(1, int(round(tau / np.median(np.diff(t)))))
+    return np.convolve(p, np.ones(w) / w, mode="same")
 
 
 def window_peak(t, p, t0, tau):
@@ -110,6 +118,10 @@ def main():
         covered = len(t) and t[-1] >= ti_run + hi
         m["peaks"][n]["plateau"] = float(p[w].mean()) if covered else float("nan")
         m["peaks"][n]["plateau_exp"] = float(pe[we].mean())
+        # how smooth the load is: rms of p about its running mean over --window, in that window
+        m["peaks"][n]["noise_rms"] = float(np.sqrt(np.mean((p - running_mean(t, p, tau))[w] ** 2))) if covered \
+            else float("nan")
+        m["peaks"][n]["noise_rms_exp"] = float(np.sqrt(np.mean((pe - running_mean(te, pe, tau))[we] ** 2)))
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
         if missing:
@@ -131,8 +143,9 @@ def main():
         ti_run, ti_exp, 100 * m["impact"]["rel"]))
     for n, s in m["peaks"].items():
         print("%s: peak %.0f Pa (exp %.0f), %g ms mean %.0f Pa (exp %.0f), mean 50-150 ms after the impact %.0f Pa "
-              "(exp %.0f)" % (n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"], s["plateau"],
-                              s["plateau_exp"]))
+              "(exp %.0f), rms about the %g ms running mean there %.0f Pa (exp %.0f)" % (
+                  n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"], s["plateau"],
+                  s["plateau_exp"], a.window, s["noise_rms"], s["noise_rms_exp"]))
     for g, d in m["levels"].items():
         print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
             g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
@@ -205,8 +218,7 @@ def plot(a, te, e, head, run_p, tls, hs, dx, tau, column):
         ax.plot(te, e[:, head.index(n)] / 1e3, "k", lw=1.0, label="Kleefsman et al. 2005 (SPHERIC Test 2)")
         t, p = run_p[n]
         ax.plot(t, p / 1e3, lw=0.7, label="lahar, dx %g mm" % (1e3 * dx))
-        w = max(1, int(round(tau / np.median(np.diff(t)))))
-        ax.plot(t, np.convolve(p, np.ones(w) / w, mode="same") / 1e3, lw=1.0, label="lahar, %g ms running mean" % a.window)
+        ax.plot(t, running_mean(t, p, tau) / 1e3, lw=1.0, label="lahar, %g ms running mean" % a.window)
         ax.set_ylabel(n + ", kPa")
         ax.grid(alpha=0.3)
         if k == 0:
