@@ -1287,7 +1287,7 @@ static void block_ray_grid_free(block_ray_grid *g)
     g->start = g->items = NULL;
 }
 
-/* Returns 0, or -1 when out of memory. */
+/* Returns 0, 1 when the mesh's extent cannot be binned (then no grid), or -1 when out of memory. */
 static int block_ray_grid_build(const lahar_particle_block *b, block_ray_grid *g)
 {
     memset(g, 0, sizeof *g);
@@ -1304,6 +1304,8 @@ static int block_ray_grid_build(const lahar_particle_block *b, block_ray_grid *g
             hi[a] = fmax(hi[a], th[a]);
         }
     }
+    if (!(isfinite(lo[0]) && isfinite(lo[1]) && isfinite(hi[0] - lo[0]) && isfinite(hi[1] - lo[1])))
+        return 1; /* extents no grid can bin (coordinates near DBL_MAX): the per-point test */
     /* about one triangle per cell */
     double area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
     g->h = area > 0.0 ? sqrt(area / b->ntri) : fmax(hi[0] - lo[0], hi[1] - lo[1]) + 1.0;
@@ -1429,12 +1431,20 @@ int64_t lahar_particle_block_lattice_keep(const lahar_particle_block *b, int dim
     /* a lattice no run could hold (or whose indices would not fit int64): refused, not walked */
     if (!(lahar_particle_block_lattice_size(b, dim, dx) <= LAHAR_LATTICE_MAX))
         return -1;
+    /* an axis without a point: no point at all (and another axis may still be beyond int64, its
+     * product with 0 within the bound) */
+    if (nd[0] == 0.0 || nd[1] == 0.0 || nd[2] == 0.0)
+        return 0;
     int64_t n[3] = {(int64_t)nd[0], (int64_t)nd[1], (int64_t)nd[2]};
     int64_t count = 0;
     block_ray_grid grid;
-    const int gridded = b->kind == LAHAR_BLOCK_MESH && dim == 3 && b->ntri > GEOM_FEATURE_GRID_MIN;
-    if (gridded && block_ray_grid_build(b, &grid) != 0)
-        return -1;
+    int gridded = b->kind == LAHAR_BLOCK_MESH && dim == 3 && b->ntri > GEOM_FEATURE_GRID_MIN;
+    if (gridded) {
+        int rc = block_ray_grid_build(b, &grid);
+        if (rc < 0)
+            return -1;
+        gridded = rc == 0;
+    }
     for (int64_t i = 0; i < n[0]; i++)
         for (int64_t j = 0; j < n[1]; j++)
             for (int64_t k = 0; k < n[2]; k++) {
