@@ -210,6 +210,32 @@ int main(void)
         dem_test_check(bad == 0 && near > 200 && far > 200,
                        "grid point queries (terrain + rotated box): %d within 0.15 m equal brute force, %d beyond "
                        "return none, %d bad", near, far, bad);
+        /* the grids of a set of bodies: the terrain gets one, the 26-feature box none; the one query
+         * goes through the terrain's grid (nothing beyond the reach) and scans the box at any
+         * distance */
+        lahar_body bodies[2] = {{.shape = T}, {.shape = B}};
+        geom_body_grids gs;
+        dem_test_check(geom_body_grids_build(&gs, bodies, 2) == 0 && gs.has[0] == 1 && gs.has[1] == 0,
+                       "body grids: the 1800-triangle terrain has a grid, the box none");
+        int bad_set = 0, far_box = 0;
+        for (int it = 0; it < 2000; it++) {
+            const int sh = it % 2;
+            vec3 p = sh == 0 ? v3(3.0 * urand(&seed), 3.0 * urand(&seed), 0.6 * urand(&seed) - 0.3)
+                             : v3(0.3 + 4.0 * urand(&seed) - 2.0, -0.2 + 4.0 * urand(&seed) - 2.0, 0.5 + 4.0 * urand(&seed) - 2.0);
+            vec3 cb, cs;
+            double db = geom_point_body_core(shapes[sh], xs[sh], qs[sh], p, &cb, NULL);
+            double ds = geom_body_grids_core(&gs, sh, shapes[sh], xs[sh], qs[sh], p, 0.15, &cs, NULL);
+            far_box += sh == 1 && db > 0.15;
+            if (sh == 1 || db <= 0.15) {
+                if (ds != db || v3_norm(v3_sub(cs, cb)) > 1e-9) bad_set++;
+            } else if (ds != DBL_MAX)
+                bad_set++;
+        }
+        dem_test_check(bad_set == 0 && far_box > 200,
+                       "body grids query: terrain through its grid, box by full scan (%d beyond the reach), %d bad",
+                       far_box, bad_set);
+        geom_body_grids_free(&gs);
+        dem_test_check(gs.grid == NULL && gs.has == NULL, "body grids freed");
         lahar_shape_free(&T);
     }
     lahar_shape_free(&A);

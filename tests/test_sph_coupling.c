@@ -290,7 +290,7 @@ int main(void)
             double ang = 0.37 + t * 0.157, rr = 0.1 + 0.005 + (0.2 + 0.01 * t) * DX;
             double x[3] = {rr * cos(ang), rr * sin(ang), 0}, v[3] = {0, 0, 0};
             one_particle(&f, 2, x, v, 1, &poly);
-            CHECK(f.cpl.has_grid[0] == 1, "no feature grid for a 240-feature shape");
+            CHECK(f.cpl.grids.has[0] == 1, "no feature grid for a 240-feature shape");
             vec3 cp;
             double dc = geom_point_body_core(&poly.shape, poly.x, poly.q, v3_load(x), &cp, NULL);
             double delta = eps - (dc - 0.005);

@@ -510,3 +510,44 @@ double geom_point_body_core_near(const geom_feature_grid *g, const lahar_shape *
     if (feature) *feature = bf;
     return best;
 }
+
+int geom_body_grids_build(geom_body_grids *g, const lahar_body *bodies, int nbody)
+{
+    const size_t nb = (size_t)(nbody > 0 ? nbody : 1);
+    g->nbody = nbody;
+    g->grid = calloc(nb, sizeof *g->grid);
+    g->has = calloc(nb, sizeof *g->has);
+    if (!g->grid || !g->has) {
+        geom_body_grids_free(g);
+        return -1;
+    }
+    for (int b = 0; b < nbody; b++) {
+        const lahar_shape *s = &bodies[b].shape;
+        if (s->nv + s->ne + s->nf <= GEOM_FEATURE_GRID_MIN)
+            continue;
+        g->has[b] = 1; /* freed below even when half built */
+        if (geom_feature_grid_build(&g->grid[b], s) != 0) {
+            geom_body_grids_free(g);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void geom_body_grids_free(geom_body_grids *g)
+{
+    for (int b = 0; g->has && b < g->nbody; b++)
+        if (g->has[b])
+            geom_feature_grid_free(&g->grid[b]);
+    free(g->grid);
+    free(g->has);
+    memset(g, 0, sizeof *g);
+}
+
+double geom_body_grids_core(const geom_body_grids *g, int b, const lahar_shape *s, const double x[3],
+                            const double q[4], vec3 p, double reach, vec3 *c, int *feature)
+{
+    if (g && g->has && g->has[b])
+        return geom_point_body_core_near(&g->grid[b], s, x, q, p, reach, c, feature);
+    return geom_point_body_core(s, x, q, p, c, feature);
+}

@@ -124,4 +124,24 @@ void geom_feature_grid_query(const geom_feature_grid *g, vec3 c, double r, geom_
 double geom_point_body_core_near(const geom_feature_grid *g, const lahar_shape *s, const double x[3],
                                  const double q[4], vec3 p, double max_dist, vec3 *c, int *feature);
 
+/* ---- The feature grids of an array of bodies: a grid for each body with more than
+ * GEOM_FEATURE_GRID_MIN features, none for the others. Each user that tests many points against
+ * the bodies (the SPH coupling, the lattice cut, lahar check) owns one, built once. */
+typedef struct {
+    int nbody;
+    geom_feature_grid *grid; /* per body; valid where has[b] */
+    unsigned char *has;      /* per body: 1 when grid[b] is built */
+} geom_body_grids;
+
+/* Build the grids of bodies[0 .. nbody). Returns 0, or -1 (no memory; g is then freed). */
+int geom_body_grids_build(geom_body_grids *g, const lahar_body *bodies, int nbody);
+void geom_body_grids_free(geom_body_grids *g);
+
+/* Distance from p to the core of body b (shape s placed at x, q), its closest point c and feature:
+ * through b's grid when it has one, visiting only the features within reach of p (DBL_MAX, c and
+ * feature untouched, when none is that close: geom_point_body_core_near); else every feature at
+ * any distance (geom_point_body_core). g NULL or never built: every feature. */
+double geom_body_grids_core(const geom_body_grids *g, int b, const lahar_shape *s, const double x[3],
+                            const double q[4], vec3 p, double reach, vec3 *c, int *feature);
+
 #endif

@@ -31,11 +31,9 @@
 typedef struct {
     const lahar_case *c;
     double *reach;
-    /* per body: a feature grid for a fixed or prescribed body with more than GEOM_FEATURE_GRID_MIN
-     * features (a terrain, an STL flume), whose inside test then visits only the features near the
-     * point (geom_point_body_core_near); has_grid[m] = 0: every feature is scanned */
-    geom_feature_grid *grid;
-    int *has_grid;
+    /* the feature grids of the big bodies (a terrain, an STL flume): the inside and halo tests
+     * visit only the features within R + eps of the point */
+    geom_body_grids grids;
     double eps;
     double zone;  /* sph.body_layers > 0: the lattice leaves out the points within zone = body_layers dx
                      of a round body's surface (case_block_layers fills them); else 0 */
@@ -121,18 +119,17 @@ static int case_lattice_outside_bodies(double x[3], void *ctx)
             d2 += (x[a] - bd->x[a]) * (x[a] - bd->x[a]);
         if (d2 > k->reach[m] * k->reach[m])
             continue;
-        /* inside = lahar_body_contains: core distance < R, or in the core. Through the grid only
-         * the features within R are visited; the distance is the same when one is (the same
-         * per-feature tests), and DBL_MAX (not inside the sweep) when none is. */
+        /* inside = lahar_body_contains: core distance < R, or in the core; in a free body's halo:
+         * distance < R + eps. Through a grid only the features within R + eps are visited; the
+         * distance is the same when one is (the same per-feature tests), and DBL_MAX (neither
+         * inside the sweep nor in the halo) when none is. */
         vec3 p = v3_load(x), cp;
         int feat;
         const double R = bd->shape.radius;
-        const double dc = k->has_grid[m]
-                              ? geom_point_body_core_near(&k->grid[m], &bd->shape, bd->x, bd->q, p, R, &cp, &feat)
-                              : geom_point_body_core(&bd->shape, bd->x, bd->q, p, &cp, &feat);
+        const double dc = geom_body_grids_core(&k->grids, m, &bd->shape, bd->x, bd->q, p, R + k->eps, &cp, &feat);
         if (dc < R || geom_point_in_core(&bd->shape, bd->convex, k->c->dim, bd->x, bd->q, p))
             return 0;
-        /* in the halo of a free body (never gridded): out to d = eps along the normal */
+        /* in the halo of a free body: out to d = eps along the normal */
         if (bd->motion == LAHAR_MOTION_FREE && dc - R < k->eps - tol && dc > 0.0) {
             vec3 q = v3_axpy((R + k->eps) / dc, v3_sub(p, cp), cp);
             x[0] = q.x, x[1] = q.y, x[2] = k->c->dim == 2 ? 0.0 : q.z;
@@ -233,18 +230,12 @@ static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[
 {
     /* the halo is dx/2 (the only value sph.halo accepts) */
     const size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
-    case_lattice_cut k = {c, malloc(nb * sizeof(double)), calloc(nb, sizeof(geom_feature_grid)), calloc(nb, sizeof(int)),
-                          0.5 * c->sph_dx, 0.0};
+    case_lattice_cut k = {c, malloc(nb * sizeof(double)), {0}, 0.5 * c->sph_dx, 0.0};
     int64_t count = -1;
-    if (!k.reach || !k.grid || !k.has_grid)
+    if (!k.reach || geom_body_grids_build(&k.grids, c->bodies, c->nbody) != 0)
         goto done;
     for (int m = 0; m < c->nbody; m++) {
         const lahar_body *bd = &c->bodies[m];
-        if (bd->motion != LAHAR_MOTION_FREE && bd->shape.nv + bd->shape.ne + bd->shape.nf > GEOM_FEATURE_GRID_MIN) {
-            if (geom_feature_grid_build(&k.grid[m], &bd->shape) != 0)
-                goto done;
-            k.has_grid[m] = 1;
-        }
         k.reach[m] = 0.0;
         for (int v = 0; v < bd->shape.nv; v++)
             k.reach[m] = fmax(k.reach[m], v3_norm(v3_sub(geom_world_vertex(&bd->shape, bd->x, bd->q, v), v3_load(bd->x))));
@@ -258,12 +249,8 @@ static int64_t case_block_lattice(const lahar_case *c, int block, double (*out)[
         count = case_block_layers(c, block, &k, count, first_only ? 1 : -1, out, cap);
     }
 done:
-    for (int m = 0; m < c->nbody && k.grid; m++)
-        if (k.has_grid && k.has_grid[m])
-            geom_feature_grid_free(&k.grid[m]);
+    geom_body_grids_free(&k.grids);
     free(k.reach);
-    free(k.grid);
-    free(k.has_grid);
     return count;
 }
 

@@ -327,30 +327,8 @@ void lahar_check_data_free(lahar_check_data *d)
     free(d->t), free(d->step), free(d->x), free(d->q), free(d->v), free(d->w), free(d->ft), free(d->ncontacts);
     free(d->force);
     check_particles_free(d->particles);
-    for (int j = 0; d->has_grid && j < d->nbody; j++)
-        if (d->has_grid[j])
-            geom_feature_grid_free(&d->grid[j]);
-    free(d->grid), free(d->has_grid);
+    geom_body_grids_free(&d->grids);
     memset(d, 0, sizeof *d);
-}
-
-/* The feature grids of the case's big bodies (lahar_check_data.grid). Returns 0, or -1 when out of
- * memory. */
-static int check_build_grids(const lahar_case *c, lahar_check_data *d)
-{
-    d->grid = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *d->grid);
-    d->has_grid = calloc((size_t)(c->nbody > 0 ? c->nbody : 1), sizeof *d->has_grid);
-    if (!d->grid || !d->has_grid)
-        return -1;
-    for (int j = 0; j < c->nbody; j++) {
-        const lahar_shape *s = &c->bodies[j].shape;
-        if (s->nv + s->ne + s->nf <= GEOM_FEATURE_GRID_MIN)
-            continue;
-        if (geom_feature_grid_build(&d->grid[j], s))
-            return -1;
-        d->has_grid[j] = 1;
-    }
-    return 0;
 }
 
 /* ---------------------------------------------------------------- evaluator helpers ----- */
@@ -891,7 +869,7 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
         lahar_check_data_free(&d);
         return check_fail(outdir, ref->name, msg);
     }
-    if (check_build_grids(c, &d)) {
+    if (geom_body_grids_build(&d.grids, c->bodies, c->nbody)) {
         lahar_check_data_free(&d);
         return check_fail(outdir, ref->name, "out of memory");
     }

@@ -52,11 +52,10 @@ typedef struct {
     int32_t *ncontacts; /* [row][body] */
     double *force;      /* [row][body][3], N (N/m in 2D) */
     lahar_check_particles *particles;
-    /* per body of the case: a feature grid for a body with more than GEOM_FEATURE_GRID_MIN features
-     * (a terrain, an STL flume), so that a particle's distance test visits only the features near
-     * it (lahar_check_evaluate builds them; has_grid NULL: none) */
-    geom_feature_grid *grid;
-    int *has_grid;
+    /* the feature grids of the case's big bodies (a terrain, an STL flume), so that a particle's
+     * distance test visits only the features near it (lahar_check_evaluate builds them; never
+     * built: every feature is scanned) */
+    geom_body_grids grids;
 } lahar_check_data;
 
 /* Read particle snapshot k into p's buffers (no-op when it is already there). Returns 0, or -1

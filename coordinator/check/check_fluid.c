@@ -98,19 +98,19 @@ static double fluid_depth(const lahar_case *c, const lahar_check_data *d, int j,
     return fluid_inside_core(c, d, j, k, p) ? R + dist : R - dist;
 }
 
-/* fluid_depth(c, d, j, k, p) > level, for a body with a feature grid visiting only the features
+/* fluid_depth(c, d, j, k, p) > level; for a body with a feature grid visiting only the features
  * within R - level of p: the same answer (the nearest feature is among them whenever the depth
  * can exceed the level), for the tests every particle of every snapshot makes against a terrain. */
 static int fluid_deeper_than(const lahar_case *c, const lahar_check_data *d, int j, int64_t k, vec3 p, double level)
 {
     const double R = c->bodies[j].shape.radius;
-    if (!d->has_grid || !d->has_grid[j] || fluid_inside_core(c, d, j, k, p))
+    if (fluid_inside_core(c, d, j, k, p))
         return fluid_depth(c, d, j, k, p) > level;
     if (!(R - level > 0.0))
         return 0; /* outside the core the depth is R - distance <= R */
     double x[3], q[4];
     fluid_pose(c, d, j, k, x, q);
-    const double dist = geom_point_body_core_near(&d->grid[j], &c->bodies[j].shape, x, q, p, R - level, NULL, NULL);
+    const double dist = geom_body_grids_core(&d->grids, j, &c->bodies[j].shape, x, q, p, R - level, NULL, NULL);
     return dist != DBL_MAX && R - dist > level;
 }
 

@@ -37,9 +37,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->pcap = particle_cap < 1 ? 1 : particle_cap;
     int nb = nbody > 0 ? nbody : 1;
     c->bound = calloc((size_t)nb, sizeof *c->bound);
-    c->grid = calloc((size_t)nb, sizeof *c->grid);
     c->box = calloc((size_t)nb, sizeof *c->box);
-    c->has_grid = calloc((size_t)nb, sizeof *c->has_grid);
     c->force = calloc((size_t)nb, sizeof *c->force);
     c->torque = calloc((size_t)nb, sizeof *c->torque);
     c->body_start = calloc((size_t)nb + 1, sizeof *c->body_start);
@@ -50,7 +48,7 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
     c->slot = lahar_soa_calloc((size_t)c->pcap * SPH_COUPLING_MAX_PER_PARTICLE, sizeof *c->slot);
     c->contacts_cap = 1024;
     c->contacts = calloc((size_t)c->contacts_cap, sizeof *c->contacts);
-    if (!c->bound || !c->box || !c->grid || !c->has_grid || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
+    if (!c->bound || !c->box || !c->force || !c->torque || !c->body_start || !c->body_fill || !c->slot_n || !c->slot_body ||
         !c->slot || !c->contacts) {
         sph_coupling_free(c);
         return -1;
@@ -73,13 +71,10 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
                 c->box[b][3 + a] = fmax(c->box[b][3 + a], v3_get(w, a) + s->radius);
             }
         }
-        if (s->nv + s->ne + s->nf > GEOM_FEATURE_GRID_MIN) {
-            if (geom_feature_grid_build(&c->grid[b], s) != 0) {
-                sph_coupling_free(c);
-                return -1;
-            }
-            c->has_grid[b] = 1;
-        }
+    }
+    if (geom_body_grids_build(&c->grids, bodies, nbody) != 0) {
+        sph_coupling_free(c);
+        return -1;
     }
     /* the half-space factor, tabulated from eps/2 (closest a particle is let near) to the support */
     c->gtab_d0 = 0.5 * c->eps;
@@ -111,12 +106,8 @@ int sph_coupling_init(sph_coupling *c, int dim, int nbody, const lahar_body *bod
 
 void sph_coupling_free(sph_coupling *c)
 {
-    for (int b = 0; c->has_grid && b < c->nbody; b++)
-        if (c->has_grid[b])
-            geom_feature_grid_free(&c->grid[b]);
-    free(c->grid);
+    geom_body_grids_free(&c->grids);
     free(c->box);
-    free(c->has_grid);
     for (int b = 0; c->gtab_body && b < c->nbody; b++)
         free(c->gtab_body[b]);
     free(c->gtab_body);
@@ -308,9 +299,7 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
                     continue;
                 vec3 core = xb;
                 /* big shapes (terrain, flumes): only the features near the particle */
-                double dc = c->has_grid[b] ? geom_point_body_core_near(&c->grid[b], &body->shape, bx, bq, xi, R + support,
-                                                                       &core, NULL)
-                                           : geom_point_body_core(&body->shape, bx, bq, xi, &core, NULL);
+                double dc = geom_body_grids_core(&c->grids, b, &body->shape, bx, bq, xi, R + support, &core, NULL);
                 int inside = geom_point_in_core(&body->shape, body->convex, c->dim, bx, bq, xi); /* deep inside: far from the surface */
                 if (dc - R >= support && !inside)
                     continue;

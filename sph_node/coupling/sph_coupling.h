@@ -82,8 +82,7 @@ typedef struct {
     const lahar_body *bodies;  /* borrowed: shapes, motion */
     double *bound;             /* per body: max |core vertex - x| (body frame) + R */
     double (*box)[6];          /* per fixed body: world box of the swept shape (lo, hi) */
-    geom_feature_grid *grid;   /* per body: feature grid for big shapes (terrain), else unused */
-    int *has_grid;
+    geom_body_grids grids;     /* feature grids of the big shapes (terrain, flumes) */
     kernel k;
     double eps;                /* halo thickness, dx/2 (eq. 14) */
     double m_min;              /* eq. 15 */
