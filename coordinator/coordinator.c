@@ -33,6 +33,7 @@
 #include "lahar_step_t.h"
 #include "lahar_stop_t.h"
 #include "link.h"
+#include "machine_load.h"
 #include "netns.h"
 #include "output.h"
 #include "scene_msg.h"
@@ -124,6 +125,12 @@ typedef struct {
     char resume_dir[PATH_MAX];
     double resume_t;
     char resume_run_id[32];   /* the run id of the checkpoint's run */
+    /* the machine when the run started (summary.json "machine") */
+    lahar_machine_load load;
+    int load_read;            /* load holds a reading */
+    int busy;                 /* lahar_machine_busy */
+    const char *wait_policy;  /* OMP_WAIT_POLICY of the nodes: the user's, "passive" (set here), or NULL */
+    int wait_policy_set;      /* 1: lahar set it (busy machine, the user set none) */
 } coord;
 
 static volatile sig_atomic_t coord_interrupted;
@@ -153,6 +160,43 @@ static void coord_on_sigint(int sig)
 }
 
 /* ---- nodes: processes or threads ----------------------------------------------------------- */
+
+/* Before the nodes start: OpenMP threads wait for each other at the end of every parallel loop of
+ * a step, and libgomp's waiting thread spins (OMP_WAIT_POLICY unset) for a while before it sleeps.
+ * On cores that other work holds, or with more threads than cores, the spinning takes the CPU from
+ * the threads it waits for (docs/bench/performance.md "A busy machine"). So, when the machine is
+ * busy (lahar_machine_busy) and the user set no OMP_WAIT_POLICY, the nodes lahar starts as
+ * processes get OMP_WAIT_POLICY=passive, which changes no result; --in-process nodes share this
+ * process's OpenMP, configured before main: they only get the note. */
+static void coord_machine_load(coord *co)
+{
+    const lahar_coord_options *o = co->o;
+    co->wait_policy = getenv("OMP_WAIT_POLICY");
+    co->load_read = lahar_machine_load_read(&co->load) == 0;
+    co->busy = co->load_read && lahar_machine_busy(&co->load, o->threads);
+    if (!co->busy || o->no_spawn)
+        return;
+    if (!co->wait_policy && !o->in_process && setenv("OMP_WAIT_POLICY", "passive", 1) == 0) {
+        co->wait_policy = "passive";
+        co->wait_policy_set = 1;
+    }
+    if (o->quiet)
+        return;
+    const int t = lahar_machine_threads(&co->load, o->threads);
+    if (t > co->load.cores)
+        fprintf(stderr, "lahar: note: %d OpenMP threads per node on %d cores", t, co->load.cores);
+    else
+        fprintf(stderr, "lahar: note: this machine is busy (load average %.1f over the last minute on %d cores) and "
+                        "each node runs %d OpenMP threads",
+                co->load.load1, co->load.cores, t);
+    fprintf(stderr, ": threads that share a core wait for each other at every step, which can make the run several "
+                    "times slower. %s%s\n",
+            co->wait_policy_set ? "The nodes run with OMP_WAIT_POLICY=passive (set by lahar; results are the same). "
+            : o->in_process     ? "Set OMP_WAIT_POLICY=passive in the environment (lahar sets it only for nodes it starts "
+                                  "as processes). "
+                                : "",
+            o->threads == 1 ? "" : "--threads 1 may be faster still.");
+}
 
 typedef struct {
     coord_node *n;
@@ -494,6 +538,24 @@ static void coord_take_work(coord_node *n, const lahar_status_t *s)
     n->work.auth_rejected = s->auth_rejected;
     n->work.auth_replayed = s->auth_replayed;
     memcpy(n->work.flow, s->flow, sizeof n->work.flow);
+}
+
+/* summary.json "machine": the cores and the load when the run started, the threads per node, and
+ * the nodes' OpenMP wait policy (coord_machine_load). */
+static void coord_summary_machine(const coord *co, cJSON *root)
+{
+    if (!co->load_read)
+        return;
+    cJSON *m = cJSON_AddObjectToObject(root, "machine");
+    cJSON_AddNumberToObject(m, "cores", co->load.cores);
+    cJSON_AddNumberToObject(m, "load_average_1min", co->load.load1);
+    cJSON_AddNumberToObject(m, "threads_per_node", lahar_machine_threads(&co->load, co->o->threads));
+    cJSON_AddBoolToObject(m, "busy", co->busy);
+    if (co->wait_policy)
+        cJSON_AddStringToObject(m, "omp_wait_policy", co->wait_policy);
+    else
+        cJSON_AddNullToObject(m, "omp_wait_policy");
+    cJSON_AddBoolToObject(m, "omp_wait_policy_set_by_lahar", co->wait_policy_set);
 }
 
 /* summary.json "flow": the open boundaries' counters of the last SPH STATUS (only for a case with
@@ -1170,6 +1232,7 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(auth, "frames_replayed", replayed);
     coord_summary_work(co, root);
     coord_summary_flow(co, root);
+    coord_summary_machine(co, root);
     coord_summary_instability(co, root);
     if (co->ckpt_on || co->resumed) {
         cJSON *ck = cJSON_AddObjectToObject(root, "checkpoints");
@@ -1653,6 +1716,7 @@ int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
     }
     if (co.auth_key_path[0])
         lahar_link_set_auth_key(co.link, co.auth_key);
+    coord_machine_load(&co);
     if (!o->no_spawn)
         for (int r = 1; r < LAHAR_NROLES; r++)
             if (co.node[r].needed && coord_start_node(&co, &co.node[r]) != 0) {

@@ -4,6 +4,9 @@
 lahar_test(coupling_clock PROGRAM test_coupling_clock SOURCES test_coupling_clock.c
   LIBS lahar_coord LABELS fast coupling)
 
+lahar_test(machine_load PROGRAM test_machine_load SOURCES test_machine_load.c
+  LIBS lahar_coord LABELS fast coupling)
+
 lahar_test(coupling_link PROGRAM test_coupling_link SOURCES test_coupling_link.c
   LABELS fast coupling TIMEOUT 60)
 
@@ -23,6 +26,7 @@ function(lahar_coupling_run_test name labels)
 endfunction()
 lahar_coupling_run_test(inprocess_both "fast;coupling")
 lahar_coupling_run_test(processes "fast;netns;coupling")
+lahar_coupling_run_test(busy_machine "fast;netns;coupling")
 lahar_coupling_run_test(packet_loss "fast;netns;coupling")
 lahar_coupling_run_test(node_killed "slow;netns;coupling")
 lahar_coupling_run_test(node_stopped "slow;netns;coupling")

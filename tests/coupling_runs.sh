@@ -7,7 +7,8 @@
 #
 #   coupling_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR
 #   TEST: inprocess_both | processes | packet_loss | node_killed | node_stopped | coordinator_killed | concurrent |
-#         cross_host | cross_host_auth | no_namespace | engine_error | cli | disk_full | disk_full_start
+#         cross_host | cross_host_auth | no_namespace | engine_error | cli | disk_full | disk_full_start |
+#         busy_machine
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
 python=/usr/bin/python3
@@ -404,6 +405,45 @@ cli)
     "$bin/lahar" check "$cases/dem_bounce_3d.yaml" -o bounce -q || fail "lahar check on dem_bounce_3d failed"
     "$python" -c "import json; c = json.load(open('bounce/check.json')); assert c['pass'] is True, c" ||
         fail "check.json does not say pass"
+    ;;
+busy_machine)
+    # More OpenMP threads per node than cores: lahar notes it, and the nodes it starts run with
+    # OMP_WAIT_POLICY=passive (a spinning wait takes the CPU from the threads it waits for),
+    # which changes no result: bitwise the same as the user's OMP_WAIT_POLICY=active. A policy
+    # the user set is kept; one thread per node is never busy.
+    cores=$(nproc)
+    threads=$((2 * cores + 1))
+    write_case_both both.yaml
+    "$bin/lahar" run both.yaml -o busy --threads $threads 2> busy.txt || fail "run with $threads threads failed"
+    grep -q "lahar: note: $threads OpenMP threads per node on $cores cores" busy.txt || fail "no note: $(cat busy.txt)"
+    grep -q "The nodes run with OMP_WAIT_POLICY=passive (set by lahar" busy.txt || fail "note: $(cat busy.txt)"
+    [ "$(summary busy "s['machine']['busy'], s['machine']['omp_wait_policy'], s['machine']['omp_wait_policy_set_by_lahar'], s['machine']['threads_per_node']")" = "True passive True $threads" ] ||
+        fail "summary.json machine: $(summary busy "s['machine']")"
+    OMP_WAIT_POLICY=active "$bin/lahar" run both.yaml -o active --threads $threads -q || fail "run with the user's policy failed"
+    [ "$(summary active "s['machine']['omp_wait_policy'], s['machine']['omp_wait_policy_set_by_lahar']")" = "active False" ] ||
+        fail "the user's OMP_WAIT_POLICY was not kept: $(summary active "s['machine']")"
+    for f in bodies.h5 forces.h5 particles.h5; do
+        "$python" "$tools/h5_compare.py" --quiet busy/$f active/$f || fail "$f differs between wait policies"
+    done
+    # the node lahar started has the policy in its environment
+    write_case long.yaml 30
+    "$bin/lahar" run long.yaml -o long --threads $threads -q &
+    lahar_pid=$!
+    env_seen=
+    for i in $(seq 1 100); do
+        for p in $(child_pid $lahar_pid lahar-dem); do
+            env_seen=$(tr '\0' '\n' < /proc/$p/environ | grep '^OMP_WAIT_POLICY=')
+        done
+        [ -n "$env_seen" ] && break
+        sleep 0.1
+    done
+    kill -INT $lahar_pid; wait $lahar_pid
+    [ "$env_seen" = "OMP_WAIT_POLICY=passive" ] || fail "lahar-dem's environment: '$env_seen'"
+    "$bin/lahar" run both.yaml -o one --threads 1 2> one.txt || fail "run with one thread failed"
+    ! grep -q "note:" one.txt || fail "a note for one thread per node: $(cat one.txt)"
+    [ "$(summary one "s['machine']['busy'], s['machine']['threads_per_node']")" = "False 1" ] ||
+        fail "summary.json machine: $(summary one "s['machine']")"
+    echo "busy_machine: $threads threads on $cores cores: note, passive set, same results as active; user's policy kept"
     ;;
 disk_full)
     # OUT on a small file system (a 2 MB tmpfs in a private user + mount namespace) that the run

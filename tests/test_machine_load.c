@@ -1,0 +1,45 @@
+/* When the coordinator calls a machine busy for a run's threads (coordinator/machine_load.c): more
+ * than one thread per node, and the load average plus the threads above the cores by more than half
+ * a core; OpenMP's default (threads 0) is one thread per core. And the reading itself: the cores of
+ * this process's affinity mask, a load average that is not negative. */
+#define _GNU_SOURCE
+#include <sched.h>
+#include <stdio.h>
+#include "machine_load.h"
+
+#include "test_util.h"
+
+int main(void)
+{
+    const struct {
+        int cores;
+        double load1;
+        int threads, busy;
+    } cases[] = {
+        {2, 0.0, 2, 0},  /* an idle 2-core machine, 2 threads */
+        {2, 0.4, 2, 0},  /* within the half-core slack */
+        {2, 0.6, 2, 1},  /* another process holds most of a core */
+        {2, 1.9, 1, 0},  /* one thread: nothing to wait for */
+        {2, 0.0, 3, 1},  /* more threads than cores */
+        {2, 0.0, 0, 0},  /* OpenMP's default on an idle machine: one per core */
+        {2, 1.0, 0, 1},  /* ... on a busy one */
+        {8, 3.0, 4, 0},  /* a big machine with room for the threads */
+        {8, 3.0, 0, 1},  /* ... but not for one per core */
+        {1, 5.0, 0, 0},  /* one core: one thread by default */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        lahar_machine_load m = {.cores = cases[i].cores, .load1 = cases[i].load1};
+        CHECK(lahar_machine_busy(&m, cases[i].threads) == cases[i].busy,
+              "%d cores, load %.1f, --threads %d: busy %d, expected %d", m.cores, m.load1, cases[i].threads,
+              lahar_machine_busy(&m, cases[i].threads), cases[i].busy);
+    }
+    lahar_machine_load m = {0};
+    cpu_set_t set;
+    CHECK(lahar_machine_load_read(&m) == 0, "cannot read the machine's load");
+    CHECK(sched_getaffinity(0, sizeof set, &set) == 0 && m.cores == CPU_COUNT(&set),
+          "cores %d, the affinity mask has %d", m.cores, CPU_COUNT(&set));
+    CHECK(m.load1 >= 0.0, "load average %g", m.load1);
+    CHECK(lahar_machine_threads(&m, 0) == m.cores && lahar_machine_threads(&m, 3) == 3, "threads per node");
+    printf("machine: %d cores, load average %.2f\n", m.cores, m.load1);
+    return failures ? 1 : 0;
+}
