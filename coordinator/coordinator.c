@@ -164,7 +164,7 @@ static void coord_on_sigint(int sig)
 /* Before the nodes start: OpenMP threads wait for each other at the end of every parallel loop of
  * a step, and libgomp's waiting thread spins (OMP_WAIT_POLICY unset) for a while before it sleeps.
  * On cores that other work holds, or with more threads than cores, the spinning takes the CPU from
- * the threads it waits for (docs/bench/performance.md "A busy machine"). So, when the machine is
+ * the threads it waits for (docs/bench/busy_machine.md). So, when the machine is
  * busy (lahar_machine_busy) and the user set no OMP_WAIT_POLICY, the nodes lahar starts as
  * processes get OMP_WAIT_POLICY=passive, which changes no result; --in-process nodes share this
  * process's OpenMP, configured before main: they only get the note. */
