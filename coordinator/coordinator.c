@@ -174,6 +174,10 @@ static void coord_machine_load(coord *co)
     co->wait_policy = getenv("OMP_WAIT_POLICY");
     co->load_read = lahar_machine_load_read(&co->load) == 0;
     co->busy = co->load_read && lahar_machine_busy(&co->load, o->threads);
+    /* the load average lags by a minute: see whether the load is still there (0.2 s, paid only when
+     * the average says busy) */
+    if (co->busy && lahar_machine_sample(&co->load, 0.2) == 0)
+        co->busy = lahar_machine_busy(&co->load, o->threads);
     if (!co->busy || o->no_spawn)
         return;
     if (!co->wait_policy && !o->in_process && setenv("OMP_WAIT_POLICY", "passive", 1) == 0) {
@@ -185,6 +189,10 @@ static void coord_machine_load(coord *co)
     const int t = lahar_machine_threads(&co->load, o->threads);
     if (t > co->load.cores)
         fprintf(stderr, "lahar: note: %d OpenMP threads per node on %d cores", t, co->load.cores);
+    else if (co->load.busy_now >= 0.0)
+        fprintf(stderr, "lahar: note: this machine is busy (other work holds %.1f of its %d cores) and each node runs "
+                        "%d OpenMP threads",
+                co->load.busy_now, co->load.cores, t);
     else
         fprintf(stderr, "lahar: note: this machine is busy (load average %.1f over the last minute on %d cores) and "
                         "each node runs %d OpenMP threads",
@@ -549,6 +557,8 @@ static void coord_summary_machine(const coord *co, cJSON *root)
     cJSON *m = cJSON_AddObjectToObject(root, "machine");
     cJSON_AddNumberToObject(m, "cores", co->load.cores);
     cJSON_AddNumberToObject(m, "load_average_1min", co->load.load1);
+    if (co->load.busy_now >= 0.0)
+        cJSON_AddNumberToObject(m, "busy_cores_sampled", co->load.busy_now);
     cJSON_AddNumberToObject(m, "threads_per_node", lahar_machine_threads(&co->load, co->o->threads));
     cJSON_AddBoolToObject(m, "busy", co->busy);
     if (co->wait_policy)

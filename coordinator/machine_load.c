@@ -2,17 +2,58 @@
 #define _GNU_SOURCE
 #include "machine_load.h"
 #include <sched.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <time.h>
 
 int lahar_machine_load_read(lahar_machine_load *m)
 {
     cpu_set_t set;
     double load[1];
+    m->busy_now = -1.0;
     if (sched_getaffinity(0, sizeof set, &set) != 0 || getloadavg(load, 1) != 1)
         return -1;
     m->cores = CPU_COUNT(&set);
     m->load1 = load[0];
     return m->cores > 0 ? 0 : -1;
+}
+
+/* /proc/stat: the ticks of all CPUs, busy (all but idle and iowait) and in total, and the number
+ * of CPUs (its cpuN lines). Returns 0 or -1. */
+static int proc_stat(unsigned long long *busy, unsigned long long *total, int *ncpu)
+{
+    FILE *f = fopen("/proc/stat", "r");
+    if (!f)
+        return -1;
+    char line[512];
+    unsigned long long v[8] = {0};
+    int ok = fgets(line, sizeof line, f) &&
+             sscanf(line, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                    &v[6], &v[7]) >= 5;
+    *ncpu = 0;
+    while (ok && fgets(line, sizeof line, f))
+        *ncpu += strncmp(line, "cpu", 3) == 0;
+    fclose(f);
+    *total = 0;
+    for (int i = 0; i < 8; i++)
+        *total += v[i];
+    *busy = *total - v[3] - v[4]; /* idle, iowait */
+    return ok && *ncpu > 0 ? 0 : -1;
+}
+
+int lahar_machine_sample(lahar_machine_load *m, double seconds)
+{
+    unsigned long long b0, t0, b1, t1;
+    int n0, n1;
+    if (proc_stat(&b0, &t0, &n0) != 0)
+        return -1;
+    struct timespec ts = {(time_t)seconds, (long)((seconds - (double)(time_t)seconds) * 1e9)};
+    nanosleep(&ts, NULL);
+    if (proc_stat(&b1, &t1, &n1) != 0 || n1 != n0 || t1 <= t0)
+        return -1;
+    m->busy_now = (double)(b1 - b0) / (double)(t1 - t0) * n0;
+    return 0;
 }
 
 int lahar_machine_threads(const lahar_machine_load *m, int threads)
@@ -23,7 +64,8 @@ int lahar_machine_threads(const lahar_machine_load *m, int threads)
 int lahar_machine_busy(const lahar_machine_load *m, int threads)
 {
     const int t = lahar_machine_threads(m, threads);
-    /* half a core of slack: the load average also counts short-lived tasks and decays over a
-     * minute, so a run started just after another one reads some of that one's load */
-    return t > 1 && m->load1 + t > m->cores + 0.5;
+    /* half a core of slack for short-lived tasks; the load average decays over a minute, so a run
+     * started just after a build or another run reads its load: the sample tells whether it is
+     * still there */
+    return t > 1 && m->load1 + t > m->cores + 0.5 && (m->busy_now < 0.0 || m->busy_now + t > m->cores + 0.5);
 }

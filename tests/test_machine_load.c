@@ -5,6 +5,7 @@
 #define _GNU_SOURCE
 #include <sched.h>
 #include <stdio.h>
+#include <unistd.h>
 #include "machine_load.h"
 
 #include "test_util.h"
@@ -28,18 +29,29 @@ int main(void)
         {1, 5.0, 0, 0},  /* one core: one thread by default */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        lahar_machine_load m = {.cores = cases[i].cores, .load1 = cases[i].load1};
+        lahar_machine_load m = {.cores = cases[i].cores, .load1 = cases[i].load1, .busy_now = -1.0};
         CHECK(lahar_machine_busy(&m, cases[i].threads) == cases[i].busy,
               "%d cores, load %.1f, --threads %d: busy %d, expected %d", m.cores, m.load1, cases[i].threads,
               lahar_machine_busy(&m, cases[i].threads), cases[i].busy);
     }
+    /* the sample decides when it is taken: a load average left by a build that has ended ... */
+    lahar_machine_load after_build = {.cores = 2, .load1 = 1.5, .busy_now = 0.05};
+    CHECK(!lahar_machine_busy(&after_build, 2), "load average 1.5, 0.05 cores busy now: called busy");
+    /* ... and one still running */
+    lahar_machine_load still = {.cores = 2, .load1 = 1.5, .busy_now = 1.6};
+    CHECK(lahar_machine_busy(&still, 2), "load average 1.5, 1.6 cores busy now: not called busy");
+    /* a sample alone does not make a machine busy: the load average must say so too */
+    lahar_machine_load burst = {.cores = 2, .load1 = 0.1, .busy_now = 1.6};
+    CHECK(!lahar_machine_busy(&burst, 2), "a busy sample with an idle load average: called busy");
     lahar_machine_load m = {0};
     cpu_set_t set;
     CHECK(lahar_machine_load_read(&m) == 0, "cannot read the machine's load");
     CHECK(sched_getaffinity(0, sizeof set, &set) == 0 && m.cores == CPU_COUNT(&set),
           "cores %d, the affinity mask has %d", m.cores, CPU_COUNT(&set));
-    CHECK(m.load1 >= 0.0, "load average %g", m.load1);
+    CHECK(m.load1 >= 0.0 && m.busy_now == -1.0, "load average %g, busy_now %g before a sample", m.load1, m.busy_now);
+    CHECK(lahar_machine_sample(&m, 0.05) == 0 && m.busy_now >= 0.0 && m.busy_now <= sysconf(_SC_NPROCESSORS_CONF) + 0.5,
+          "sampled %g busy cores", m.busy_now);
     CHECK(lahar_machine_threads(&m, 0) == m.cores && lahar_machine_threads(&m, 3) == 3, "threads per node");
-    printf("machine: %d cores, load average %.2f\n", m.cores, m.load1);
+    printf("machine: %d cores, load average %.2f, %.2f cores busy over 50 ms\n", m.cores, m.load1, m.busy_now);
     return failures ? 1 : 0;
 }
