@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "case.h"
+#include "errmsg.h"
 #include "msg_check.h"
 #include "scene_msg_fields.h"
 
@@ -204,29 +205,38 @@ void lahar_scene_msg_release(lahar_scene_t *m)
     memset(m, 0, sizeof *m);
 }
 
+/* The decoding of the scene message (lahar_scene_msg_to_case): each part returns 0, SCENE_BAD
+ * with the reason in err (a message no lahar sent; the fuzzers send such), or SCENE_OOM. */
+enum { SCENE_BAD = -1, SCENE_OOM = -2 };
 
-int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
+/* The counts, the dimension and the options that travel as small integers: each must name one of
+ * its enum's values. */
+static int scene_header_check(const lahar_scene_t *m, char *err, size_t errlen)
 {
-    memset(c, 0, sizeof *c);
     if (m->nmaterial < 0 || m->nbody < 0 || m->nblock < 0 || m->nprobe < 0 || (m->dim != 2 && m->dim != 3)) {
-        snprintf(err, errlen, "malformed scene message (counts or dimension)");
-        return -1;
+        lahar_errf(err, errlen, "malformed scene message (counts or dimension)");
+        return SCENE_BAD;
     }
-    /* the options travel as small integers: each must name one of its enum's values */
     const lahar_sph_options_t *so = &m->sph;
     if (so->eos < 0 || so->eos > LAHAR_SPH_EOS_TAIT || so->wall_viscous < 0 || so->wall_viscous > LAHAR_SPH_WALL_PAPER ||
         so->initial_pressure < 0 || so->initial_pressure > LAHAR_SPH_INITIAL_PRESSURE_HYDROSTATIC ||
         so->wall_pressure < 0 || so->wall_pressure > LAHAR_SPH_WALL_PRESSURE_GHOST || so->penalty_stiffness < 0 ||
         so->penalty_stiffness > LAHAR_SPH_PENALTY_ACOUSTIC || so->soil_wall_stress < 0 ||
         so->soil_wall_stress > LAHAR_SPH_WALL_PRESSURE_GHOST || so->scheme < 0 || so->scheme > LAHAR_SPH_SCHEME_RIEMANN) {
-        snprintf(err, errlen, "malformed scene message (sph options)");
-        return -1;
+        lahar_errf(err, errlen, "malformed scene message (sph options)");
+        return SCENE_BAD;
     }
     for (int i = 0; i < m->nmaterial; i++)
         if (m->materials[i].model < LAHAR_CONTACT_LINEAR || m->materials[i].model > LAHAR_CONTACT_SOIL) {
-            snprintf(err, errlen, "malformed scene message (material %d: contact model)", i);
-            return -1;
+            lahar_errf(err, errlen, "malformed scene message (material %d: contact model)", i);
+            return SCENE_BAD;
         }
+    return 0;
+}
+
+/* The case's scalars: paths, time, output, engine, stability limits and the sph options. */
+static void scene_settings_from_msg(const lahar_scene_t *m, lahar_case *c)
+{
     snprintf(c->path, sizeof c->path, "%s", m->case_path ? m->case_path : "");
     c->resume = m->resume_dir && m->resume_dir[0] && m->resume_step >= 0;
     c->resume_step = c->resume ? m->resume_step : 0;
@@ -248,12 +258,165 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
     c->sph_dx = m->sph_dx;
     c->sph_density = m->sph_density;
     scene_sph_from_msg(&m->sph, &c->sph);
+}
 
+/* Body i's shape indices: the engines index vertices by edge and face entries, and faces by
+ * face_start, so every index must lie in its array (face f is face_v[face_start[f] ..
+ * face_start[f + 1])). */
+static int scene_body_indices_ok(const lahar_body_t *a)
+{
+    int bad = 0;
+    for (int k = 0; k < a->ne && !bad; k++)
+        bad = a->e[k][0] < 0 || a->e[k][0] >= a->nv || a->e[k][1] < 0 || a->e[k][1] >= a->nv;
+    for (int f = 0; f < a->nf && !bad; f++)
+        bad = a->face_start[f] < (f ? a->face_start[f - 1] : 0) || a->face_start[f] > a->nfv ||
+              (int64_t)a->face_nv[f] != (int64_t)(f + 1 < a->nf ? a->face_start[f + 1] : a->nfv) - a->face_start[f];
+    for (int k = 0; k < a->nfv && !bad; k++)
+        bad = a->face_v[k] < 0 || a->face_v[k] >= a->nv;
+    return !bad && !(a->nf > 0 && a->face_start[0] != 0) && !(a->nf == 0 && a->nfv != 0);
+}
+
+static int scene_body_from_msg(const lahar_scene_t *m, int i, lahar_body *b, char *err, size_t errlen)
+{
+    const lahar_body_t *a = &m->bodies[i];
+    lahar_shape *s = &b->shape;
+    if (a->nv < 0 || a->ne < 0 || a->nf < 0 || a->nfv < 0 || a->material < 0 || a->material >= m->nmaterial ||
+        a->motion < LAHAR_MOTION_FREE || a->motion > LAHAR_MOTION_PRESCRIBED) {
+        lahar_errf(err, errlen, "malformed scene message (body %d)", i);
+        return SCENE_BAD;
+    }
+    if (!scene_body_indices_ok(a)) {
+        lahar_errf(err, errlen, "malformed scene message (body %d: shape indices)", i);
+        return SCENE_BAD;
+    }
+    scene_copy_name(b->name, a->name);
+    b->material = a->material;
+    b->motion = (lahar_motion)a->motion;
+    b->convex = a->convex;
+    s->radius = a->radius;
+    s->nv = a->nv;
+    s->ne = a->ne;
+    s->nf = a->nf;
+    s->v = malloc((size_t)(a->nv > 0 ? a->nv : 1) * sizeof *s->v);
+    s->e = malloc((size_t)(a->ne > 0 ? a->ne : 1) * sizeof *s->e);
+    s->face_start = malloc((size_t)(a->nf + 1) * sizeof *s->face_start);
+    s->face_v = malloc((size_t)(a->nfv > 0 ? a->nfv : 1) * sizeof *s->face_v);
+    if (!s->v || !s->e || !s->face_start || !s->face_v)
+        return SCENE_OOM;
+    for (int k = 0; k < a->nv; k++)
+        memcpy(s->v[k], a->v[k], sizeof s->v[k]);
+    for (int k = 0; k < a->ne; k++) {
+        s->e[k][0] = a->e[k][0];
+        s->e[k][1] = a->e[k][1];
+    }
+    for (int f = 0; f < a->nf; f++)
+        s->face_start[f] = a->face_start[f];
+    s->face_start[a->nf] = a->nfv;
+    for (int k = 0; k < a->nfv; k++)
+        s->face_v[k] = a->face_v[k];
+    b->mass = a->mass;
+    memcpy(b->inertia, a->inertia, sizeof b->inertia);
+    memcpy(b->x, a->x, sizeof b->x);
+    memcpy(b->q, a->q, sizeof b->q);
+    memcpy(b->v, a->vel, sizeof b->v);
+    memcpy(b->w, a->w, sizeof b->w);
+    b->record_contacts = m->body_record_contacts[i] != 0;
+    return 0;
+}
+
+/* A text of the message copied into a fixed buffer: present and short enough. */
+static int scene_text_fits(const char *text, size_t size) { return text && strlen(text) < size; }
+
+static int scene_block_from_msg(const lahar_scene_t *m, int i, lahar_particle_block *b, char *err, size_t errlen)
+{
+    const lahar_particle_block_t *a = &m->blocks[i];
+    if (a->nvert < 0 || a->ntri < 0 || a->kind < LAHAR_BLOCK_BOX || a->kind > LAHAR_BLOCK_MESH) {
+        lahar_errf(err, errlen, "malformed scene message (particle block %d)", i);
+        return SCENE_BAD;
+    }
+    for (int t = 0; t < a->ntri; t++)
+        for (int k = 0; k < 3; k++)
+            if (a->tri[t][k] < 0 || a->tri[t][k] >= a->nvert) {
+                lahar_errf(err, errlen, "malformed scene message (particle block %d, triangle %d)", i, t);
+                return SCENE_BAD;
+            }
+    scene_copy_name(b->name, a->name);
+    b->kind = (lahar_block_kind)a->kind;
+    memcpy(b->lo, a->lo, sizeof b->lo);
+    memcpy(b->hi, a->hi, sizeof b->hi);
+    memcpy(b->v, a->v, sizeof b->v);
+    snprintf(b->source, sizeof b->source, "%s", a->source ? a->source : "");
+    if (a->phase < 0 || a->phase > 1 || (a->phase == 1 && (a->material < 0 || a->material >= m->nmaterial))) {
+        lahar_errf(err, errlen, "malformed scene message (particle block %d: phase/material)", i);
+        return SCENE_BAD;
+    }
+    b->phase = a->phase;
+    b->material = a->material;
+    for (int k = 0; k < 3; k++) {
+        if (!scene_text_fits(a->velocity_expr[k], LAHAR_EXPR_MAX)) {
+            lahar_errf(err, errlen, "malformed scene message (particle block %d: velocity expression)", i);
+            return SCENE_BAD;
+        }
+        snprintf(b->vexpr[k], sizeof b->vexpr[k], "%s", a->velocity_expr[k]);
+    }
+    if (!scene_text_fits(a->pressure_expr, LAHAR_EXPR_MAX)) {
+        lahar_errf(err, errlen, "malformed scene message (particle block %d: pressure expression)", i);
+        return SCENE_BAD;
+    }
+    snprintf(b->pexpr, sizeof b->pexpr, "%s", a->pressure_expr);
+    if (!scene_text_fits(a->initial_file, sizeof b->init_file)) {
+        lahar_errf(err, errlen, "malformed scene message (particle block %d: initial file)", i);
+        return SCENE_BAD;
+    }
+    snprintf(b->init_file, sizeof b->init_file, "%s", a->initial_file);
+    if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
+        return SCENE_OOM;
+    b->nvert = a->nvert;
+    if (a->ntri > 0 && !(b->tri = malloc((size_t)a->ntri * sizeof *b->tri)))
+        return SCENE_OOM;
+    b->ntri = a->ntri;
+    for (int k = 0; k < a->nvert; k++)
+        memcpy(b->vert[k], a->vert[k], sizeof b->vert[k]);
+    for (int k = 0; k < a->ntri; k++)
+        for (int j = 0; j < 3; j++)
+            b->tri[k][j] = a->tri[k][j];
+    return 0;
+}
+
+static int scene_probe_from_msg(const lahar_scene_t *m, int i, lahar_probe *b, char *err, size_t errlen)
+{
+    const lahar_probe_t *a = &m->probes[i];
+    if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
+        a->kind < LAHAR_PROBE_PRESSURE || a->kind > LAHAR_PROBE_CONTROL_VOLUME || a->axis < 0 || a->axis >= m->dim ||
+        (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
+        lahar_errf(err, errlen, "malformed scene message (probe %d)", i);
+        return SCENE_BAD;
+    }
+    scene_copy_name(b->name, a->name);
+    b->kind = a->kind;
+    b->top = a->top;
+    memcpy(b->x, a->x, sizeof b->x);
+    memcpy(b->n, a->n, sizeof b->n);
+    b->body = a->body;
+    b->size = a->size;
+    b->rate = a->rate;
+    memcpy(b->hi, a->hi, sizeof b->hi);
+    b->axis = a->axis;
+    return 0;
+}
+
+/* The case of a scene message, every count and index checked (it may come from the network). */
+static int scene_case_from_msg(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
+{
+    int rc = scene_header_check(m, err, errlen);
+    if (rc)
+        return rc;
+    scene_settings_from_msg(m, c);
     c->materials = calloc((size_t)(m->nmaterial > 0 ? m->nmaterial : 1), sizeof *c->materials);
     c->bodies = calloc((size_t)(m->nbody > 0 ? m->nbody : 1), sizeof *c->bodies);
     c->blocks = calloc((size_t)(m->nblock > 0 ? m->nblock : 1), sizeof *c->blocks);
     if (!c->materials || !c->bodies || !c->blocks)
-        goto oom;
+        return SCENE_OOM;
     c->nmaterial = m->nmaterial;
     for (int i = 0; i < m->nmaterial; i++) {
         const lahar_material_t *from = &m->materials[i];
@@ -263,160 +426,35 @@ int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, si
         MATERIAL_CODE_FIELDS(FROM_MSG_CODE)
     }
     c->nbody = m->nbody;
-    for (int i = 0; i < m->nbody; i++) {
-        const lahar_body_t *a = &m->bodies[i];
-        lahar_body *b = &c->bodies[i];
-        lahar_shape *s = &b->shape;
-        if (a->nv < 0 || a->ne < 0 || a->nf < 0 || a->nfv < 0 || a->material < 0 || a->material >= m->nmaterial ||
-            a->motion < LAHAR_MOTION_FREE || a->motion > LAHAR_MOTION_PRESCRIBED) {
-            snprintf(err, errlen, "malformed scene message (body %d)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        /* the engines index vertices by edge and face entries, and faces by face_start: every
-         * index must lie in its array (face f is face_v[face_start[f] .. face_start[f + 1])) */
-        int bad = 0;
-        for (int k = 0; k < a->ne && !bad; k++)
-            bad = a->e[k][0] < 0 || a->e[k][0] >= a->nv || a->e[k][1] < 0 || a->e[k][1] >= a->nv;
-        for (int f = 0; f < a->nf && !bad; f++)
-            bad = a->face_start[f] < (f ? a->face_start[f - 1] : 0) || a->face_start[f] > a->nfv ||
-                  (int64_t)a->face_nv[f] != (int64_t)(f + 1 < a->nf ? a->face_start[f + 1] : a->nfv) - a->face_start[f];
-        for (int k = 0; k < a->nfv && !bad; k++)
-            bad = a->face_v[k] < 0 || a->face_v[k] >= a->nv;
-        if (bad || (a->nf > 0 && a->face_start[0] != 0) || (a->nf == 0 && a->nfv != 0)) {
-            snprintf(err, errlen, "malformed scene message (body %d: shape indices)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        scene_copy_name(b->name, a->name);
-        b->material = a->material;
-        b->motion = (lahar_motion)a->motion;
-        b->convex = a->convex;
-        s->radius = a->radius;
-        s->nv = a->nv;
-        s->ne = a->ne;
-        s->nf = a->nf;
-        s->v = malloc((size_t)(a->nv > 0 ? a->nv : 1) * sizeof *s->v);
-        s->e = malloc((size_t)(a->ne > 0 ? a->ne : 1) * sizeof *s->e);
-        s->face_start = malloc((size_t)(a->nf + 1) * sizeof *s->face_start);
-        s->face_v = malloc((size_t)(a->nfv > 0 ? a->nfv : 1) * sizeof *s->face_v);
-        if (!s->v || !s->e || !s->face_start || !s->face_v)
-            goto oom;
-        for (int k = 0; k < a->nv; k++)
-            memcpy(s->v[k], a->v[k], sizeof s->v[k]);
-        for (int k = 0; k < a->ne; k++) {
-            s->e[k][0] = a->e[k][0];
-            s->e[k][1] = a->e[k][1];
-        }
-        for (int f = 0; f < a->nf; f++)
-            s->face_start[f] = a->face_start[f];
-        s->face_start[a->nf] = a->nfv;
-        for (int k = 0; k < a->nfv; k++)
-            s->face_v[k] = a->face_v[k];
-        b->mass = a->mass;
-        memcpy(b->inertia, a->inertia, sizeof b->inertia);
-        memcpy(b->x, a->x, sizeof b->x);
-        memcpy(b->q, a->q, sizeof b->q);
-        memcpy(b->v, a->vel, sizeof b->v);
-        memcpy(b->w, a->w, sizeof b->w);
-        b->record_contacts = m->body_record_contacts[i] != 0;
-    }
-    for (int i = 0; i < m->nblock; i++) {
-        const lahar_particle_block_t *a = &m->blocks[i];
-        lahar_particle_block *b = &c->blocks[i];
+    for (int i = 0; i < m->nbody && !rc; i++)
+        rc = scene_body_from_msg(m, i, &c->bodies[i], err, errlen);
+    for (int i = 0; i < m->nblock && !rc; i++) {
         c->nblock = i + 1;
-        if (a->nvert < 0 || a->ntri < 0 || a->kind < LAHAR_BLOCK_BOX || a->kind > LAHAR_BLOCK_MESH) {
-            snprintf(err, errlen, "malformed scene message (particle block %d)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        for (int t = 0; t < a->ntri; t++)
-            for (int k = 0; k < 3; k++)
-                if (a->tri[t][k] < 0 || a->tri[t][k] >= a->nvert) {
-                    snprintf(err, errlen, "malformed scene message (particle block %d, triangle %d)", i, t);
-                    lahar_case_free(c);
-                    return -1;
-                }
-        scene_copy_name(b->name, a->name);
-        b->kind = (lahar_block_kind)a->kind;
-        memcpy(b->lo, a->lo, sizeof b->lo);
-        memcpy(b->hi, a->hi, sizeof b->hi);
-        memcpy(b->v, a->v, sizeof b->v);
-        snprintf(b->source, sizeof b->source, "%s", a->source ? a->source : "");
-        if (a->phase < 0 || a->phase > 1 || (a->phase == 1 && (a->material < 0 || a->material >= m->nmaterial))) {
-            snprintf(err, errlen, "malformed scene message (particle block %d: phase/material)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        b->phase = a->phase;
-        b->material = a->material;
-        for (int k = 0; k < 3; k++)
-            if (!a->velocity_expr[k] || strlen(a->velocity_expr[k]) >= LAHAR_EXPR_MAX) {
-                snprintf(err, errlen, "malformed scene message (particle block %d: velocity expression)", i);
-                lahar_case_free(c);
-                return -1;
-            } else
-                snprintf(b->vexpr[k], sizeof b->vexpr[k], "%s", a->velocity_expr[k]);
-        if (!a->pressure_expr || strlen(a->pressure_expr) >= LAHAR_EXPR_MAX) {
-            snprintf(err, errlen, "malformed scene message (particle block %d: pressure expression)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        snprintf(b->pexpr, sizeof b->pexpr, "%s", a->pressure_expr);
-        if (!a->initial_file || strlen(a->initial_file) >= sizeof b->init_file) {
-            snprintf(err, errlen, "malformed scene message (particle block %d: initial file)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        snprintf(b->init_file, sizeof b->init_file, "%s", a->initial_file);
-        if (a->nvert > 0 && !(b->vert = malloc((size_t)a->nvert * sizeof *b->vert)))
-            goto oom;
-        b->nvert = a->nvert;
-        if (a->ntri > 0 && !(b->tri = malloc((size_t)a->ntri * sizeof *b->tri)))
-            goto oom;
-        b->ntri = a->ntri;
-        for (int k = 0; k < a->nvert; k++)
-            memcpy(b->vert[k], a->vert[k], sizeof b->vert[k]);
-        for (int k = 0; k < a->ntri; k++)
-            for (int j = 0; j < 3; j++)
-                b->tri[k][j] = a->tri[k][j];
+        rc = scene_block_from_msg(m, i, &c->blocks[i], err, errlen);
     }
+    if (rc)
+        return rc;
     if (m->nprobe > 0) {
         if (!(c->probes = calloc((size_t)m->nprobe, sizeof *c->probes)))
-            goto oom;
+            return SCENE_OOM;
         c->nprobe = m->nprobe;
     }
-    for (int i = 0; i < m->nprobe; i++) {
-        const lahar_probe_t *a = &m->probes[i];
-        lahar_probe *b = &c->probes[i];
-        if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
-            a->kind < LAHAR_PROBE_PRESSURE || a->kind > LAHAR_PROBE_CONTROL_VOLUME || a->axis < 0 ||
-            a->axis >= m->dim ||
-            (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
-            snprintf(err, errlen, "malformed scene message (probe %d)", i);
-            lahar_case_free(c);
-            return -1;
-        }
-        scene_copy_name(b->name, a->name);
-        b->kind = a->kind;
-        b->top = a->top;
-        memcpy(b->x, a->x, sizeof b->x);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->body = a->body;
-        b->size = a->size;
-        b->rate = a->rate;
-        memcpy(b->hi, a->hi, sizeof b->hi);
-        b->axis = a->axis;
-    }
-    if (lahar_scene_msg_inflow_to_case(m, c, err, errlen) != 0) {
+    for (int i = 0; i < m->nprobe && !rc; i++)
+        rc = scene_probe_from_msg(m, i, &c->probes[i], err, errlen);
+    if (!rc && lahar_scene_msg_inflow_to_case(m, c, err, errlen) != 0)
+        rc = SCENE_BAD;
+    return rc;
+}
+
+int lahar_scene_msg_to_case(const lahar_scene_t *m, lahar_case *c, char *err, size_t errlen)
+{
+    memset(c, 0, sizeof *c);
+    int rc = scene_case_from_msg(m, c, err, errlen);
+    if (rc == SCENE_OOM)
+        snprintf(err, errlen, "out of memory building the scene");
+    if (rc)
         lahar_case_free(c);
-        return -1;
-    }
-    return 0;
-oom:
-    snprintf(err, errlen, "out of memory building the scene");
-    lahar_case_free(c);
-    return -1;
+    return rc ? -1 : 0;
 }
 
 /* ---- node side of the start of a run ------------------------------------------------------- */
