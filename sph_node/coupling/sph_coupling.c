@@ -216,222 +216,320 @@ void sph_coupling_mark(sph_coupling *c, const sph_cells *cells, int64_t n, const
     c->near_valid = 1;
 }
 
-int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt)
+/* Where body b is now: the DEM node's state when it moves, the case's pose when it is fixed (fixed
+ * bodies keep world-frame vertices, x = origin of that frame). */
+typedef struct {
+    const double *x, *q, *v, *w;
+} coupling_pose;
+
+static inline coupling_pose coupling_body_pose(const sph_coupling *c, const lahar_body_state *states, int b)
 {
-    const int64_t n = p->n;
+    const lahar_body *body = &c->bodies[b];
+    const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
+    return st ? (coupling_pose){st->x, st->q, st->v, st->w} : (coupling_pose){body->x, body->q, body->v, body->w};
+}
+
+/* The constants of one evaluation. */
+typedef struct {
+    double dt, kn; /* the step and the penalty stiffness K_n (eq. 15) */
+    double w0, hd; /* W(0) and h^D of eq. 17 */
+} coupling_consts;
+
+/* What one particle gathers over its contacts in one evaluation: the scalars, kept apart from the
+ * arrays below so that the compiler holds them in registers (the arrays' addresses go to functions
+ * of other files). */
+typedef struct {
+    int ns;        /* contacts written to its slots */
+    int nh;        /* soil-DEM springs in contact now (sph_coupling_enable_soil) */
+    int have_sbar; /* the soil ghosts' stresses are set (coupling_soil_ghost) */
+    vec3 ftot;     /* the force on it from all of them */
+    double drho_g; /* the ghosts' continuity term */
+    double pbar;   /* the pressure around the particle, NaN until a ghost needs it */
+} coupling_acc;
+
+/* ... and the arrays, per contact or per spring. */
+typedef struct {
+    int hist_b[SPH_COUPLING_MAX_PER_PARTICLE]; /* the springs' bodies and values */
+    double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
+    /* ghost pressure per contact: normal, relative velocity, distance (< 0: no ghost), p_w */
+    vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE], gu[SPH_COUPLING_MAX_PER_PARTICLE];
+    double gd[SPH_COUPLING_MAX_PER_PARTICLE], gp[SPH_COUPLING_MAX_PER_PARTICLE];
+    /* soil ghosts (sph_coupling_set_soil_wall): the stresses, and their share of the velocity
+     * gradient; set at the first soil ghost */
+    double sbar[SPH_NSTRESS], sown[SPH_NSTRESS], lw[9];
+} coupling_scratch;
+
+/* The contact of a particle (an image of it) with a body's surface. */
+typedef struct {
+    vec3 nrm;  /* unit normal out of the body at the contact; zero on the core */
+    vec3 xs;   /* the surface point (eq. 12) */
+    double d;  /* signed distance to the surface (eq. 13) */
+    int cross; /* the particle is behind the surface (or on the core) */
+} coupling_surface;
+
+/* The periodic images of a particle that may touch body b (sph_coupling_set_periodic): the
+ * particle shifted by n whole periods towards the body, for every n along each periodic axis that
+ * brings it within the body's range plus the support; the contact then lies on the body itself. A
+ * body as long as the period along an axis (a channel's wall) overlaps its own images: it spans
+ * that axis and has none along it, as without images; a body outside the period (plus the
+ * support) is outside the domain and has none either. Returns n in [nlo, nhi] per axis. */
+static inline void coupling_image_range(const sph_coupling *c, int b, const double *bx, vec3 xp, int nlo[3], int nhi[3])
+{
     const double support = c->k.support;
-    /* eq. 15: K_n = 0.1 m_min / dt^2; with kn_dt > 0 the acoustic step instead (sph_coupling.h) */
-    const double dtk = c->kn_dt > 0.0 ? c->kn_dt : dt;
-    const double kn = 0.1 * c->m_min / (dtk * dtk);
-    c->kn = kn;
-    const double w0 = kernel_w(&c->k, 0.0), hd = pow(c->k.h, c->dim);
-    if (n > c->pcap)
-        return -1;
-
-    const int near_valid = c->near_valid && c->nbody < 32;
-    c->near_valid = 0; /* the marks serve this evaluation only */
-#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
-    for (int64_t i = 0; i < n; i++) {
-        int ns = 0;
-        const vec3 xp = v3(p->x[i], p->y[i], p->z[i]);
-        vec3 ftot = v3(0, 0, 0);
-        /* soil-DEM springs of this evaluation (sph_coupling_enable_soil) */
-        const int soil = p->phase[i] != 0 && c->soil_hist_body;
-        int nh = 0, hist_b[SPH_COUPLING_MAX_PER_PARTICLE];
-        double hist_d[SPH_COUPLING_MAX_PER_PARTICLE][3];
-        vec3 gn[SPH_COUPLING_MAX_PER_PARTICLE]; /* ghost pressure: normal and distance per contact */
-        double gd[SPH_COUPLING_MAX_PER_PARTICLE], gp[SPH_COUPLING_MAX_PER_PARTICLE], drho_g = 0.0, pbar = NAN;
-        double sbar[SPH_NSTRESS] = {0.0}, sown[SPH_NSTRESS] = {0.0}; /* soil ghosts (sph_coupling_set_soil_wall) */
-        double lw[9] = {0.0}; /* their share of the velocity gradient */
-        int have_sbar = 0;
-        vec3 gu[SPH_COUPLING_MAX_PER_PARTICLE];
-        const uint32_t near = near_valid ? c->near[i] : ~0u;
-        for (int b = 0; b < c->nbody && ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
-            if (!(near >> b & 1u)) /* sph_coupling_mark: this body is out of reach */
-                continue;
-            const lahar_body *body = &c->bodies[b];
-            const lahar_body_state *st = states && body->motion != LAHAR_MOTION_FIXED ? &states[b] : NULL;
-            const double *bx = st ? st->x : body->x, *bq = st ? st->q : body->q;
-            const double *bv = st ? st->v : body->v, *bw = st ? st->w : body->w;
-            vec3 xb = v3_load(bx);
-            const double R = body->shape.radius;
-            /* periodic images (sph_coupling_set_periodic): the particle shifted by n whole periods
-             * towards the body, for every n along each periodic axis that brings it within the
-             * body's range plus the support; the contact then lies on the body itself. A body as
-             * long as the period along an axis (a channel's wall) overlaps its own images: it
-             * spans that axis and has none along it, as without images; a body outside the period
-             * (plus the support) is outside the domain and has none either. */
-            int nlo[3] = {0, 0, 0}, nhi[3] = {0, 0, 0};
-            for (int a = 0; a < 3; a++) {
-                if (!c->periodic[a])
-                    continue;
-                /* the range of the body along a: its world box when fixed (tight), else its sphere */
-                const double *bb = c->box[b];
-                int boxed = body->motion == LAHAR_MOTION_FIXED && isfinite(bb[a]) && isfinite(bb[3 + a]);
-                double lo = boxed ? bb[a] : bx[a] - c->bound[b], hi = boxed ? bb[3 + a] : bx[a] + c->bound[b];
-                double xa = v3_get(xp, a);
-                const double plo = c->period_lo[a], phi = plo + c->period[a];
-                if (c->periodic[a] && hi - lo < c->period[a] && hi > plo - support && lo < phi + support &&
-                    isfinite(xa)) {
-                    nlo[a] = (int)ceil((xa - hi - support) / c->period[a]);
-                    nhi[a] = (int)floor((xa - lo + support) / c->period[a]);
-                }
-            }
-            const int nx = nhi[0] - nlo[0] + 1, ny = nhi[1] - nlo[1] + 1, nimg = nx * ny * (nhi[2] - nlo[2] + 1);
-            for (int img = 0; img < nimg && ns < SPH_COUPLING_MAX_PER_PARTICLE; img++) {
-                /* without images (ix = iy = iz = 0) xi is the particle's position bit for bit; the
-                 * divisions only where there are several images (most particles have one) */
-                const int ix = nlo[0] + (nimg > 1 ? img % nx : 0), iy = nlo[1] + (nimg > 1 ? img / nx % ny : 0),
-                          iz = nlo[2] + (nimg > 1 ? img / (nx * ny) : 0);
-                vec3 xi = v3(xp.x - ix * c->period[0], xp.y - iy * c->period[1], xp.z - iz * c->period[2]);
-                /* culling, cheapest test first (a particle culled here is at least the support from
-                 * the surface, so the tests' order and form change no result): fixed bodies have
-                 * a tight world box, every body a bounding sphere (fixed bodies keep world-frame
-                 * vertices, x = origin of that frame) */
-                if (body->motion == LAHAR_MOTION_FIXED) {
-                    const double *bb = c->box[b];
-                    if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support ||
-                        xi.y > bb[4] + support || xi.z < bb[2] - support || xi.z > bb[5] + support)
-                        continue;
-                }
-                const double reach = c->bound[b] + support;
-                if (v3_norm2(v3_sub(xi, xb)) > reach * reach)
-                    continue;
-                vec3 core = xb;
-                /* big shapes (terrain, flumes): only the features near the particle */
-                double dc = geom_body_grids_core(&c->grids, b, &body->shape, bx, bq, xi, R + support, &core, NULL);
-                int inside = geom_point_in_core(&body->shape, body->convex, c->dim, bx, bq, xi); /* deep inside: far from the surface */
-                if (dc - R >= support && !inside)
-                    continue;
-                if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
-                    dc = 0.0;
-                int cross = inside || dc < R;
-                vec3 nrm;
-                double d;
-                if (dc > 0.0) {
-                    nrm = v3_scale(v3_sub(xi, core), 1.0 / dc);
-                    d = dc - R; /* eq. 13, signed */
-                    if (inside) {
-                        nrm = v3_neg(nrm);
-                        d = -dc - R;
-                    }
-                } else {
-                    nrm = v3(0, 0, 0); /* on the core: no direction to push; counted as a crossing */
-                    d = -R;
-                }
-                vec3 xs = v3_axpy(R, nrm, core);         /* eq. 12 */
-                double delta = c->eps - d;               /* eq. 14 */
-                vec3 fn = delta > 0.0 ? v3_scale(nrm, kn * delta) : v3(0, 0, 0); /* eq. 15 */
-                /* eq. 16: relative velocity to the body's surface at x_s */
-                vec3 urel = v3_sub(v3(p->vx[i], p->vy[i], p->vz[i]),
-                                   v3_add(v3_load(bv), v3_cross(v3_load(bw), v3_sub(xs, xb))));
-                double dv = fmax(d, 0.5 * c->eps); /* the viscous term's distance, kept off zero */
-                double coef;
-                if (c->viscous == LAHAR_SPH_WALL_HALFSPACE)
-                    coef = 2.0 * c->mu / p->rho[i] * sph_coupling_body_halfspace_factor(c, b, dv);
-                else /* eq. 17 as printed */
-                    coef = 4.0 * p->m[i] / (3.0 * hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
-                           kernel_dwdr(&c->k, dv) / w0;
-                /* m_i a_tau (eq. 19) for water; soil: the frictional force of section 4.2 */
-                vec3 ft = p->phase[i] == 0 ? v3_scale(urel, p->m[i] * coef) : v3(0, 0, 0);
-                /* soil ghost stress (sph_coupling_set_soil_wall): its push along n joins F_n of
-                 * the friction cap */
-                vec3 fg = v3(0, 0, 0);
-                double fgn = 0.0;
-                if (p->phase[i] != 0 && c->soil_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !cross && p->sig[0]) {
-                    if (!have_sbar) {
-                        sph_ghost_soil_sigbar(c, p, i, sbar);
-                        for (int a = 0; a < SPH_NSTRESS; a++)
-                            sown[a] = p->sig[a][i];
-                        have_sbar = 1;
-                    }
-                    vec3 A;
-                    fg = v3_scale(sph_ghost_soil_accel(c, sown, sbar, p->rho[i], dv, nrm, &A), p->m[i]);
-                    fgn = fmax(v3_dot(fg, nrm), 0.0);
-                    /* L_ab += sum_g V_g (v_g - v_i)_a (grad_i W_ig)_b with the ghosts' normal
-                     * velocity the wall's (free slip: their tangential velocity the particle's),
-                     * v_g - v_i = -(u_rel.n) n, grad_i W_ig = -F r_g: (u_rel.n) n_a A_b */
-                    const double un = v3_dot(urel, nrm), na[3] = {nrm.x, nrm.y, nrm.z}, ab[3] = {A.x, A.y, A.z};
-                    for (int a = 0; a < 3; a++)
-                        for (int bb = 0; bb < 3; bb++)
-                            lw[a * 3 + bb] += un * na[a] * ab[bb];
-                }
-                const double fn_tot = (delta > 0.0 ? kn * delta : 0.0) + fgn;
-                if (soil && fn_tot > 0.0) {
-                    ft = coupling_soil_tangential(c, p->id[i], b, nrm, urel, fn_tot, kn, dt, hist_d[nh]);
-                    hist_b[nh++] = b;
-                }
-                vec3 f = v3_add(v3_add(fn, ft), fg);
-                gd[ns] = -1.0;
-                if (c->pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !cross && p->phase[i] == 0) { /* water only: soil has eq. 22-27 */
-                    double drw;
-                    if (pbar != pbar)
-                        pbar = sph_ghost_pbar(c, p, i);
-                    /* the Riemann scheme adds this wall's dissipation to p_i (sph_riemann.h) */
-                    gp[ns] = c->riemann ? p->p[i] + sph_riemann_wall_dissipation(p->rho[i], v3_dot(urel, nrm), c->riemann_c0,
-                                                                                 c->riemann_eta)
-                                        : p->p[i];
-                    f = v3_axpy(p->m[i], sph_ghost_wall_accel(c, gp[ns], pbar, p->rho[i], dv, nrm, urel, &drw), f);
-                    drho_g += drw;
-                    gn[ns] = nrm;
-                    gd[ns] = dv;
-                    gu[ns] = urel;
-                }
-                ftot = v3_add(ftot, f);
-                int64_t k = i * SPH_COUPLING_MAX_PER_PARTICLE + ns;
-                c->slot_body[k] = cross ? -(b + 1) : b;
-                sph_contact *ct = &c->slot[k];
-                v3_store(xs, ct->xs);
-                v3_store(v3_neg(f), ct->force); /* eq. 20 */
-                ct->delta = delta;
-                ct->particle_id = p->id[i];
-                ns++;
-            }
-        }
-        /* ghost pressure at a concave corner of perpendicular bodies: the quadrant behind both
-         * once, not twice (sph_coupling.h) */
-        for (int s1 = 0; s1 < ns; s1++)
-            for (int s2 = 0; s2 < ns; s2++) {
-                if (s1 == s2 || gd[s1] < 0.0 || gd[s2] < 0.0 || fabs(v3_dot(gn[s1], gn[s2])) >= 0.1)
-                    continue;
-                double drc;
-                vec3 fc = v3_scale(sph_ghost_corner_accel(c, gp[s1], pbar, p->rho[i], gd[s1], gn[s1], gd[s2], gn[s2], gu[s1], gu[s2], &drc),
-                                   -p->m[i]);
-                drho_g -= drc;
-                /* eq. 20: wall s1 takes the reaction of the correction; of the half quadrant its
-                 * layers keep, the push along n_s2 is wall s2's (a ghost behind both walls pushes
-                 * across each wall's own plane), so that part of the reaction (-fc) moves over */
-                sph_contact *ca = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s1];
-                sph_contact *cb = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s2];
-                vec3 fb = v3_scale(gn[s2], v3_dot(fc, gn[s2]));
-                v3_store(v3_sub(v3_load(ca->force), v3_add(fc, fb)), ca->force);
-                v3_store(v3_add(v3_load(cb->force), fb), cb->force);
-                ftot = v3_add(ftot, fc);
-            }
-        c->slot_n[i] = ns;
-        if (c->soil_lw_on) {
-            c->soil_lw_on[i] = (unsigned char)have_sbar;
-            if (have_sbar)
-                memcpy(c->soil_lw[i], lw, sizeof lw);
-        }
-        if (soil) { /* the springs of the pairs in contact now; the others are released */
-            const int64_t base = p->id[i] * SPH_COUPLING_MAX_PER_PARTICLE;
-            for (int s = 0; s < SPH_COUPLING_MAX_PER_PARTICLE; s++) {
-                c->soil_hist_body[base + s] = s < nh ? hist_b[s] : -1;
-                if (s < nh)
-                    memcpy(c->soil_hist_d[base + s], hist_d[s], sizeof hist_d[s]);
-            }
-        }
-        if (ns == 0 && drho_g == 0.0) /* far from every body (most particles): nothing to add */
+    for (int a = 0; a < 3; a++) {
+        nlo[a] = nhi[a] = 0;
+        if (!c->periodic[a])
             continue;
-        double inv_m = 1.0 / p->m[i];
-        p->drho[i] += drho_g;
-        p->ax[i] += ftot.x * inv_m;
-        p->ay[i] += ftot.y * inv_m;
-        p->az[i] += ftot.z * inv_m;
+        /* the range of the body along a: its world box when fixed (tight), else its sphere */
+        const double *bb = c->box[b];
+        int boxed = c->bodies[b].motion == LAHAR_MOTION_FIXED && isfinite(bb[a]) && isfinite(bb[3 + a]);
+        double lo = boxed ? bb[a] : bx[a] - c->bound[b], hi = boxed ? bb[3 + a] : bx[a] + c->bound[b];
+        double xa = v3_get(xp, a);
+        const double plo = c->period_lo[a], phi = plo + c->period[a];
+        if (hi - lo < c->period[a] && hi > plo - support && lo < phi + support && isfinite(xa)) {
+            nlo[a] = (int)ceil((xa - hi - support) / c->period[a]);
+            nhi[a] = (int)floor((xa - lo + support) / c->period[a]);
+        }
     }
+}
 
-    /* serial, in particle order: per-body resultants, contact list, crossings */
+/* Culling, cheapest test first: the point xi is out of body b's reach (at least the support from
+ * its surface) by a fixed body's tight world box or by any body's bounding sphere. A point culled
+ * here is out of reach, so the tests' order and form change no result. */
+static inline int coupling_culled(const sph_coupling *c, int b, vec3 xb, vec3 xi)
+{
+    const double support = c->k.support;
+    if (c->bodies[b].motion == LAHAR_MOTION_FIXED) {
+        const double *bb = c->box[b];
+        if (xi.x < bb[0] - support || xi.x > bb[3] + support || xi.y < bb[1] - support || xi.y > bb[4] + support ||
+            xi.z < bb[2] - support || xi.z > bb[5] + support)
+            return 1;
+    }
+    const double reach = c->bound[b] + support;
+    return v3_norm2(v3_sub(xi, xb)) > reach * reach;
+}
+
+/* The contact of the point xi with body b's surface (xb its position), past the culling; 0 when
+ * the distance to the core, through the feature grids of big shapes (terrain, flumes), puts it out
+ * of reach. Not inlined, nor is coupling_contact: they run for one culling test in ~50, and inlined
+ * they crowd the registers of the culling loop (callgrind, debris_2d: 12 % more instructions in
+ * the particle loop inlined, 6 % fewer than that loop written out in one function as it was). */
+static __attribute__((noinline)) int coupling_find_surface(const sph_coupling *c, int b, coupling_pose pose, vec3 xb,
+                                                           vec3 xi, coupling_surface *s)
+{
+    const lahar_body *body = &c->bodies[b];
+    const double support = c->k.support, R = body->shape.radius;
+    vec3 core = xb;
+    double dc = geom_body_grids_core(&c->grids, b, &body->shape, pose.x, pose.q, xi, R + support, &core, NULL);
+    /* deep inside: far from the surface */
+    int inside = geom_point_in_core(&body->shape, body->convex, c->dim, pose.x, pose.q, xi);
+    if (dc - R >= support && !inside)
+        return 0;
+    if (dc == DBL_MAX) /* inside a big closed core, far from every feature: no direction */
+        dc = 0.0;
+    s->cross = inside || dc < R;
+    if (dc > 0.0) {
+        s->nrm = v3_scale(v3_sub(xi, core), 1.0 / dc);
+        s->d = dc - R; /* eq. 13, signed */
+        if (inside) {
+            s->nrm = v3_neg(s->nrm);
+            s->d = -dc - R;
+        }
+    } else {
+        s->nrm = v3(0, 0, 0); /* on the core: no direction to push; counted as a crossing */
+        s->d = -R;
+    }
+    s->xs = v3_axpy(R, s->nrm, core); /* eq. 12 */
+    return 1;
+}
+
+/* Water's wall shear m_i a_tau (eq. 19): the coefficient of u_rel at the viscous distance dv,
+ * from the half-space model or eq. 17 as printed. */
+static inline double coupling_wall_shear_coef(const sph_coupling *c, const sph_particles *p, int64_t i, int b,
+                                              double dv, const coupling_consts *k)
+{
+    if (c->viscous == LAHAR_SPH_WALL_HALFSPACE)
+        return 2.0 * c->mu / p->rho[i] * sph_coupling_body_halfspace_factor(c, b, dv);
+    return 4.0 * p->m[i] / (3.0 * k->hd) * (2.0 * c->mu) / (4.0 * p->rho[i] * p->rho[i]) / dv *
+           kernel_dwdr(&c->k, dv) / k->w0;
+}
+
+/* The soil ghost stress on a soil particle (sph_coupling_set_soil_wall); its push along n (fgn)
+ * joins F_n of the friction cap, and its ghosts add to the particle's velocity gradient. */
+static inline vec3 coupling_soil_ghost(const sph_coupling *c, const sph_particles *p, int64_t i,
+                                       const coupling_surface *s, vec3 urel, double dv, coupling_acc *a,
+                                       coupling_scratch *w, double *fgn)
+{
+    if (!a->have_sbar) {
+        sph_ghost_soil_sigbar(c, p, i, w->sbar);
+        for (int k = 0; k < SPH_NSTRESS; k++)
+            w->sown[k] = p->sig[k][i];
+        memset(w->lw, 0, sizeof w->lw);
+        a->have_sbar = 1;
+    }
+    vec3 A;
+    vec3 fg = v3_scale(sph_ghost_soil_accel(c, w->sown, w->sbar, p->rho[i], dv, s->nrm, &A), p->m[i]);
+    *fgn = fmax(v3_dot(fg, s->nrm), 0.0);
+    /* L_ab += sum_g V_g (v_g - v_i)_a (grad_i W_ig)_b with the ghosts' normal velocity the
+     * wall's (free slip: their tangential velocity the particle's), v_g - v_i = -(u_rel.n) n,
+     * grad_i W_ig = -F r_g: (u_rel.n) n_a A_b */
+    const double un = v3_dot(urel, s->nrm), na[3] = {s->nrm.x, s->nrm.y, s->nrm.z}, ab[3] = {A.x, A.y, A.z};
+    for (int r = 0; r < 3; r++)
+        for (int q = 0; q < 3; q++)
+            w->lw[r * 3 + q] += un * na[r] * ab[q];
+    return fg;
+}
+
+/* The ghost wall pressure on a water particle (Adami et al. 2012, sph_wall_ghost.c): its
+ * acceleration; the contact's normal, distance, velocity and wall pressure are kept for the
+ * corner correction. The Riemann scheme adds this wall's dissipation to p_i (sph_riemann.h). */
+static inline vec3 coupling_water_ghost(const sph_coupling *c, const sph_particles *p, int64_t i,
+                                        const coupling_surface *s, vec3 urel, double dv, coupling_acc *a,
+                                        coupling_scratch *w)
+{
+    const int ns = a->ns;
+    double drw;
+    if (a->pbar != a->pbar)
+        a->pbar = sph_ghost_pbar(c, p, i);
+    w->gp[ns] = c->riemann ? p->p[i] + sph_riemann_wall_dissipation(p->rho[i], v3_dot(urel, s->nrm), c->riemann_c0,
+                                                                     c->riemann_eta)
+                           : p->p[i];
+    vec3 acc = sph_ghost_wall_accel(c, w->gp[ns], a->pbar, p->rho[i], dv, s->nrm, urel, &drw);
+    a->drho_g += drw;
+    w->gn[ns] = s->nrm;
+    w->gd[ns] = dv;
+    w->gu[ns] = urel;
+    return acc;
+}
+
+/* The force of one contact on particle i (section 4: penalty eq. 14-15, wall shear eq. 16-19 or
+ * the soil's friction of section 4.2, the ghost walls), added to a->ftot; the reaction (eq. 20)
+ * goes to the particle's next slot. */
+static __attribute__((noinline)) void coupling_contact(sph_coupling *c, const sph_particles *p, int64_t i, int b,
+                                                       coupling_pose pose, const coupling_surface *s,
+                                                       const coupling_consts *k, int soil, coupling_acc *a,
+                                                       coupling_scratch *w)
+{
+    const int water = p->phase[i] == 0;
+    const double delta = c->eps - s->d; /* eq. 14 */
+    vec3 fn = delta > 0.0 ? v3_scale(s->nrm, k->kn * delta) : v3(0, 0, 0); /* eq. 15 */
+    /* eq. 16: relative velocity to the body's surface at x_s */
+    vec3 urel = v3_sub(v3(p->vx[i], p->vy[i], p->vz[i]),
+                       v3_add(v3_load(pose.v), v3_cross(v3_load(pose.w), v3_sub(s->xs, v3_load(pose.x)))));
+    double dv = fmax(s->d, 0.5 * c->eps); /* the viscous term's distance, kept off zero */
+    vec3 ft = water ? v3_scale(urel, p->m[i] * coupling_wall_shear_coef(c, p, i, b, dv, k)) : v3(0, 0, 0);
+    vec3 fg = v3(0, 0, 0);
+    double fgn = 0.0;
+    if (!water && c->soil_pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !s->cross && p->sig[0])
+        fg = coupling_soil_ghost(c, p, i, s, urel, dv, a, w, &fgn);
+    const double fn_tot = (delta > 0.0 ? k->kn * delta : 0.0) + fgn;
+    if (soil && fn_tot > 0.0) {
+        ft = coupling_soil_tangential(c, p->id[i], b, s->nrm, urel, fn_tot, k->kn, k->dt, w->hist_d[a->nh]);
+        w->hist_b[a->nh++] = b;
+    }
+    vec3 f = v3_add(v3_add(fn, ft), fg);
+    w->gd[a->ns] = -1.0;
+    if (c->pressure == LAHAR_SPH_WALL_PRESSURE_GHOST && !s->cross && water) /* soil has eq. 22-27 */
+        f = v3_axpy(p->m[i], coupling_water_ghost(c, p, i, s, urel, dv, a, w), f);
+    a->ftot = v3_add(a->ftot, f);
+    int64_t slot = i * SPH_COUPLING_MAX_PER_PARTICLE + a->ns;
+    c->slot_body[slot] = s->cross ? -(b + 1) : b;
+    sph_contact *ct = &c->slot[slot];
+    v3_store(s->xs, ct->xs);
+    v3_store(v3_neg(f), ct->force); /* eq. 20 */
+    ct->delta = delta;
+    ct->particle_id = p->id[i];
+    a->ns++;
+}
+
+/* Ghost pressure at a concave corner of perpendicular bodies: the quadrant behind both once, not
+ * twice (sph_coupling.h). */
+static inline void coupling_ghost_corners(sph_coupling *c, const sph_particles *p, int64_t i, coupling_acc *a,
+                                          coupling_scratch *w)
+{
+    for (int s1 = 0; s1 < a->ns; s1++)
+        for (int s2 = 0; s2 < a->ns; s2++) {
+            if (s1 == s2 || w->gd[s1] < 0.0 || w->gd[s2] < 0.0 || fabs(v3_dot(w->gn[s1], w->gn[s2])) >= 0.1)
+                continue;
+            double drc;
+            vec3 fc = v3_scale(sph_ghost_corner_accel(c, w->gp[s1], a->pbar, p->rho[i], w->gd[s1], w->gn[s1], w->gd[s2],
+                                                      w->gn[s2], w->gu[s1], w->gu[s2], &drc),
+                               -p->m[i]);
+            a->drho_g -= drc;
+            /* eq. 20: wall s1 takes the reaction of the correction; of the half quadrant its
+             * layers keep, the push along n_s2 is wall s2's (a ghost behind both walls pushes
+             * across each wall's own plane), so that part of the reaction (-fc) moves over */
+            sph_contact *ca = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s1];
+            sph_contact *cb = &c->slot[i * SPH_COUPLING_MAX_PER_PARTICLE + s2];
+            vec3 fb = v3_scale(w->gn[s2], v3_dot(fc, w->gn[s2]));
+            v3_store(v3_sub(v3_load(ca->force), v3_add(fc, fb)), ca->force);
+            v3_store(v3_add(v3_load(cb->force), fb), cb->force);
+            a->ftot = v3_add(a->ftot, fc);
+        }
+}
+
+/* Particle i's contacts with every body in reach, each periodic image of it included. */
+static inline void coupling_particle_contacts(sph_coupling *c, const sph_particles *p, int64_t i,
+                                              const lahar_body_state *states, uint32_t near, const coupling_consts *k,
+                                              int soil, coupling_acc *a, coupling_scratch *w)
+{
+    const vec3 xp = v3(p->x[i], p->y[i], p->z[i]);
+    for (int b = 0; b < c->nbody && a->ns < SPH_COUPLING_MAX_PER_PARTICLE; b++) {
+        if (!(near >> b & 1u)) /* sph_coupling_mark: this body is out of reach */
+            continue;
+        const coupling_pose pose = coupling_body_pose(c, states, b);
+        const vec3 xb = v3_load(pose.x);
+        int nlo[3], nhi[3];
+        coupling_image_range(c, b, pose.x, xp, nlo, nhi);
+        const int nx = nhi[0] - nlo[0] + 1, ny = nhi[1] - nlo[1] + 1, nimg = nx * ny * (nhi[2] - nlo[2] + 1);
+        for (int img = 0; img < nimg && a->ns < SPH_COUPLING_MAX_PER_PARTICLE; img++) {
+            /* without images (ix = iy = iz = 0) xi is the particle's position bit for bit; the
+             * divisions only where there are several images (most particles have one) */
+            const int ix = nlo[0] + (nimg > 1 ? img % nx : 0), iy = nlo[1] + (nimg > 1 ? img / nx % ny : 0),
+                      iz = nlo[2] + (nimg > 1 ? img / (nx * ny) : 0);
+            vec3 xi = v3(xp.x - ix * c->period[0], xp.y - iy * c->period[1], xp.z - iz * c->period[2]);
+            if (coupling_culled(c, b, xb, xi))
+                continue;
+            coupling_surface s;
+            if (coupling_find_surface(c, b, pose, xb, xi, &s))
+                coupling_contact(c, p, i, b, pose, &s, k, soil, a, w);
+        }
+    }
+}
+
+/* Particle i's share of the evaluation: its slot count, soil velocity gradient and springs, and
+ * the accelerations and continuity term on it. */
+static inline void coupling_particle_finish(sph_coupling *c, sph_particles *p, int64_t i, int soil,
+                                            const coupling_acc *a, const coupling_scratch *w)
+{
+    c->slot_n[i] = a->ns;
+    if (c->soil_lw_on) {
+        c->soil_lw_on[i] = (unsigned char)a->have_sbar;
+        if (a->have_sbar)
+            memcpy(c->soil_lw[i], w->lw, sizeof w->lw);
+    }
+    if (soil) { /* the springs of the pairs in contact now; the others are released */
+        const int64_t base = p->id[i] * SPH_COUPLING_MAX_PER_PARTICLE;
+        for (int s = 0; s < SPH_COUPLING_MAX_PER_PARTICLE; s++) {
+            c->soil_hist_body[base + s] = s < a->nh ? w->hist_b[s] : -1;
+            if (s < a->nh)
+                memcpy(c->soil_hist_d[base + s], w->hist_d[s], sizeof w->hist_d[s]);
+        }
+    }
+    if (a->ns == 0 && a->drho_g == 0.0) /* far from every body (most particles): nothing to add */
+        return;
+    double inv_m = 1.0 / p->m[i];
+    p->drho[i] += a->drho_g;
+    p->ax[i] += a->ftot.x * inv_m;
+    p->ay[i] += a->ftot.y * inv_m;
+    p->az[i] += a->ftot.z * inv_m;
+}
+
+/* Serial, in particle order: the contacts per body (crossings noted, the first one kept for the
+ * message), their list by body, and each body's resultant force and torque (eq. 21 with the torque
+ * as r x F). Returns -1 when the list cannot grow. */
+static int coupling_gather(sph_coupling *c, int64_t n, const lahar_body_state *states)
+{
     for (int b = 0; b < c->nbody; b++) {
         c->force[b][0] = c->force[b][1] = c->force[b][2] = 0.0;
         c->torque[b][0] = c->torque[b][1] = c->torque[b][2] = 0.0;
@@ -479,14 +577,41 @@ int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_s
             int b = c->slot_body[k];
             const sph_contact *ct = &c->slot[k];
             c->contacts[c->body_fill[b]++] = *ct;
-            const double *bx = states && c->bodies[b].motion != LAHAR_MOTION_FIXED ? states[b].x : c->bodies[b].x;
-            vec3 f = v3_load(ct->force), r = v3_sub(v3_load(ct->xs), v3_load(bx));
-            vec3 t = v3_cross(r, f); /* eq. 21 with the torque as r x F */
+            vec3 f = v3_load(ct->force), r = v3_sub(v3_load(ct->xs), v3_load(coupling_body_pose(c, states, b).x));
+            vec3 t = v3_cross(r, f);
             for (int a = 0; a < 3; a++) {
                 c->force[b][a] += v3_get(f, a);
                 c->torque[b][a] += v3_get(t, a);
             }
         }
     c->ncontacts = total;
+    return 0;
+}
+
+int64_t sph_coupling_apply(sph_coupling *c, sph_particles *p, const lahar_body_state *states, double dt)
+{
+    const int64_t n = p->n;
+    /* eq. 15: K_n = 0.1 m_min / dt^2; with kn_dt > 0 the acoustic step instead (sph_coupling.h) */
+    const double dtk = c->kn_dt > 0.0 ? c->kn_dt : dt;
+    const coupling_consts k = {.dt = dt, .kn = 0.1 * c->m_min / (dtk * dtk), .w0 = kernel_w(&c->k, 0.0),
+                               .hd = pow(c->k.h, c->dim)};
+    c->kn = k.kn;
+    if (n > c->pcap)
+        return -1;
+
+    const int near_valid = c->near_valid && c->nbody < 32;
+    c->near_valid = 0; /* the marks serve this evaluation only */
+#pragma omp parallel for schedule(dynamic, SPH_OMP_CHUNK) if (n >= SPH_OMP_MIN_HEAVY)
+    for (int64_t i = 0; i < n; i++) {
+        /* soil-DEM springs of this evaluation (sph_coupling_enable_soil) */
+        const int soil = p->phase[i] != 0 && c->soil_hist_body;
+        coupling_acc a = {.ns = 0, .nh = 0, .have_sbar = 0, .ftot = v3(0, 0, 0), .drho_g = 0.0, .pbar = NAN};
+        coupling_scratch w;
+        coupling_particle_contacts(c, p, i, states, near_valid ? c->near[i] : ~0u, &k, soil, &a, &w);
+        coupling_ghost_corners(c, p, i, &a, &w);
+        coupling_particle_finish(c, p, i, soil, &a, &w);
+    }
+    if (coupling_gather(c, n, states))
+        return -1;
     return c->crossings;
 }
