@@ -1610,211 +1610,318 @@ static int coord_resume_prepare(coord *co, lahar_case *rc, double t_end)
     return 0;
 }
 
-int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
-{
-    coord co;
-    memset(&co, 0, sizeof co);
-    co.c = c;
-    co.o = o;
-    co.status = "error";
-    co.summary_fd = -1;
-    co.wall0 = lahar_now();
-    co.node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
-    co.node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
-    if (!co.node[LAHAR_ROLE_DEM].needed && !co.node[LAHAR_ROLE_SPH].needed) {
-        fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
-        return LAHAR_EXIT_SETUP;
-    }
-    if (lahar_mkdir_p(o->outdir) != 0 || !realpath(o->outdir, co.outdir)) {
-        fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", o->outdir, strerror(errno));
-        return LAHAR_EXIT_SETUP;
-    }
-    int lock_fd = coord_lock_outdir(co.outdir, c->path);
-    if (lock_fd < 0)
-        return LAHAR_EXIT_SETUP;
-    co.ckpt_last_step = -1;
-    co.ckpt_on = c->checkpoint_interval > 0.0;
-    static lahar_case resumed_case; /* the case with the resume fields (and a later end) */
-    if (o->resume) {
-        resumed_case = *c;
-        int rc = coord_resume_prepare(&co, &resumed_case, o->resume_t_end);
-        if (rc != 0) {
-            close(lock_fd);
-            return rc > 0 ? LAHAR_EXIT_OK : LAHAR_EXIT_SETUP;
-        }
-        c = &resumed_case;
-        co.c = c;
-    } else if (coord_clear_outdir(co.outdir, o->overwrite) != 0 ||
-               (co.ckpt_on && coord_save_case(co.outdir, c) != 0)) {
-        close(lock_fd);
-        return LAHAR_EXIT_SETUP;
-    }
+/* ---- a run, step by step (lahar_coord_run) ------------------------------------------------- */
 
-    /* Where the messages go. Default: a private network namespace of our own. */
+/* What a set-up step returns when the run goes on; any other value is the exit status to end
+ * with. */
+#define COORD_GO_ON (-1)
+
+/* The run's record before anything is touched; -1 (and the message) when the case has nothing for
+ * either node to do, so that OUT is not even created. */
+static int coord_init(coord *co, const lahar_case *c, const lahar_coord_options *o)
+{
+    memset(co, 0, sizeof *co);
+    co->c = c;
+    co->o = o;
+    co->status = "error";
+    co->summary_fd = -1;
+    co->wall0 = lahar_now();
+    co->node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
+    co->node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
+    if (!co->node[LAHAR_ROLE_DEM].needed && !co->node[LAHAR_ROLE_SPH].needed) {
+        fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
+        return -1;
+    }
+    co->ckpt_last_step = -1;
+    co->ckpt_on = c->checkpoint_interval > 0.0;
+    return 0;
+}
+
+/* OUT created, its absolute path (the nodes write there from their own working directories) and
+ * its lock; the lock's descriptor, or -1 after saying why. */
+static int coord_claim_outdir(coord *co)
+{
+    if (lahar_mkdir_p(co->o->outdir) != 0 || !realpath(co->o->outdir, co->outdir)) {
+        fprintf(stderr, "lahar: cannot create the output directory %s: %s\n", co->o->outdir, strerror(errno));
+        return -1;
+    }
+    return coord_lock_outdir(co->outdir, co->c->path);
+}
+
+/* What OUT holds before the nodes start: for `lahar resume` the output cut back to the newest
+ * checkpoint and the case it continues (co->c becomes that copy, with the resume fields); for a
+ * new run an OUT without an earlier run's files, and the case kept beside the checkpoints.
+ * COORD_GO_ON, or the exit status (LAHAR_EXIT_OK: a resume with nothing left to do). */
+static int coord_prepare_outdir(coord *co)
+{
+    static lahar_case resumed_case; /* the case with the resume fields (and a later end) */
+    if (co->o->resume) {
+        resumed_case = *co->c;
+        int rc = coord_resume_prepare(co, &resumed_case, co->o->resume_t_end);
+        if (rc != 0)
+            return rc > 0 ? LAHAR_EXIT_OK : LAHAR_EXIT_SETUP;
+        co->c = &resumed_case;
+        return COORD_GO_ON;
+    }
+    if (coord_clear_outdir(co->outdir, co->o->overwrite) != 0 ||
+        (co->ckpt_on && coord_save_case(co->outdir, co->c) != 0))
+        return LAHAR_EXIT_SETUP;
+    return COORD_GO_ON;
+}
+
+/* Where the messages go (co->url, co->mode). Default: a private network namespace of our own, so
+ * that nothing leaves the machine and two runs never hear each other. 0, or -1 after saying why. */
+static int coord_choose_network(coord *co)
+{
+    const lahar_coord_options *o = co->o;
     char err[1024];
     const char *env_url = getenv("LCM_DEFAULT_URL");
     if (o->in_process) {
-        co.url = "memq://";
-        co.mode = "in-process";
+        co->url = "memq://";
+        co->mode = "in-process";
     } else if (o->lcm_url || env_url) {
-        co.url = o->lcm_url ? o->lcm_url : env_url;
-        co.mode = o->no_spawn ? "no-spawn" : "processes";
-        if (strncmp(co.url, "udpm://", 7) == 0 && !strstr(co.url, "recv_buf_size"))
+        co->url = o->lcm_url ? o->lcm_url : env_url;
+        co->mode = o->no_spawn ? "no-spawn" : "processes";
+        if (strncmp(co->url, "udpm://", 7) == 0 && !strstr(co->url, "recv_buf_size"))
             fprintf(stderr, "lahar: warning: %s has no recv_buf_size; large messages may be lost "
-                            "(add ?recv_buf_size=8388608)\n", co.url);
+                            "(add ?recv_buf_size=8388608)\n", co->url);
     } else if (o->no_spawn) {
         /* nodes started by hand cannot join a namespace made here; the network must be named */
         fprintf(stderr, "lahar: --no-spawn needs --lcm-url URL (or $LCM_DEFAULT_URL), the same URL the nodes you "
                         "start are given, e.g. '%s' inside a network namespace you made\n", LAHAR_NETNS_URL);
-        close(lock_fd);
-        return LAHAR_EXIT_SETUP;
+        return -1;
     } else {
         if (lahar_netns_enter(err, sizeof err) != 0) {
             fprintf(stderr, "lahar: %s\n", err);
-            close(lock_fd);
-            return LAHAR_EXIT_SETUP;
+            return -1;
         }
-        co.url = LAHAR_NETNS_URL;
-        co.mode = "processes";
+        co->url = LAHAR_NETNS_URL;
+        co->mode = "processes";
     }
-    /* an authenticated run (--auth-key or $LAHAR_AUTH_KEY): memq:// inside this process has no
-     * one to keep out, every network run takes the key */
+    return 0;
+}
+
+/* An authenticated run (--auth-key or $LAHAR_AUTH_KEY): memq:// inside this process has no one to
+ * keep out, every network run takes the key. 0, or -1 after saying why. */
+static int coord_load_auth_key(coord *co)
+{
+    const lahar_coord_options *o = co->o;
+    char err[1024];
     const char *key_path = o->auth_key_path ? o->auth_key_path : getenv(LAHAR_AUTH_ENV);
     if (key_path && *key_path && !o->in_process) {
-        if (!realpath(key_path, co.auth_key_path) ||
-            lahar_auth_key_load(co.auth_key_path, co.auth_key, err, sizeof err) != 0) {
-            if (!co.auth_key_path[0] || errno == ENOENT)
+        if (!realpath(key_path, co->auth_key_path) ||
+            lahar_auth_key_load(co->auth_key_path, co->auth_key, err, sizeof err) != 0) {
+            if (!co->auth_key_path[0] || errno == ENOENT)
                 snprintf(err, sizeof err, "auth key %s: %s (make one with `lahar keygen FILE`)", key_path,
                          strerror(errno));
             fprintf(stderr, "lahar: %s\n", err);
-            close(lock_fd);
-            return LAHAR_EXIT_SETUP;
+            return -1;
         }
     }
-    if (coord_reserve_summary(&co) != 0) {
-        close(lock_fd);
-        return LAHAR_EXIT_SETUP;
-    }
-    co.run_id = coord_random_run_id();
-    co.progress = o->quiet ? 0
-                  : isatty(STDERR_FILENO) ? COORD_PROGRESS_TERMINAL
-                  : o->progress_every_s > 0 ? COORD_PROGRESS_LOG : 0;
-    co.last_progress = co.wall0;
+    return 0;
+}
 
+/* Progress on stderr: none with --quiet, a line rewritten in place on a terminal, whole lines
+ * every --progress-every s into a file or a pipe (a batch job's log). */
+static void coord_choose_progress(coord *co)
+{
+    const lahar_coord_options *o = co->o;
+    co->progress = o->quiet ? 0
+                   : isatty(STDERR_FILENO) ? COORD_PROGRESS_TERMINAL
+                   : o->progress_every_s > 0 ? COORD_PROGRESS_LOG : 0;
+    co->last_progress = co->wall0;
+}
+
+/* Ctrl-C ends the run (the nodes are stopped, summary.json written); SIGTERM too, or with
+ * checkpoints a checkpoint first and a clean, resumable stop; SIGUSR1 asks for a checkpoint. */
+static void coord_catch_signals(const coord *co)
+{
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = coord_on_sigint;
     sigaction(SIGINT, &sa, NULL);
-    if (co.ckpt_on) /* SIGTERM: a checkpoint, then a clean stop (resumable) */
+    if (co->ckpt_on) /* SIGTERM: a checkpoint, then a clean stop (resumable) */
         sa.sa_handler = coord_on_sigterm;
     sigaction(SIGTERM, &sa, NULL);
     sa.sa_handler = coord_on_sigusr1;
     sigaction(SIGUSR1, &sa, NULL);
+}
 
-    int status = LAHAR_EXIT_SETUP;
-    co.t = lahar_transport_open(co.url, err, sizeof err);
-    if (!co.t) {
-        snprintf(co.message, sizeof co.message, "%s", err);
-        goto out;
+/* The transport and the coordinator's link on it (with the run's key). LAHAR_EXIT_OK, or
+ * LAHAR_EXIT_SETUP with co->message saying why. */
+static int coord_open_link(coord *co)
+{
+    char err[1024];
+    co->t = lahar_transport_open(co->url, err, sizeof err);
+    if (!co->t) {
+        snprintf(co->message, sizeof co->message, "%s", err);
+        return LAHAR_EXIT_SETUP;
     }
-    co.link = lahar_link_create(co.t, LAHAR_ROLE_COORDINATOR, co.run_id,
-                                LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STATUS), err,
-                                sizeof err);
-    if (!co.link) {
-        snprintf(co.message, sizeof co.message, "%s", err);
-        goto out;
+    co->link = lahar_link_create(co->t, LAHAR_ROLE_COORDINATOR, co->run_id,
+                                 LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_HELLO) | LAHAR_MSG_BIT(LAHAR_FRAME_T_MSG_STATUS), err,
+                                 sizeof err);
+    if (!co->link) {
+        snprintf(co->message, sizeof co->message, "%s", err);
+        return LAHAR_EXIT_SETUP;
     }
-    if (co.auth_key_path[0])
-        lahar_link_set_auth_key(co.link, co.auth_key);
-    coord_machine_load(&co);
+    if (co->auth_key_path[0])
+        lahar_link_set_auth_key(co->link, co->auth_key);
+    return LAHAR_EXIT_OK;
+}
+
+/* The nodes started (unless the user starts them, --no-spawn), the heartbeat running and every
+ * node's HELLO heard. The machine's load is read first: it decides the nodes' OpenMP wait policy
+ * (coord_machine_load). LAHAR_EXIT_OK or the exit status, with co->message. */
+static int coord_start_nodes(coord *co)
+{
+    const lahar_coord_options *o = co->o;
+    coord_machine_load(co);
     if (!o->no_spawn)
         for (int r = 1; r < LAHAR_NROLES; r++)
-            if (co.node[r].needed && coord_start_node(&co, &co.node[r]) != 0) {
-                snprintf(co.message, sizeof co.message, "cannot start the %s", lahar_link_role_name(r));
-                goto stop;
+            if (co->node[r].needed && coord_start_node(co, &co->node[r]) != 0) {
+                snprintf(co->message, sizeof co->message, "cannot start the %s", lahar_link_role_name(r));
+                return LAHAR_EXIT_SETUP;
             }
     if (o->no_spawn && !o->quiet)
         fprintf(stderr, "lahar: run %lld on %s: waiting for%s%s (start them with --lcm-url '%s')\n",
-                (long long)co.run_id, co.url, co.node[LAHAR_ROLE_DEM].needed ? " lahar-dem" : "",
-                co.node[LAHAR_ROLE_SPH].needed ? " lahar-sph" : "", co.url);
-    lahar_link_set_step(co.link, -1);
-    if (lahar_link_heartbeat_start(co.link, LAHAR_HEARTBEAT_PERIOD) != 0) {
-        snprintf(co.message, sizeof co.message, "cannot start the heartbeat thread");
-        goto stop;
+                (long long)co->run_id, co->url, co->node[LAHAR_ROLE_DEM].needed ? " lahar-dem" : "",
+                co->node[LAHAR_ROLE_SPH].needed ? " lahar-sph" : "", co->url);
+    lahar_link_set_step(co->link, -1);
+    if (lahar_link_heartbeat_start(co->link, LAHAR_HEARTBEAT_PERIOD) != 0) {
+        snprintf(co->message, sizeof co->message, "cannot start the heartbeat thread");
+        return LAHAR_EXIT_SETUP;
     }
-    status = coord_hello(&co);
-    if (status != LAHAR_EXIT_OK)
-        goto stop;
+    return coord_hello(co);
+}
 
+/* The scene (the case as the nodes need it) published, then STATUS(-1) of every node awaited: the
+ * nodes' set-up (particles filled, first rates). LAHAR_EXIT_OK or the exit status. */
+static int coord_set_up_nodes(coord *co)
+{
     lahar_scene_t sm;
-    if (lahar_scene_msg_from_case(c, co.outdir, co.node[LAHAR_ROLE_DEM].needed, co.node[LAHAR_ROLE_SPH].needed,
-                                  co.run_id, &sm) != 0) {
-        snprintf(co.message, sizeof co.message, "out of memory");
-        status = LAHAR_EXIT_SETUP;
-        goto stop;
+    if (lahar_scene_msg_from_case(co->c, co->outdir, co->node[LAHAR_ROLE_DEM].needed,
+                                  co->node[LAHAR_ROLE_SPH].needed, co->run_id, &sm) != 0) {
+        snprintf(co->message, sizeof co->message, "out of memory");
+        return LAHAR_EXIT_SETUP;
     }
     int rc;
-    LAHAR_LINK_SEND(rc, co.link, LAHAR_FRAME_T_MSG_SCENE, lahar_scene_t, -1, &sm);
+    LAHAR_LINK_SEND(rc, co->link, LAHAR_FRAME_T_MSG_SCENE, lahar_scene_t, -1, &sm);
     lahar_scene_msg_release(&sm);
     if (rc != 0) {
-        snprintf(co.message, sizeof co.message, "cannot publish the scene");
-        status = LAHAR_EXIT_SETUP;
-        goto stop;
+        snprintf(co->message, sizeof co->message, "cannot publish the scene");
+        return LAHAR_EXIT_SETUP;
     }
-    status = coord_collect_status(&co, -1);
-    if (co.setup_shown) {
+    int status = coord_collect_status(co, -1);
+    if (co->setup_shown) { /* end the set-up line on the terminal */
         fprintf(stderr, "\n");
-        co.setup_shown = 0;
+        co->setup_shown = 0;
     }
-    if (status != LAHAR_EXIT_OK)
-        goto stop;
-    co.lock0 = lahar_now();
-    status = coord_lockstep(&co);
-    co.lock1 = lahar_now();
+    return status;
+}
+
+/* The lockstep, timed apart from set-up and finish (summary.json setup_s, stepping_s, finish_s). */
+static int coord_step_to_end(coord *co)
+{
+    co->lock0 = lahar_now();
+    int status = coord_lockstep(co);
+    co->lock1 = lahar_now();
     if (status == LAHAR_EXIT_OK)
-        co.status = "finished";
-stop:
-    coord_progress(&co, 1);
-    coord_send_stop(&co, status == LAHAR_EXIT_OK || co.clean_stop ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
-                    co.message);
-    coord_finish_nodes(&co);
-    /* a node that fails on its way out (an output error at close, a sanitizer report) fails the run */
+        co->status = "finished";
+    return status;
+}
+
+/* STOP (its reason from how the run ended) and the nodes' exit. A node that fails on its way out
+ * (an output error at close, a sanitizer report) fails a run that had finished. The run's exit
+ * status. */
+static int coord_stop_nodes(coord *co, int status)
+{
+    coord_progress(co, 1);
+    coord_send_stop(co, status == LAHAR_EXIT_OK || co->clean_stop ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
+                    co->message);
+    coord_finish_nodes(co);
     for (int r = 1; r < LAHAR_NROLES && status == LAHAR_EXIT_OK; r++)
-        if (co.node[r].needed && co.node[r].exited && co.node[r].exit_status != 0) {
-            snprintf(co.message, sizeof co.message, "the %s exited with status %d after the run",
-                     lahar_link_role_name(r), co.node[r].exit_status);
-            co.status = "error";
+        if (co->node[r].needed && co->node[r].exited && co->node[r].exit_status != 0) {
+            snprintf(co->message, sizeof co->message, "the %s exited with status %d after the run",
+                     lahar_link_role_name(r), co->node[r].exit_status);
+            co->status = "error";
             status = LAHAR_EXIT_RUN_ERROR;
         }
-out:
-    coord_release_files(&co);
-    co.exit_status = status;
+    return status;
+}
+
+/* Where the output is and how to look at it (stdout; not with --quiet). */
+static void coord_print_hints(const coord *co)
+{
+    printf("lahar: %s: %lld steps to t = %.6g s in %.2f s wall; output in %s\n", co->status, (long long)co->steps,
+           co->sim_time, lahar_now() - co->wall0, co->outdir);
+    printf("  look at it: paraview %s/lahar.xmf (bodies and particles over time)\n", co->outdir);
+    static const char *const files[] = {"bodies.h5", "forces.h5", "particles.h5", "contacts.h5"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        char path[PATH_MAX + 32];
+        snprintf(path, sizeof path, "%s/%s", co->outdir, files[i]);
+        if (access(path, R_OK) == 0)
+            printf("              h5dump -H %s\n", path);
+    }
+    if (co->c->nbody > 0 && co->c->output_forces)
+        printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
+               LAHAR_TOOLS_DIR, co->outdir);
+    printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co->outdir);
+    printf("  run summary: %s/summary.json\n", co->outdir);
+}
+
+/* However the run ended once it had a summary.json: the files a dead node left readable, the
+ * reason on stderr, summary.json, the combined ParaView file and the closing hints. */
+static void coord_report_end(coord *co, int status)
+{
+    coord_release_files(co);
+    co->exit_status = status;
     if (status != LAHAR_EXIT_OK)
-        fprintf(stderr, "lahar: %s\n", co.message[0] ? co.message : "run failed");
-    if (co.link)
-        lahar_link_heartbeat_stop(co.link);
-    coord_write_summary(&co);
-    if (co.node[LAHAR_ROLE_DEM].needed || co.node[LAHAR_ROLE_SPH].needed) {
-        if (lahar_output_xdmf_combine(co.outdir, err, sizeof err) != 0 && !o->quiet)
+        fprintf(stderr, "lahar: %s\n", co->message[0] ? co->message : "run failed");
+    if (co->link)
+        lahar_link_heartbeat_stop(co->link);
+    coord_write_summary(co);
+    if (co->node[LAHAR_ROLE_DEM].needed || co->node[LAHAR_ROLE_SPH].needed) {
+        char err[1024];
+        if (lahar_output_xdmf_combine(co->outdir, err, sizeof err) != 0 && !co->o->quiet)
             fprintf(stderr, "lahar: %s\n", err);
     }
-    if (!o->quiet) {
-        printf("lahar: %s: %lld steps to t = %.6g s in %.2f s wall; output in %s\n", co.status, (long long)co.steps,
-               co.sim_time, lahar_now() - co.wall0, co.outdir);
-        printf("  look at it: paraview %s/lahar.xmf (bodies and particles over time)\n", co.outdir);
-        static const char *const files[] = {"bodies.h5", "forces.h5", "particles.h5", "contacts.h5"};
-        for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
-            char path[PATH_MAX + 32];
-            snprintf(path, sizeof path, "%s/%s", co.outdir, files[i]);
-            if (access(path, R_OK) == 0)
-                printf("              h5dump -H %s\n", path);
-        }
-        if (c->nbody > 0 && c->output_forces)
-            printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
-                   LAHAR_TOOLS_DIR, co.outdir);
-        printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co.outdir);
-        printf("  run summary: %s/summary.json\n", co.outdir);
+    if (!co->o->quiet)
+        coord_print_hints(co);
+}
+
+/* Set-up that can still refuse the run (exit 2, or 0 for a resume with nothing to do) without
+ * having written anything of it, then the run: nodes, scene, steps, STOP; summary.json is written
+ * however it ends. */
+int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o)
+{
+    coord co;
+    if (coord_init(&co, c, o) != 0)
+        return LAHAR_EXIT_SETUP;
+    const int lock_fd = coord_claim_outdir(&co);
+    if (lock_fd < 0)
+        return LAHAR_EXIT_SETUP;
+    int status = coord_prepare_outdir(&co);
+    if (status == COORD_GO_ON &&
+        (coord_choose_network(&co) != 0 || coord_load_auth_key(&co) != 0 || coord_reserve_summary(&co) != 0))
+        status = LAHAR_EXIT_SETUP;
+    if (status != COORD_GO_ON) {
+        close(lock_fd);
+        return status;
     }
+    co.run_id = coord_random_run_id();
+    coord_choose_progress(&co);
+    coord_catch_signals(&co);
+
+    status = coord_open_link(&co);
+    if (status == LAHAR_EXIT_OK) { /* a link to send STOP on: from here the nodes are stopped however it ends */
+        status = coord_start_nodes(&co);
+        if (status == LAHAR_EXIT_OK)
+            status = coord_set_up_nodes(&co);
+        if (status == LAHAR_EXIT_OK)
+            status = coord_step_to_end(&co);
+        status = coord_stop_nodes(&co, status);
+    }
+    coord_report_end(&co, status);
     lahar_link_destroy(co.link);
     lahar_transport_close(co.t);
     close(lock_fd);
