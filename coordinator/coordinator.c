@@ -1136,9 +1136,10 @@ static void coord_summary_instability(coord *co, cJSON *root)
     }
 }
 
-static void coord_write_summary(coord *co)
+/* summary.json: how the run ended and what it was (case, OUT, transport, run id), and how far it
+ * came. */
+static void coord_summary_outcome(const coord *co, cJSON *root)
 {
-    cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "status", co->status);
     cJSON_AddNumberToObject(root, "exit_status", co->exit_status);
     cJSON_AddStringToObject(root, "message", co->message);
@@ -1152,6 +1153,11 @@ static void coord_write_summary(coord *co)
     cJSON_AddNumberToObject(root, "steps", (double)co->steps);
     cJSON_AddNumberToObject(root, "sim_time", co->sim_time);
     cJSON_AddNumberToObject(root, "t_end", co->c->t_end);
+}
+
+/* summary.json: where the wall time went */
+static void coord_summary_times(const coord *co, cJSON *root)
+{
     double wall = lahar_now() - co->wall0;
     cJSON_AddNumberToObject(root, "wall_time_s", wall);
     /* a resumed run: steps counts from t = 0, the rate only this invocation's */
@@ -1170,10 +1176,16 @@ static void coord_write_summary(coord *co)
         lahar_link_sched_gaps(co->link, &gap_max, &gap_sum);
     cJSON_AddNumberToObject(root, "coordinator_sched_gap_max_s", gap_max);
     cJSON_AddNumberToObject(root, "coordinator_sched_gap_sum_s", gap_sum);
+}
+
+/* summary.json "nodes": per node what it is, where it ran, what it last reported and how it
+ * answered (liveness); then "dem_substeps" */
+static void coord_summary_nodes(const coord *co, cJSON *root)
+{
     cJSON *nodes = cJSON_AddObjectToObject(root, "nodes");
     int64_t dem_substeps = 0;
     for (int r = 1; r < LAHAR_NROLES; r++) {
-        coord_node *n = &co->node[r];
+        const coord_node *n = &co->node[r];
         if (!n->needed)
             continue;
         cJSON *j = cJSON_AddObjectToObject(nodes, r == LAHAR_ROLE_DEM ? "dem" : "sph");
@@ -1200,8 +1212,13 @@ static void coord_write_summary(coord *co)
         cJSON_AddNumberToObject(j, "starved_max_s", n->starved_max_s);
     }
     cJSON_AddNumberToObject(root, "dem_substeps", (double)dem_substeps);
-    /* Traffic as seen by the coordinator: what it sent, and every frame of the run it heard
-     * (it listens on all channels, so node-to-node traffic is included). */
+}
+
+/* summary.json "channels" and "resent_frames": traffic as seen by the coordinator, what it sent
+ * and every frame of the run it heard (it listens on all channels, so node-to-node traffic is
+ * included) */
+static void coord_summary_channels(const coord *co, cJSON *root)
+{
     cJSON *ch = cJSON_AddObjectToObject(root, "channels");
     uint64_t resent = 0;
     if (co->link) {
@@ -1227,7 +1244,12 @@ static void coord_write_summary(coord *co)
         }
     }
     cJSON_AddNumberToObject(root, "resent_frames", (double)resent);
-    /* what the coordinator dropped plus what each node reported in its last STATUS */
+}
+
+/* summary.json "auth": what the coordinator dropped plus what each node reported in its last
+ * STATUS */
+static void coord_summary_auth(const coord *co, cJSON *root)
+{
     lahar_link_auth_stats as = {0};
     cJSON *auth = cJSON_AddObjectToObject(root, "auth");
     cJSON_AddBoolToObject(auth, "enabled", co->link && lahar_link_auth(co->link, &as));
@@ -1240,10 +1262,12 @@ static void coord_write_summary(coord *co)
     }
     cJSON_AddNumberToObject(auth, "frames_rejected", rejected);
     cJSON_AddNumberToObject(auth, "frames_replayed", replayed);
-    coord_summary_work(co, root);
-    coord_summary_flow(co, root);
-    coord_summary_machine(co, root);
-    coord_summary_instability(co, root);
+}
+
+/* summary.json "checkpoints" (a run with checkpoints, or resumed) and "resumed_from": where
+ * `lahar resume` would continue, and where this invocation continued from */
+static void coord_summary_checkpoints(const coord *co, cJSON *root)
+{
     if (co->ckpt_on || co->resumed) {
         cJSON *ck = cJSON_AddObjectToObject(root, "checkpoints");
         cJSON_AddNumberToObject(ck, "interval", co->c->checkpoint_interval);
@@ -1262,11 +1286,16 @@ static void coord_write_summary(coord *co)
         cJSON_AddNumberToObject(r, "time", co->resume_t);
         cJSON_AddStringToObject(r, "run_id", co->resume_run_id);
     }
+}
+
+/* OUT/summary.json written from root, into the room reserved at the start
+ * (coord_reserve_summary): written in place, then cut to its length, which needs no new space on
+ * a full disk. Failing that, stderr says why and how the run ended. */
+static void coord_summary_save(coord *co, const cJSON *root)
+{
     char *text = cJSON_Print(root);
     char path[PATH_MAX + 32];
     snprintf(path, sizeof path, "%s/summary.json", co->outdir);
-    /* into the room reserved at the start (coord_reserve_summary): written in place, then cut to
-     * its length, which needs no new space on a full disk */
     int fd = co->summary_fd >= 0 ? co->summary_fd : open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     int ok = 0;
     if (fd >= 0 && text) {
@@ -1282,6 +1311,23 @@ static void coord_write_summary(coord *co)
         fprintf(stderr, "lahar: cannot write %s: %s\n", path, strerror(errno));
     co->summary_fd = -1;
     free(text);
+}
+
+/* OUT/summary.json, section by section (their order here is the order of its keys) */
+static void coord_write_summary(coord *co)
+{
+    cJSON *root = cJSON_CreateObject();
+    coord_summary_outcome(co, root);
+    coord_summary_times(co, root);
+    coord_summary_nodes(co, root);
+    coord_summary_channels(co, root);
+    coord_summary_auth(co, root);
+    coord_summary_work(co, root);
+    coord_summary_flow(co, root);
+    coord_summary_machine(co, root);
+    coord_summary_instability(co, root);
+    coord_summary_checkpoints(co, root);
+    coord_summary_save(co, root);
     cJSON_Delete(root);
 }
 
