@@ -247,12 +247,44 @@ static int check_dem_engine(const lahar_case *cs)
     return 0;
 }
 
-int main(int argc, char **argv)
+/* What a step of main returns when the command goes on; any other value is its exit status. */
+#define GO_ON (-1)
+
+/* `lahar keys [SECTION | --yaml]` */
+static int keys_command(int argc, char **argv)
 {
-    if (argc < 2) {
-        usage(stderr);
+    if (argc > 3) {
+        fprintf(stderr, "usage: lahar keys [SECTION | --yaml]\n");
         return 2;
     }
+    if (argc == 3 && !strcmp(argv[2], "--yaml")) {
+        lahar_keys_print_yaml(stdout);
+        return 0;
+    }
+    return lahar_keys_print(stdout, argc == 3 ? argv[2] : NULL) == 0 ? 0 : 2;
+}
+
+/* `lahar keygen FILE` */
+static int keygen_command(int argc, char **argv)
+{
+    char err[512];
+    if (argc != 3 || argv[2][0] == '-') {
+        fprintf(stderr, "usage: lahar keygen FILE   (a new key for authenticated runs, mode 0600)\n");
+        return 2;
+    }
+    if (lahar_auth_keygen(argv[2], err, sizeof err) != 0) {
+        fprintf(stderr, "lahar keygen: %s\n", err);
+        return 2;
+    }
+    printf("lahar keygen: wrote a new key to %s; copy it (privately) to every host of the run and give it "
+           "to lahar, lahar-dem and lahar-sph with --auth-key %s\n", argv[2], argv[2]);
+    return 0;
+}
+
+/* The commands without a case or the run options (help, --version, bench, keys, keygen): their
+ * exit status, or GO_ON for any other command. */
+static int other_command(int argc, char **argv)
+{
     const char *cmd = argv[1];
     if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
         usage(stdout);
@@ -264,41 +296,46 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "bench"))
         return bench_exec(argc, argv);
-    if (!strcmp(cmd, "keys")) {
-        if (argc > 3) {
-            fprintf(stderr, "usage: lahar keys [SECTION | --yaml]\n");
-            return 2;
-        }
-        if (argc == 3 && !strcmp(argv[2], "--yaml")) {
-            lahar_keys_print_yaml(stdout);
-            return 0;
-        }
-        return lahar_keys_print(stdout, argc == 3 ? argv[2] : NULL) == 0 ? 0 : 2;
-    }
-    if (!strcmp(cmd, "keygen")) {
-        char err[512];
-        if (argc != 3 || argv[2][0] == '-') {
-            fprintf(stderr, "usage: lahar keygen FILE   (a new key for authenticated runs, mode 0600)\n");
-            return 2;
-        }
-        if (lahar_auth_keygen(argv[2], err, sizeof err) != 0) {
-            fprintf(stderr, "lahar keygen: %s\n", err);
-            return 2;
-        }
-        printf("lahar keygen: wrote a new key to %s; copy it (privately) to every host of the run and give it "
-               "to lahar, lahar-dem and lahar-sph with --auth-key %s\n", argv[2], argv[2]);
-        return 0;
-    }
-    int is_run = !strcmp(cmd, "run"), is_check = !strcmp(cmd, "check"), is_validate = !strcmp(cmd, "validate");
-    int is_resume = !strcmp(cmd, "resume");
-    if (!is_run && !is_check && !is_validate && !is_resume) {
+    if (!strcmp(cmd, "keys"))
+        return keys_command(argc, argv);
+    if (!strcmp(cmd, "keygen"))
+        return keygen_command(argc, argv);
+    return GO_ON;
+}
+
+/* run, check, validate or resume, and the options given that are not lahar_coord_options */
+typedef struct {
+    const char *cmd;
+    int is_check, is_validate, is_resume;
+    int evaluate_only, allow_large;
+} cli_command;
+
+/* Which of run, check, validate and resume cmd is; -1 (and the usage) for none of them. */
+static int identify_command(const char *cmd, cli_command *a)
+{
+    memset(a, 0, sizeof *a);
+    a->cmd = cmd;
+    int is_run = !strcmp(cmd, "run");
+    a->is_check = !strcmp(cmd, "check");
+    a->is_validate = !strcmp(cmd, "validate");
+    a->is_resume = !strcmp(cmd, "resume");
+    if (!is_run && !a->is_check && !a->is_validate && !a->is_resume) {
         fprintf(stderr, "lahar: unknown command '%s' (run, check, validate, resume, bench, keys, keygen)\n", cmd);
         usage(stderr);
-        return 2;
+        return -1;
     }
-    lahar_coord_options o = {0};
-    o.argv0 = argv[0];
-    o.progress_every_s = 60.0;
+    return 0;
+}
+
+/* The options after the command (getopt_long from argv[2]; optind is then at the first operand).
+ * A value out of range ends lahar with status 2 here, before a case is read. GO_ON, or the exit
+ * status (0 for --help). */
+static int parse_options(int argc, char **argv, cli_command *a, lahar_coord_options *o)
+{
+    const char *cmd = a->cmd;
+    memset(o, 0, sizeof *o);
+    o->argv0 = argv[0];
+    o->progress_every_s = 60.0;
     static const struct option opts[] = {
         {"output", required_argument, NULL, 'o'}, {"threads", required_argument, NULL, 't'},
         {"in-process", no_argument, NULL, 'i'},   {"no-spawn", no_argument, NULL, 'n'},
@@ -311,85 +348,142 @@ int main(int argc, char **argv)
         {NULL, 0, NULL, 0},
     };
     optind = 2;
-    int c, evaluate_only = 0, allow_large = 0;
+    int c;
     while ((c = getopt_long(argc, argv, "o:qh", opts, NULL)) != -1) {
         switch (c) {
-        case 'o': o.outdir = optarg; break;
+        case 'o': o->outdir = optarg; break;
         case 't':
-            if (parse_int_option(cmd, "--threads", optarg, 1, 1024, &o.threads) != 0)
+            if (parse_int_option(cmd, "--threads", optarg, 1, 1024, &o->threads) != 0)
                 return 2;
             break;
-        case 'i': o.in_process = 1; break;
-        case 'n': o.no_spawn = 1; break;
-        case 'u': o.lcm_url = optarg; break;
+        case 'i': o->in_process = 1; break;
+        case 'n': o->no_spawn = 1; break;
+        case 'u': o->lcm_url = optarg; break;
         case 'w':
-            if (parse_seconds_option(cmd, "--wait", optarg, 0.0, 86400.0, 0, &o.join_wait_s) != 0)
+            if (parse_seconds_option(cmd, "--wait", optarg, 0.0, 86400.0, 0, &o->join_wait_s) != 0)
                 return 2;
             break;
-        case 'q': o.quiet = 1; break;
+        case 'q': o->quiet = 1; break;
         case 'P': /* 0: no progress lines */
-            if (parse_seconds_option(cmd, "--progress-every", optarg, 0.0, 86400.0, 1, &o.progress_every_s) != 0)
+            if (parse_seconds_option(cmd, "--progress-every", optarg, 0.0, 86400.0, 1, &o->progress_every_s) != 0)
                 return 2;
             break;
-        case 'e': evaluate_only = 1; break;
-        case 'L': allow_large = 1; break;
-        case 'O': o.overwrite = 1; break;
-        case 'K': o.auth_key_path = optarg; break;
+        case 'e': a->evaluate_only = 1; break;
+        case 'L': a->allow_large = 1; break;
+        case 'O': o->overwrite = 1; break;
+        case 'K': o->auth_key_path = optarg; break;
         case 'E':
-            if (!is_resume) {
+            if (!a->is_resume) {
                 fprintf(stderr, "lahar %s: --time-end belongs to `lahar resume` (the case's time.end sets a run's end)\n",
                         cmd);
                 return 2;
             }
-            if (parse_seconds_option(cmd, "--time-end", optarg, 0.0, 1e12, 0, &o.resume_t_end) != 0)
+            if (parse_seconds_option(cmd, "--time-end", optarg, 0.0, 1e12, 0, &o->resume_t_end) != 0)
                 return 2;
             break;
         case 'T':
-            if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, 0, &o.node_timeout_s) != 0)
+            if (parse_seconds_option(cmd, "--node-timeout", optarg, 0.0, 3600.0, 0, &o->node_timeout_s) != 0)
                 return 2;
             break;
         case 'h': usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
     }
-    if (is_resume) {
-        /* lahar resume OUT: the case the run was started with, kept in OUT/checkpoints */
-        if (optind != argc - 1 || o.outdir) {
-            fprintf(stderr, "lahar resume: expected exactly one output directory (lahar resume OUT [options])\n");
-            return 2;
-        }
-        o.outdir = argv[optind];
-        o.resume = 1;
-        if (o.in_process && (o.no_spawn || o.lcm_url)) {
-            fprintf(stderr, "lahar resume: --in-process runs without network; it excludes --no-spawn and --lcm-url\n");
-            return 2;
-        }
-        lahar_case rc;
-        int st = lahar_coord_resume_case(o.outdir, &rc);
-        if (st != 0)
-            return st;
-        st = check_dem_engine(&rc) != 0 ? LAHAR_EXIT_BAD_INPUT : lahar_coord_run(&rc, &o);
-        lahar_case_free(&rc);
-        return st;
+    return GO_ON;
+}
+
+/* `lahar resume OUT`: the case the run was started with, kept in OUT/checkpoints, run on from the
+ * newest checkpoint. */
+static int resume_command(int argc, char **argv, lahar_coord_options *o)
+{
+    if (optind != argc - 1 || o->outdir) {
+        fprintf(stderr, "lahar resume: expected exactly one output directory (lahar resume OUT [options])\n");
+        return 2;
     }
+    o->outdir = argv[optind];
+    o->resume = 1;
+    if (o->in_process && (o->no_spawn || o->lcm_url)) {
+        fprintf(stderr, "lahar resume: --in-process runs without network; it excludes --no-spawn and --lcm-url\n");
+        return 2;
+    }
+    lahar_case rc;
+    int st = lahar_coord_resume_case(o->outdir, &rc);
+    if (st != 0)
+        return st;
+    st = check_dem_engine(&rc) != 0 ? LAHAR_EXIT_BAD_INPUT : lahar_coord_run(&rc, o);
+    lahar_case_free(&rc);
+    return st;
+}
+
+/* The operands and the options that go together, for run, check and validate: -1 (exit 2) after
+ * saying what is wrong. */
+static int check_case_arguments(const cli_command *a, int argc, const lahar_coord_options *o)
+{
+    const char *cmd = a->cmd;
     if (optind != argc - 1) {
         fprintf(stderr, "lahar %s: expected exactly one case file\n", cmd);
         usage(stderr);
-        return 2;
+        return -1;
     }
-    const char *case_path = argv[optind];
-    if (!is_validate && !o.outdir) {
+    if (!a->is_validate && !o->outdir) {
         fprintf(stderr, "lahar %s: missing -o OUT (output directory)\n", cmd);
-        return 2;
+        return -1;
     }
-    if (evaluate_only && !is_check) {
+    if (a->evaluate_only && !a->is_check) {
         fprintf(stderr, "lahar %s: --evaluate-only belongs to `lahar check`\n", cmd);
-        return 2;
+        return -1;
     }
-    if (o.in_process && (o.no_spawn || o.lcm_url)) {
+    if (o->in_process && (o->no_spawn || o->lcm_url)) {
         fprintf(stderr, "lahar %s: --in-process runs without network; it excludes --no-spawn and --lcm-url\n", cmd);
-        return 2;
+        return -1;
     }
+    return 0;
+}
+
+/* `lahar validate`: the case is valid (it was loaded); what it holds and will cost, on stdout. */
+static int validate_case(const char *case_path, const lahar_case *cs)
+{
+    lahar_estimate est;
+    lahar_estimate_case(cs, LAHAR_ESTIMATE_COUNT_MAX, &est);
+    printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs->dim, cs->nbody,
+           cs->nblock, cs->t_end);
+    print_estimate(cs, &est);
+    note_block_fill(stdout, cs);
+    return 0;
+}
+
+/* `lahar run` and `lahar check`: the run (not with --evaluate-only; refused when it would not fit
+ * in memory, unless --allow-large, and not judged for nodes on other hosts), then for `check` the
+ * evaluation of a finished run. */
+static int run_case(const cli_command *a, const char *case_path, const lahar_case *cs, const lahar_coord_options *o)
+{
+    int status = 0;
+    if (!a->evaluate_only) {
+        lahar_estimate est;
+        lahar_estimate_case(cs, LAHAR_ESTIMATE_COUNT_RUN, &est);
+        if (!o->no_spawn && !a->allow_large && check_memory(a->cmd, cs, &est) != 0)
+            return LAHAR_EXIT_BAD_INPUT;
+        note_block_fill(stderr, cs);
+        status = lahar_coord_run(cs, o);
+    }
+    if (a->is_check && status == 0) {
+        if (!cs->check.enabled) {
+            fprintf(stderr, "lahar check: %s has no check: section\n", case_path);
+            status = 2;
+        } else {
+            status = lahar_check_evaluate(cs, o->outdir);
+        }
+    }
+    return status;
+}
+
+/* run, check, validate: the case loaded and validated (bad input: exit 2 before anything runs),
+ * then the command. */
+static int case_command(const cli_command *a, int argc, char **argv, const lahar_coord_options *o)
+{
+    if (check_case_arguments(a, argc, o) != 0)
+        return 2;
+    const char *case_path = argv[optind];
     lahar_case cs;
     if (lahar_case_load(case_path, &cs) != 0)
         return LAHAR_EXIT_BAD_INPUT;
@@ -397,30 +491,26 @@ int main(int argc, char **argv)
         lahar_case_free(&cs);
         return LAHAR_EXIT_BAD_INPUT;
     }
-    int status = 0;
-    lahar_estimate est;
-    if (is_validate || !evaluate_only)
-        lahar_estimate_case(&cs, is_validate ? LAHAR_ESTIMATE_COUNT_MAX : LAHAR_ESTIMATE_COUNT_RUN, &est);
-    if (is_validate) {
-        printf("%s: valid (%dD, %d bodies, %d particle blocks, t_end = %g s)\n", case_path, cs.dim, cs.nbody, cs.nblock,
-               cs.t_end);
-        print_estimate(&cs, &est);
-        note_block_fill(stdout, &cs);
-    } else if (!evaluate_only && !o.no_spawn && !allow_large && check_memory(cmd, &cs, &est) != 0) {
-        status = LAHAR_EXIT_BAD_INPUT;
-    } else {
-        if (!evaluate_only)
-            note_block_fill(stderr, &cs);
-        status = evaluate_only ? 0 : lahar_coord_run(&cs, &o);
-        if (is_check && status == 0) {
-            if (!cs.check.enabled) {
-                fprintf(stderr, "lahar check: %s has no check: section\n", case_path);
-                status = 2;
-            } else {
-                status = lahar_check_evaluate(&cs, o.outdir);
-            }
-        }
-    }
+    const int status = a->is_validate ? validate_case(case_path, &cs) : run_case(a, case_path, &cs, o);
     lahar_case_free(&cs);
     return lahar_output_exit(status); /* HDF5's clean-up at exit would crash on a file that failed to close */
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    int status = other_command(argc, argv);
+    if (status != GO_ON)
+        return status;
+    cli_command a;
+    if (identify_command(argv[1], &a) != 0)
+        return 2;
+    lahar_coord_options o;
+    status = parse_options(argc, argv, &a, &o);
+    if (status != GO_ON)
+        return status;
+    return a.is_resume ? resume_command(argc, argv, &o) : case_command(&a, argc, argv, &o);
 }
