@@ -1755,11 +1755,15 @@ static int coord_load_auth_key(coord *co)
     char err[1024];
     const char *key_path = o->auth_key_path ? o->auth_key_path : getenv(LAHAR_AUTH_ENV);
     if (key_path && *key_path && !o->in_process) {
-        if (!realpath(key_path, co->auth_key_path) ||
-            lahar_auth_key_load(co->auth_key_path, co->auth_key, err, sizeof err) != 0) {
-            if (!co->auth_key_path[0] || errno == ENOENT)
-                snprintf(err, sizeof err, "auth key %s: %s (make one with `lahar keygen FILE`)", key_path,
-                         strerror(errno));
+        /* realpath may leave part of a path in its buffer when it fails: say why from errno */
+        if (!realpath(key_path, co->auth_key_path)) {
+            const int e = errno;
+            fprintf(stderr, "lahar: auth key %s: %s (%s)\n", key_path, strerror(e),
+                    e == ENOENT ? "make one with `lahar keygen FILE`" : "check the path and its permissions");
+            co->auth_key_path[0] = '\0';
+            return -1;
+        }
+        if (lahar_auth_key_load(co->auth_key_path, co->auth_key, err, sizeof err) != 0) {
             fprintf(stderr, "lahar: %s\n", err);
             return -1;
         }

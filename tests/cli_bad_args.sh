@@ -80,5 +80,9 @@ kill $holder 2>/dev/null; wait $holder 2>/dev/null
 expect 0 "" -- run "$good" -o "$work/busy" --in-process -q
 grep -q "^pid [0-9]" "$work/busy/.lahar.lock" && ! grep -q 4242 "$work/busy/.lahar.lock" ||
     { echo "FAIL the run did not write its own pid into the lock file"; fail=$((fail + 1)); }
+# a key that cannot be found or reached is named with the reason, before any node starts
+expect 2 "auth key $work/no.key: No such file or directory \(make one with \`lahar keygen FILE\`\)" -- \
+    run "$good" -o "$work/auth" --auth-key "$work/no.key"
+expect 2 "auth key $good/run.key: Not a directory \(check the path and its permissions\)" -- run "$good" -o "$work/auth" --auth-key "$good/run.key"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
