@@ -28,6 +28,7 @@
 #include "case.h"
 #include "case_keys.h"
 #include "checkpoint.h"
+#include "errmsg.h"
 #include "instability.h"
 #include "lahar_body_state_t.h"
 #include "lahar_loads_t.h"
@@ -979,135 +980,169 @@ static int sph_node_checkpoint(sph_node *s, int64_t state_step, double t, char *
     return 0;
 }
 
+/* One step of sph_node_loop as its phases see it: what they did, and the first failure. */
+typedef struct {
+    lahar_status_t st; /* the STATUS sent at the end of the step; st.error: the step failed */
+    char err[2048];    /* why, when st.error */
+    int begun;         /* sph_fluid_step_begin ran: the particles have drifted */
+    int stepped;       /* ... and sph_fluid_step_end: the state is t_{k+1} */
+    int unstable;      /* a stability check failed; u says which */
+    lahar_instability u;
+} sph_step;
+
+/* The first half of step k, which needs no body states: done before waiting for them, so the DEM
+ * node's advance and the BODY_STATE latency hide behind it. At k = 0 the rates at t_0 with K_n of
+ * the first step (eq. 15 depends on dt); without bodies the rates of the set-up do not depend on
+ * dt and stand. Then the loads to the DEM node (or the forces on fixed bodies), the inflow and the
+ * drift. */
+static void sph_step_first_half(sph_node *s, int64_t k, const lahar_step_t *step, int has_dem, sph_step *w)
+{
+    if (k == 0 && s->f.has_bodies) {
+        int64_t cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step->dt);
+        sph_node_count_coupling(s);
+        if (cross < 0) {
+            w->st.error = 1;
+            lahar_errf(w->err, sizeof w->err, "out of memory in the SPH rates");
+        } else if (cross > 0) {
+            w->st.error = 1;
+            sph_node_crossing_message(s, -1, 0.0, w->err, sizeof w->err);
+        }
+    }
+    if (has_dem && sph_node_send_loads(s, k) != 0 && !w->st.error) {
+        w->st.error = 1;
+        lahar_errf(w->err, sizeof w->err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
+    } else if (s->fixed_only && !w->st.error && sph_node_fixed_forces(s, k, step, w->err, sizeof w->err) != 0) {
+        w->st.error = 1;
+    }
+    if (!w->st.error && s->has_flow &&
+        sph_inflow_apply(&s->flow, &s->f, step->t, step->dt, w->err, (int)sizeof w->err) == INT64_MIN)
+        w->st.error = 1;
+    if (w->st.error)
+        return;
+    if (sph_fluid_step_begin(&s->f, step->dt) != 0) {
+        w->st.error = 1;
+        lahar_errf(w->err, sizeof w->err, "out of memory in the SPH step");
+    } else {
+        w->begun = 1;
+    }
+}
+
+/* The moving bodies at t_{k+1}, after the DEM node's advance with LOADS(k). Returns -1 to go on
+ * (w->st.error set if the message was bad), else the node's exit status: 0 when the coordinator
+ * stopped the run, 3 when the link was lost. */
+static int sph_step_wait_bodies(sph_node *s, int64_t k, const lahar_step_t *step, sph_step *w)
+{
+    lahar_link_msg msg;
+    int rc = lahar_link_wait(s->link, LAHAR_ROLE_DEM, LAHAR_FRAME_T_MSG_BODY_STATE, k, -1, &msg);
+    if (rc == LAHAR_LINK_STOP) {
+        if (w->begun)
+            sph_node_stopped_half_step(s, &msg, k, step);
+        return 0;
+    }
+    if (rc == LAHAR_LINK_LOST)
+        return 3;
+    if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {
+        if (!w->st.error)
+            snprintf(w->err, sizeof w->err, "undecodable BODY_STATE(%lld)", (long long)k);
+        w->st.error = 1;
+    } else {
+        sph_node_take_states(s);
+    }
+    return -1;
+}
+
+/* The second half: the kick with the body states, then the checks of the new state (a body
+ * crossed, the stability checks) and the probes at t_{k+1}. A failed BODY_STATE after step_begin
+ * leaves the particles drifted but not kicked: that state is neither t_k nor t_{k+1}, so the step
+ * is not taken (stepped stays 0) and no snapshot is written for it (sph_step_output). */
+static void sph_step_second_half(sph_node *s, int64_t k, const lahar_step_t *step, int has_dem, sph_step *w)
+{
+    w->stepped = w->begun && !w->st.error;
+    if (!w->stepped)
+        return;
+    int64_t cross = sph_fluid_step_end(&s->f, step->dt, has_dem ? s->states : NULL);
+    sph_node_count_coupling(s);
+    if (cross < 0) {
+        w->st.error = 1;
+        lahar_errf(w->err, sizeof w->err, "out of memory in the SPH step");
+    } else if (cross > 0) {
+        sph_node_crossing_report(s, k, step->t_next, &w->u);
+        w->unstable = 1;
+    } else {
+        w->unstable = sph_node_check_particles(s, k, step->t_next, &w->u) > 0;
+    }
+    if (w->unstable) {
+        w->st.error = 1;
+        lahar_instability_encode(&w->u, w->err, sizeof w->err);
+    } else if (!w->st.error && sph_node_probes_sample(s, k, step->t_next) != 0) {
+        w->st.error = 1;
+        lahar_errf(w->err, sizeof w->err, "cannot write gauges.h5 in %s", s->ns.output_dir);
+        lahar_output_explain(w->err, sizeof w->err);
+    }
+}
+
+/* What the step leaves: the snapshot, the STATUS figures and the checkpoint. On an error the state
+ * reached is kept as the last snapshot to look at: after the step, or at t_k when the step was not
+ * taken (unless a snapshot of t_k exists). */
+static void sph_step_output(sph_node *s, int64_t k, const lahar_step_t *step, sph_step *w)
+{
+    if (w->stepped && (step->write_output || w->st.error) && sph_node_snapshot(s, k + 1, step->t_next) != 0 &&
+        !w->st.error) {
+        w->st.error = 1;
+        lahar_errf(w->err, sizeof w->err, "cannot write a snapshot in %s", s->ns.output_dir);
+        lahar_output_explain(w->err, sizeof w->err);
+    } else if (!w->stepped && !w->begun && s->last_snapshot != k) {
+        sph_node_snapshot(s, k, step->t);
+    }
+    if (w->unstable && s->last_snapshot == k + 1)
+        sph_node_mark_last(s, "instability", w->u.text);
+    w->st.dt_proposed = sph_fluid_dt(&s->f);
+    w->st.dt_stable = w->st.dt_proposed;
+    w->st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
+    /* the kinetic energy is a summary figure (the coordinator keeps the last one): computed at the
+     * output times (the last step is one) and on an error, not every step */
+    if (step->write_output || w->st.error)
+        s->kinetic_energy = sph_node_kinetic_energy(&s->f.p);
+    w->st.kinetic_energy = s->kinetic_energy;
+    sph_node_work(s, &w->st);
+    if (step->checkpoint && !w->st.error) {
+        if (sph_node_checkpoint(s, k + 1, step->t_next, w->err, sizeof w->err) == 0)
+            w->st.checkpointed = 1;
+        else
+            w->st.error = 1;
+    }
+}
+
+/* The steps from k0 (the state at t0) until the coordinator stops the run: the node's exit status. */
 static int sph_node_loop(sph_node *s, int64_t k0, double t0)
 {
-    char err[2048];
-    lahar_link_msg msg;
     const int has_dem = s->ns.has_dem && s->nbody > 0;
     double t_now = t0; /* time of the state: the end of the last step taken */
     for (int64_t k = k0;; k++) {
         double wait0 = lahar_link_wait_seconds(s->link);
+        lahar_link_msg msg;
         lahar_step_t step;
         int rc = lahar_node_wait_step(s->link, "lahar-sph", k, &msg, &step);
         if (rc == 0)
             sph_node_final_snapshot(s, &msg, k, t_now);
         if (rc >= 0)
             return rc;
-        lahar_status_t st = {0};
-        err[0] = '\0';
-        double compute = 0.0, c0 = lahar_now();
-        int64_t cross = 0;
-        if (k == 0 && s->f.has_bodies) {
-            /* the rates at t_0 with K_n of the first step (eq. 15 depends on dt); without bodies
-             * the rates of the set-up do not depend on dt and stand */
-            cross = sph_fluid_rates(&s->f, has_dem ? s->states : NULL, step.dt);
-            sph_node_count_coupling(s);
-            if (cross < 0) {
-                st.error = 1;
-                snprintf(err, sizeof err, "out of memory in the SPH rates");
-            } else if (cross > 0) {
-                st.error = 1;
-                sph_node_crossing_message(s, -1, 0.0, err, sizeof err);
-            }
-        }
-        if (has_dem && sph_node_send_loads(s, k) != 0 && !st.error) {
-            st.error = 1;
-            snprintf(err, sizeof err, "cannot send LOADS(%lld) (out of memory)", (long long)k);
-        } else if (s->fixed_only && !st.error && sph_node_fixed_forces(s, k, &step, err, sizeof err) != 0) {
-            st.error = 1;
-        }
-        /* the particle work of step k needs no body states: do it before waiting for them, so
-         * the DEM node's advance and the BODY_STATE latency hide behind it */
-        int begun = 0;
-        if (!st.error && s->has_flow &&
-            sph_inflow_apply(&s->flow, &s->f, step.t, step.dt, err, (int)sizeof err) == INT64_MIN)
-            st.error = 1;
-        if (!st.error) {
-            if (sph_fluid_step_begin(&s->f, step.dt) != 0) {
-                st.error = 1;
-                snprintf(err, sizeof err, "out of memory in the SPH step");
-            } else {
-                begun = 1;
-            }
-        }
-        compute += lahar_now() - c0;
-        if (has_dem && s->nmoving > 0) {
-            /* the moving bodies at t_{k+1}, after the DEM node's advance with LOADS(k) */
-            rc = lahar_link_wait(s->link, LAHAR_ROLE_DEM, LAHAR_FRAME_T_MSG_BODY_STATE, k, -1, &msg);
-            if (rc == LAHAR_LINK_STOP) {
-                if (begun)
-                    sph_node_stopped_half_step(s, &msg, k, &step);
-                return 0;
-            }
-            if (rc == LAHAR_LINK_LOST)
-                return 3;
-            if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {
-                if (!st.error)
-                    snprintf(err, sizeof err, "undecodable BODY_STATE(%lld)", (long long)k);
-                st.error = 1;
-            } else {
-                sph_node_take_states(s);
-            }
-        }
+        sph_step w = {.st = {0}};
+        double c0 = lahar_now();
+        sph_step_first_half(s, k, &step, has_dem, &w);
+        double compute = lahar_now() - c0;
+        if (has_dem && s->nmoving > 0 && (rc = sph_step_wait_bodies(s, k, &step, &w)) >= 0)
+            return rc;
         c0 = lahar_now();
-        /* a failed BODY_STATE after step_begin leaves the particles drifted but not kicked: that
-         * state is neither t_k nor t_{k+1}, so no snapshot is written for it (see below) */
-        int stepped = begun && !st.error, unstable = 0;
-        lahar_instability u;
-        if (stepped) {
-            cross = sph_fluid_step_end(&s->f, step.dt, has_dem ? s->states : NULL);
-            sph_node_count_coupling(s);
-            if (cross < 0) {
-                st.error = 1;
-                snprintf(err, sizeof err, "out of memory in the SPH step");
-            } else if (cross > 0) {
-                sph_node_crossing_report(s, k, step.t_next, &u);
-                unstable = 1;
-            } else {
-                unstable = sph_node_check_particles(s, k, step.t_next, &u) > 0;
-            }
-            if (unstable) {
-                st.error = 1;
-                lahar_instability_encode(&u, err, sizeof err);
-            } else if (!st.error && sph_node_probes_sample(s, k, step.t_next) != 0) {
-                st.error = 1;
-                snprintf(err, sizeof err, "cannot write gauges.h5 in %s", s->ns.output_dir);
-                lahar_output_explain(err, sizeof err);
-            }
-        }
-        /* on an error the state reached is kept as the last snapshot to look at: after the step,
-         * or at t_k when the step was not taken (unless a snapshot of t_k exists) */
-        if (stepped && (step.write_output || st.error) && sph_node_snapshot(s, k + 1, step.t_next) != 0 && !st.error) {
-            st.error = 1;
-            snprintf(err, sizeof err, "cannot write a snapshot in %s", s->ns.output_dir);
-            lahar_output_explain(err, sizeof err);
-        } else if (!stepped && !begun && s->last_snapshot != k) {
-            sph_node_snapshot(s, k, step.t);
-        }
-        if (unstable && s->last_snapshot == k + 1)
-            sph_node_mark_last(s, "instability", u.text);
-        st.dt_proposed = sph_fluid_dt(&s->f);
-        st.dt_stable = st.dt_proposed;
-        st.ncontacts = s->f.has_bodies ? (int32_t)s->f.cpl.ncontacts : 0;
-        /* the kinetic energy is a summary figure (the coordinator keeps the last one): computed
-         * at the output times (the last step is one) and on an error, not every step */
-        if (step.write_output || st.error)
-            s->kinetic_energy = sph_node_kinetic_energy(&s->f.p);
-        st.kinetic_energy = s->kinetic_energy;
-        sph_node_work(s, &st);
-        if (step.checkpoint && !st.error) {
-            if (sph_node_checkpoint(s, k + 1, step.t_next, err, sizeof err) == 0)
-                st.checkpointed = 1;
-            else
-                st.error = 1;
-        }
+        sph_step_second_half(s, k, &step, has_dem, &w);
+        sph_step_output(s, k, &step, &w);
         compute += lahar_now() - c0;
-        st.compute_s = compute;
-        st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
-        lahar_node_send_status(s->link, ROLE, k, &st, err);
-        if (st.error) {
-            fprintf(stderr, "lahar-sph: step %lld: %s%s\n", (long long)k, unstable ? "unstable: " : "",
-                    unstable ? u.text : err);
+        w.st.compute_s = compute;
+        w.st.wait_s = lahar_link_wait_seconds(s->link) - wait0;
+        lahar_node_send_status(s->link, ROLE, k, &w.st, w.err);
+        if (w.st.error) {
+            fprintf(stderr, "lahar-sph: step %lld: %s%s\n", (long long)k, w.unstable ? "unstable: " : "",
+                    w.unstable ? w.u.text : w.err);
             sph_node_wait_stop(s);
             return 1;
         }
