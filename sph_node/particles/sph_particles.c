@@ -236,14 +236,12 @@ static void sorted_doubles(sph_particles *p, double **a[SPH_NSORTED])
     memcpy(a, list, sizeof list);
 }
 
-int sph_cells_sort(sph_cells *c, sph_particles *p)
+/* The grid over the particles: periodic axes keep their period and take the particles that left it
+ * back in; the others span the particles' extent in cells of at least min_size. */
+static void cells_fit_grid(sph_cells *c, sph_particles *p, int par)
 {
-    int64_t n = p->n;
-    if (n > c->pcap)
-        return -1;
-    const int par = n >= SPH_OMP_MIN_LIGHT;
+    const int64_t n = p->n;
     double *pos[3] = {p->x, p->y, p->z};
-    /* grid: periodic axes wrap, the others follow the particles */
     for (int a = 0; a < 3; a++) {
         if (a == 2 && c->dim == 2) {
             c->nc[2] = 1;
@@ -290,22 +288,34 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
                 c->size[a] = fmax(c->min_size, (c->hi[a] - c->lo[a]) / c->nc[a] * (1.0 + 1e-12));
             }
     }
-    int64_t ncell = (int64_t)c->nc[0] * c->nc[1] * c->nc[2];
-    if (ncell > c->ncell_cap) {
-        int64_t cap = c->ncell_cap;
-        while (cap < ncell)
-            cap *= 2;
-        int64_t *s = realloc(c->start, (size_t)(cap + 1) * sizeof *s);
-        if (!s)
-            return -1;
-        c->start = s;
-        int64_t *cnt = realloc(c->count, (size_t)cap * sizeof *cnt);
-        if (!cnt)
-            return -1;
-        c->count = cnt;
-        c->ncell_cap = cap;
-    }
-    c->ncell = ncell;
+}
+
+/* Room for ncell cells in the start and count tables (doubling: rare, never in a steady run). */
+static int cells_reserve(sph_cells *c, int64_t ncell)
+{
+    if (ncell <= c->ncell_cap)
+        return 0;
+    int64_t cap = c->ncell_cap;
+    while (cap < ncell)
+        cap *= 2;
+    int64_t *s = realloc(c->start, (size_t)(cap + 1) * sizeof *s);
+    if (!s)
+        return -1;
+    c->start = s;
+    int64_t *cnt = realloc(c->count, (size_t)cap * sizeof *cnt);
+    if (!cnt)
+        return -1;
+    c->count = cnt;
+    c->ncell_cap = cap;
+    return 0;
+}
+
+/* Each particle's cell, then a counting sort: the cells' start offsets and the permutation that
+ * orders the particles by cell (serial: a few operations per particle; stable, so the order within
+ * a cell and hence every sum over neighbours is the same for any number of threads). */
+static void cells_count_sort(sph_cells *c, const sph_particles *p, int par)
+{
+    const int64_t n = p->n, ncell = c->ncell;
     const int d3 = c->dim == 3;
 #pragma omp parallel for schedule(static) if (par)
     for (int64_t i = 0; i < n; i++) {
@@ -313,7 +323,6 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
         int iz = d3 ? sph_cells_coord(c, 2, p->z[i]) : 0;
         c->cell_of[i] = ((int64_t)iz * c->nc[1] + iy) * c->nc[0] + ix;
     }
-    /* counting sort (serial: a few operations per particle) */
     memset(c->count, 0, (size_t)ncell * sizeof *c->count);
     for (int64_t i = 0; i < n; i++)
         c->count[c->cell_of[i]]++;
@@ -324,7 +333,13 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
     }
     for (int64_t i = 0; i < n; i++)
         c->perm[c->count[c->cell_of[i]]++] = i;
-    /* permute the particle arrays (gathers, one parallel region) and cell_of into the new order */
+}
+
+/* Every particle array into the order perm (gathers, one parallel region): each array is gathered
+ * into its scratch array, which then takes its place. */
+static void particles_permute(sph_particles *p, const int64_t *perm, int par)
+{
+    const int64_t n = p->n;
     double **a[SPH_NSORTED + 2 * SPH_NSTRESS + 3];
     sorted_doubles(p, a);
     int na = SPH_NSORTED;
@@ -333,9 +348,6 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
             a[na++] = &p->sig[k], a[na++] = &p->sigh[k];
     if (p->tvx) /* transport velocity offset */
         a[na++] = &p->tvx, a[na++] = &p->tvy, a[na++] = &p->tvz;
-    const int64_t *perm = c->perm;
-    int64_t *cell_of = c->cell_of;
-    /* each array is gathered into the scratch array, which then takes its place */
 #pragma omp parallel if (par)
     {
         for (int k = 0; k < na; k++) {
@@ -372,7 +384,23 @@ int sph_cells_sort(sph_cells *c, sph_particles *p)
         p->inlet = p->scratch_p;
         p->scratch_p = tp;
     }
+}
+
+int sph_cells_sort(sph_cells *c, sph_particles *p)
+{
+    const int64_t n = p->n;
+    if (n > c->pcap)
+        return -1;
+    const int par = n >= SPH_OMP_MIN_LIGHT;
+    cells_fit_grid(c, p, par);
+    const int64_t ncell = (int64_t)c->nc[0] * c->nc[1] * c->nc[2];
+    if (cells_reserve(c, ncell) != 0)
+        return -1;
+    c->ncell = ncell;
+    cells_count_sort(c, p, par);
+    particles_permute(p, c->perm, par);
     /* cell_of in the new order */
+    int64_t *cell_of = c->cell_of;
 #pragma omp parallel for schedule(static) if (par)
     for (int64_t k = 0; k < ncell; k++)
         for (int64_t i = c->start[k]; i < c->start[k + 1]; i++)
