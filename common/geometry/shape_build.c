@@ -820,6 +820,201 @@ static void wedge_dirs(double th, double *c1, double *s1, double *cc, double *ss
     *cs = 0.5 * sin(th) * sin(th);
 }
 
+/* Per edge and per vertex of a 3D core, what its wedge and sector need (moments_3d): the edge's
+ * dihedral opening theta and the unit vectors u, w spanning it, the faces on each side; the
+ * vertex's solid angle omega and first moment mv of its normal cone; the face normals. */
+typedef struct {
+    double *theta;
+    vec3 *eu, *ew;
+    int *ef1, *ef2; /* the faces at each edge: f1 walks it i -> j, f2 walks j -> i */
+    double *omega;
+    vec3 *mv, *fn;
+} sweep_parts;
+
+static void sweep_parts_free(sweep_parts *sp)
+{
+    free(sp->theta);
+    free(sp->eu);
+    free(sp->ew);
+    free(sp->ef1);
+    free(sp->ef2);
+    free(sp->omega);
+    free(sp->mv);
+    free(sp->fn);
+}
+
+static int sweep_parts_alloc(sweep_parts *sp, int ne, int nv, int nf)
+{
+    sp->theta = calloc((size_t)ne, sizeof *sp->theta);
+    sp->eu = calloc((size_t)ne, sizeof *sp->eu);
+    sp->ew = calloc((size_t)ne, sizeof *sp->ew);
+    sp->ef1 = calloc((size_t)ne, sizeof *sp->ef1);
+    sp->ef2 = calloc((size_t)ne, sizeof *sp->ef2);
+    sp->omega = calloc((size_t)nv, sizeof *sp->omega);
+    sp->mv = calloc((size_t)nv, sizeof *sp->mv);
+    sp->fn = calloc((size_t)(nf ? nf : 1), sizeof *sp->fn);
+    return sp->theta && sp->eu && sp->ew && sp->ef1 && sp->ef2 && sp->omega && sp->mv && sp->fn ? 0 : -1;
+}
+
+/* A capsule (segment core): the edge wedge is a full cylinder, the vertex cones hemispheres. */
+static void capsule_parts(const lahar_shape *s, sweep_parts *sp)
+{
+    vec3 a = shape_vertex(s, 0), b = shape_vertex(s, 1), t = v3_normalize(v3_sub(b, a));
+    vec3 ref = fabs(t.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
+    sp->eu[0] = v3_normalize(v3_cross(t, ref));
+    sp->ew[0] = v3_cross(t, sp->eu[0]);
+    sp->theta[0] = 2.0 * M_PI;
+    sp->omega[0] = sp->omega[1] = 2.0 * M_PI;
+    sp->mv[0] = v3_scale(t, -M_PI); /* half of theta times the unit vector away from the edge */
+    sp->mv[1] = v3_scale(t, M_PI);
+}
+
+/* The core polyhedron (tetrahedra from the vertex centroid to each fan triangle) and the face
+ * prisms (each triangle extruded by R along its face's normal); the face normals into sp->fn. */
+static void add_core_and_face_prisms(const lahar_shape *s, sweep_parts *sp, moments *m)
+{
+    const double R = s->radius;
+    vec3 o = v3(0, 0, 0);
+    for (int i = 0; i < s->nv; i++)
+        o = v3_add(o, shape_vertex(s, i));
+    o = v3_scale(o, 1.0 / s->nv);
+    for (int f = 0; f < s->nf; f++) {
+        int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
+        sp->fn[f] = v3_normalize(face_newell(s, f));
+        vec3 p0 = shape_vertex(s, s->face_v[a0]);
+        for (int k = 1; k + 1 < cnt; k++) {
+            vec3 p1 = shape_vertex(s, s->face_v[a0 + k]), p2 = shape_vertex(s, s->face_v[a0 + k + 1]);
+            vec3 tet[4] = {o, p0, p1, p2};
+            double V = v3_dot(v3_sub(p0, o), v3_cross(v3_sub(p1, o), v3_sub(p2, o))) / 6.0;
+            m->vol += V;
+            for (int c = 0; c < 3; c++)
+                m->m1[c] += V * 0.25 * (v3_get(o, c) + v3_get(p0, c) + v3_get(p1, c) + v3_get(p2, c));
+            mom_add_simplex_m2(m, V, tet, 4, 1.0);
+            /* face prism: triangle T extruded by R along the normal n:
+             * int x = R int_T y + A R^2/2 n, int x x^T = R int_T y y^T
+             *   + R^2/2 (int_T y n^T + n int_T y^T) + A R^3/3 n n^T */
+            vec3 tri[3] = {p0, p1, p2}, n = sp->fn[f];
+            double A = 0.5 * v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+            vec3 cy = v3_scale(v3_add(v3_add(p0, p1), p2), A / 3.0); /* int_T y */
+            m->vol += A * R;
+            for (int c = 0; c < 3; c++)
+                m->m1[c] += R * v3_get(cy, c) + A * R * R * 0.5 * v3_get(n, c);
+            mom_add_simplex_m2(m, A, tri, 3, R);
+            mom_add_outer(m, 0.5 * R * R, cy, n);
+            mom_add_outer(m, 0.5 * R * R, n, cy);
+            mom_add_outer(m, A * R * R * R / 3.0, n, n);
+        }
+    }
+}
+
+/* The two faces at each edge (one walking it each way); -1 when the polyhedron is open (an edge
+ * with fewer or more faces, or walked twice the same way). */
+static int find_edge_faces(const lahar_shape *s, sweep_parts *sp)
+{
+    for (int k = 0; k < s->ne; k++)
+        sp->ef1[k] = sp->ef2[k] = -1;
+    for (int f = 0; f < s->nf; f++) {
+        int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
+        for (int k = 0; k < cnt; k++) {
+            int key[2] = {s->face_v[a0 + k], s->face_v[a0 + (k + 1) % cnt]};
+            int sorted[2] = {key[0] < key[1] ? key[0] : key[1], key[0] < key[1] ? key[1] : key[0]};
+            int *hit = bsearch(sorted, s->e, (size_t)s->ne, sizeof *s->e, edge_cmp);
+            if (!hit)
+                return -1;
+            int ei = (int)((int(*)[2])hit - s->e);
+            int *slot = key[0] == s->e[ei][0] ? &sp->ef1[ei] : &sp->ef2[ei];
+            if (*slot >= 0)
+                return -1;
+            *slot = f;
+        }
+    }
+    for (int k = 0; k < s->ne; k++)
+        if (sp->ef1[k] < 0 || sp->ef2[k] < 0)
+            return -1;
+    return 0;
+}
+
+/* Each edge's opening between its faces' normals, each vertex's normal-cone first moment
+ * (1/2 sum over its edges of theta (v - w)/|v - w|) and solid angle (the angle defect 2 pi - sum of
+ * the face corner angles). */
+static void edge_and_vertex_angles(const lahar_shape *s, sweep_parts *sp)
+{
+    for (int k = 0; k < s->ne; k++) {
+        vec3 n1 = sp->fn[sp->ef1[k]], n2 = sp->fn[sp->ef2[k]];
+        sp->theta[k] = atan2(v3_norm(v3_cross(n1, n2)), v3_dot(n1, n2));
+        sp->eu[k] = n1;
+        vec3 w = v3_sub(n2, v3_scale(n1, v3_dot(n1, n2)));
+        sp->ew[k] = v3_norm(w) > 1e-300 ? v3_normalize(w) : v3(0, 0, 0);
+        vec3 a = shape_vertex(s, s->e[k][0]), b = shape_vertex(s, s->e[k][1]);
+        vec3 t = v3_normalize(v3_sub(a, b));
+        sp->mv[s->e[k][0]] = v3_add(sp->mv[s->e[k][0]], v3_scale(t, 0.5 * sp->theta[k]));
+        sp->mv[s->e[k][1]] = v3_sub(sp->mv[s->e[k][1]], v3_scale(t, 0.5 * sp->theta[k]));
+    }
+    for (int i = 0; i < s->nv; i++)
+        sp->omega[i] = 2.0 * M_PI;
+    for (int f = 0; f < s->nf; f++) {
+        int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
+        for (int k = 0; k < cnt; k++) {
+            int i = s->face_v[a0 + k];
+            vec3 p = shape_vertex(s, i), prev = shape_vertex(s, s->face_v[a0 + (k + cnt - 1) % cnt]),
+                 next = shape_vertex(s, s->face_v[a0 + (k + 1) % cnt]);
+            vec3 d1 = v3_sub(prev, p), d2 = v3_sub(next, p);
+            sp->omega[i] -= atan2(v3_norm(v3_cross(d1, d2)), v3_dot(d1, d2));
+        }
+    }
+}
+
+/* The edge wedges: x = a + s t + r (cos phi u + sin phi w), s in [0, L], r in [0, R],
+ * phi in [0, theta]. */
+static void add_edge_wedges(const lahar_shape *s, int ne, const sweep_parts *sp, moments *m)
+{
+    const double R = s->radius;
+    for (int k = 0; k < ne; k++) {
+        vec3 a = shape_vertex(s, s->e[k][0]), b = shape_vertex(s, s->e[k][1]);
+        double Lk = v3_norm(v3_sub(b, a));
+        vec3 t = v3_scale(v3_sub(b, a), 1.0 / Lk);
+        double c1, s1, cc, ss, cs;
+        wedge_dirs(sp->theta[k], &c1, &s1, &cc, &ss, &cs);
+        double V = 0.5 * sp->theta[k] * R * R * Lk;
+        vec3 D1 = v3_add(v3_scale(sp->eu[k], c1), v3_scale(sp->ew[k], s1)); /* int d dphi */
+        vec3 ic = v3_add(v3_scale(a, Lk), v3_scale(t, 0.5 * Lk * Lk)); /* int_0^L c(s) ds */
+        m->vol += V;
+        for (int c = 0; c < 3; c++)
+            m->m1[c] += 0.5 * sp->theta[k] * R * R * v3_get(ic, c) + Lk * R * R * R / 3.0 * v3_get(D1, c);
+        /* int c c^T ds = L a a^T + L^2/2 (a t^T + t a^T) + L^3/3 t t^T, times theta R^2/2 */
+        double wr = 0.5 * sp->theta[k] * R * R;
+        mom_add_outer(m, wr * Lk, a, a);
+        mom_add_outer(m, wr * 0.5 * Lk * Lk, a, t);
+        mom_add_outer(m, wr * 0.5 * Lk * Lk, t, a);
+        mom_add_outer(m, wr * Lk * Lk * Lk / 3.0, t, t);
+        mom_add_outer(m, R * R * R / 3.0, ic, D1);
+        mom_add_outer(m, R * R * R / 3.0, D1, ic);
+        double w4 = Lk * pow(R, 4) / 4.0;
+        mom_add_outer(m, w4 * cc, sp->eu[k], sp->eu[k]);
+        mom_add_outer(m, w4 * ss, sp->ew[k], sp->ew[k]);
+        mom_add_outer(m, w4 * cs, sp->eu[k], sp->ew[k]);
+        mom_add_outer(m, w4 * cs, sp->ew[k], sp->eu[k]);
+    }
+}
+
+/* The vertex sectors: x = v + r u over the normal cone (solid angle omega, int u = mv). */
+static void add_vertex_sectors(const lahar_shape *s, const sweep_parts *sp, moments *m)
+{
+    const double R = s->radius;
+    for (int i = 0; i < s->nv; i++) {
+        vec3 p = shape_vertex(s, i);
+        double V = sp->omega[i] * R * R * R / 3.0, w = pow(R, 4) / 4.0;
+        m->vol += V;
+        for (int c = 0; c < 3; c++)
+            m->m1[c] += V * v3_get(p, c) + w * v3_get(sp->mv[i], c);
+        mom_add_outer(m, V, p, p);
+        mom_add_outer(m, w, p, sp->mv[i]);
+        mom_add_outer(m, w, sp->mv[i], p);
+    }
+}
+
+/* Volume, first and second moments of a 3D sphero-polyhedron: the core, the face prisms, the edge
+ * wedges and the vertex sectors (a sphere, a capsule or a closed polyhedron swept by R). */
 static int moments_3d(const lahar_shape *s, moments *m, char *err, size_t errlen)
 {
     const double R = s->radius;
@@ -836,171 +1031,32 @@ static int moments_3d(const lahar_shape *s, moments *m, char *err, size_t errlen
         mom_add_outer(m, V, c, c);
         return 0;
     }
-    int ne = s->ne;
-    double *theta = NULL;
-    vec3 *eu = NULL, *ew = NULL;
-    int rc = -1;
-    if (s->nf == 0 && s->nv == 2) {
-        ne = 1;
-    } else if (s->nf < 4) {
+    const int capsule = s->nf == 0 && s->nv == 2;
+    if (!capsule && s->nf < 4) {
         lahar_errf(err, errlen, "mass properties need a closed core (sphere, segment or polyhedron)");
         return -1;
     }
-    theta = calloc((size_t)ne, sizeof *theta);
-    eu = calloc((size_t)ne, sizeof *eu);
-    ew = calloc((size_t)ne, sizeof *ew);
-    int *ef1 = calloc((size_t)ne, sizeof *ef1), *ef2 = calloc((size_t)ne, sizeof *ef2);
-    double *omega = calloc((size_t)s->nv, sizeof *omega);
-    vec3 *mv = calloc((size_t)s->nv, sizeof *mv);
-    vec3 *fn = calloc((size_t)(s->nf ? s->nf : 1), sizeof *fn);
-    if (!theta || !eu || !ew || !ef1 || !ef2 || !omega || !mv || !fn)
-        goto done;
-
-    if (s->nf == 0) { /* capsule: the edge wedge is a full cylinder, the vertex cones hemispheres */
-        vec3 a = shape_vertex(s, 0), b = shape_vertex(s, 1), t = v3_normalize(v3_sub(b, a));
-        vec3 ref = fabs(t.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
-        eu[0] = v3_normalize(v3_cross(t, ref));
-        ew[0] = v3_cross(t, eu[0]);
-        theta[0] = 2.0 * M_PI;
-        omega[0] = omega[1] = 2.0 * M_PI;
-        mv[0] = v3_scale(t, -M_PI); /* half of theta times the unit vector away from the edge */
-        mv[1] = v3_scale(t, M_PI);
+    const int ne = capsule ? 1 : s->ne;
+    sweep_parts sp;
+    int rc = sweep_parts_alloc(&sp, ne, s->nv, s->nf);
+    if (rc != 0) {
+        lahar_errf(err, errlen, "out of memory computing the mass properties");
+    } else if (capsule) {
+        capsule_parts(s, &sp);
     } else {
-        /* core polyhedron: tetrahedra from the vertex centroid to each fan triangle */
-        vec3 o = v3(0, 0, 0);
-        for (int i = 0; i < s->nv; i++)
-            o = v3_add(o, shape_vertex(s, i));
-        o = v3_scale(o, 1.0 / s->nv);
-        for (int f = 0; f < s->nf; f++) {
-            int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
-            fn[f] = v3_normalize(face_newell(s, f));
-            vec3 p0 = shape_vertex(s, s->face_v[a0]);
-            for (int k = 1; k + 1 < cnt; k++) {
-                vec3 p1 = shape_vertex(s, s->face_v[a0 + k]), p2 = shape_vertex(s, s->face_v[a0 + k + 1]);
-                vec3 tet[4] = {o, p0, p1, p2};
-                double V = v3_dot(v3_sub(p0, o), v3_cross(v3_sub(p1, o), v3_sub(p2, o))) / 6.0;
-                m->vol += V;
-                for (int c = 0; c < 3; c++)
-                    m->m1[c] += V * 0.25 * (v3_get(o, c) + v3_get(p0, c) + v3_get(p1, c) + v3_get(p2, c));
-                mom_add_simplex_m2(m, V, tet, 4, 1.0);
-                /* face prism: triangle T extruded by R along the normal n:
-                 * int x = R int_T y + A R^2/2 n, int x x^T = R int_T y y^T
-                 *   + R^2/2 (int_T y n^T + n int_T y^T) + A R^3/3 n n^T */
-                vec3 tri[3] = {p0, p1, p2}, n = fn[f];
-                double A = 0.5 * v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
-                vec3 cy = v3_scale(v3_add(v3_add(p0, p1), p2), A / 3.0); /* int_T y */
-                m->vol += A * R;
-                for (int c = 0; c < 3; c++)
-                    m->m1[c] += R * v3_get(cy, c) + A * R * R * 0.5 * v3_get(n, c);
-                mom_add_simplex_m2(m, A, tri, 3, R);
-                mom_add_outer(m, 0.5 * R * R, cy, n);
-                mom_add_outer(m, 0.5 * R * R, n, cy);
-                mom_add_outer(m, A * R * R * R / 3.0, n, n);
-            }
-        }
-        /* which faces meet at each edge: f1 walks it i -> j, f2 walks j -> i */
-        for (int k = 0; k < ne; k++)
-            ef1[k] = ef2[k] = -1;
-        for (int f = 0; f < s->nf; f++) {
-            int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
-            for (int k = 0; k < cnt; k++) {
-                int key[2] = {s->face_v[a0 + k], s->face_v[a0 + (k + 1) % cnt]};
-                int sorted[2] = {key[0] < key[1] ? key[0] : key[1], key[0] < key[1] ? key[1] : key[0]};
-                int *hit = bsearch(sorted, s->e, (size_t)ne, sizeof *s->e, edge_cmp);
-                if (!hit)
-                    goto open;
-                int ei = (int)((int(*)[2])hit - s->e);
-                if (key[0] == s->e[ei][0]) {
-                    if (ef1[ei] >= 0)
-                        goto open;
-                    ef1[ei] = f;
-                } else {
-                    if (ef2[ei] >= 0)
-                        goto open;
-                    ef2[ei] = f;
-                }
-            }
-        }
-        for (int k = 0; k < ne; k++) {
-            if (ef1[k] < 0 || ef2[k] < 0)
-                goto open;
-            vec3 n1 = fn[ef1[k]], n2 = fn[ef2[k]];
-            theta[k] = atan2(v3_norm(v3_cross(n1, n2)), v3_dot(n1, n2));
-            eu[k] = n1;
-            vec3 w = v3_sub(n2, v3_scale(n1, v3_dot(n1, n2)));
-            ew[k] = v3_norm(w) > 1e-300 ? v3_normalize(w) : v3(0, 0, 0);
-            /* vertex normal-cone first moments: 1/2 sum over edges of theta (v - w)/|v - w| */
-            vec3 a = shape_vertex(s, s->e[k][0]), b = shape_vertex(s, s->e[k][1]);
-            vec3 t = v3_normalize(v3_sub(a, b));
-            mv[s->e[k][0]] = v3_add(mv[s->e[k][0]], v3_scale(t, 0.5 * theta[k]));
-            mv[s->e[k][1]] = v3_sub(mv[s->e[k][1]], v3_scale(t, 0.5 * theta[k]));
-        }
-        /* vertex solid angle = angle defect 2 pi - sum of the face corner angles */
-        for (int i = 0; i < s->nv; i++)
-            omega[i] = 2.0 * M_PI;
-        for (int f = 0; f < s->nf; f++) {
-            int a0 = s->face_start[f], cnt = s->face_start[f + 1] - a0;
-            for (int k = 0; k < cnt; k++) {
-                int i = s->face_v[a0 + k];
-                vec3 p = shape_vertex(s, i), prev = shape_vertex(s, s->face_v[a0 + (k + cnt - 1) % cnt]),
-                     next = shape_vertex(s, s->face_v[a0 + (k + 1) % cnt]);
-                vec3 d1 = v3_sub(prev, p), d2 = v3_sub(next, p);
-                omega[i] -= atan2(v3_norm(v3_cross(d1, d2)), v3_dot(d1, d2));
-            }
-        }
+        add_core_and_face_prisms(s, &sp, m);
+        rc = find_edge_faces(s, &sp);
+        if (rc != 0)
+            lahar_errf(err, errlen, "mass properties need a closed polyhedron (every edge shared by two faces "
+                       "walking it in opposite directions)");
+        else
+            edge_and_vertex_angles(s, &sp);
     }
-    /* edge wedges: x = a + s t + r (cos phi u + sin phi w), s in [0, L], r in [0, R], phi in [0, theta] */
-    for (int k = 0; k < ne; k++) {
-        vec3 a = shape_vertex(s, s->e[k][0]), b = shape_vertex(s, s->e[k][1]);
-        double Lk = v3_norm(v3_sub(b, a));
-        vec3 t = v3_scale(v3_sub(b, a), 1.0 / Lk);
-        double c1, s1, cc, ss, cs;
-        wedge_dirs(theta[k], &c1, &s1, &cc, &ss, &cs);
-        double V = 0.5 * theta[k] * R * R * Lk;
-        vec3 D1 = v3_add(v3_scale(eu[k], c1), v3_scale(ew[k], s1)); /* int d dphi */
-        vec3 ic = v3_add(v3_scale(a, Lk), v3_scale(t, 0.5 * Lk * Lk)); /* int_0^L c(s) ds */
-        m->vol += V;
-        for (int c = 0; c < 3; c++)
-            m->m1[c] += 0.5 * theta[k] * R * R * v3_get(ic, c) + Lk * R * R * R / 3.0 * v3_get(D1, c);
-        /* int c c^T ds = L a a^T + L^2/2 (a t^T + t a^T) + L^3/3 t t^T, times theta R^2/2 */
-        double wr = 0.5 * theta[k] * R * R;
-        mom_add_outer(m, wr * Lk, a, a);
-        mom_add_outer(m, wr * 0.5 * Lk * Lk, a, t);
-        mom_add_outer(m, wr * 0.5 * Lk * Lk, t, a);
-        mom_add_outer(m, wr * Lk * Lk * Lk / 3.0, t, t);
-        mom_add_outer(m, R * R * R / 3.0, ic, D1);
-        mom_add_outer(m, R * R * R / 3.0, D1, ic);
-        double w4 = Lk * pow(R, 4) / 4.0;
-        mom_add_outer(m, w4 * cc, eu[k], eu[k]);
-        mom_add_outer(m, w4 * ss, ew[k], ew[k]);
-        mom_add_outer(m, w4 * cs, eu[k], ew[k]);
-        mom_add_outer(m, w4 * cs, ew[k], eu[k]);
+    if (rc == 0) {
+        add_edge_wedges(s, ne, &sp, m);
+        add_vertex_sectors(s, &sp, m);
     }
-    /* vertex sectors: x = v + r u over the normal cone (solid angle omega, int u = mv) */
-    for (int i = 0; i < s->nv; i++) {
-        vec3 p = shape_vertex(s, i);
-        double V = omega[i] * R * R * R / 3.0, w = pow(R, 4) / 4.0;
-        m->vol += V;
-        for (int c = 0; c < 3; c++)
-            m->m1[c] += V * v3_get(p, c) + w * v3_get(mv[i], c);
-        mom_add_outer(m, V, p, p);
-        mom_add_outer(m, w, p, mv[i]);
-        mom_add_outer(m, w, mv[i], p);
-    }
-    rc = 0;
-    goto done;
-open:
-    lahar_errf(err, errlen, "mass properties need a closed polyhedron (every edge shared by two faces walking it "
-              "in opposite directions)");
-done:
-    free(theta);
-    free(eu);
-    free(ew);
-    free(ef1);
-    free(ef2);
-    free(omega);
-    free(mv);
-    free(fn);
+    sweep_parts_free(&sp);
     return rc;
 }
 
