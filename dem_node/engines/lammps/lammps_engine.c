@@ -579,25 +579,67 @@ static int make_wall(const lahar_case *c, int i, lmp_wall *w, char *err, size_t 
     return 0;
 }
 
-/* Everything up to LAMMPS itself; with start = 0 the engine is returned before LAMMPS is opened,
- * so that check_case can run every refusal without starting it. */
-static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, size_t errlen)
+/* ---- create: the refusals, before LAMMPS ------------------------------------------------------- */
+
+/* What create works with and the engine does not keep: the contact law of every pair of materials
+ * and the classes behind the atom types. Freed on every way out of lmp_build. */
+typedef struct {
+    dem_pair_law *laws; /* [a * nmaterial + b] */
+    int *tmat;          /* per atom type (0-based): its material */
+    double *tmass;      /* per atom type: the mass of its bodies (linear law; c_n needs it), 0 (Hertz) */
+} lmp_setup;
+
+static void setup_free(lmp_setup *su)
 {
-    /* everything LAMMPS could refuse is checked before LAMMPS starts (no exceptions in this build) */
+    free(su->laws);
+    free(su->tmat);
+    free(su->tmass);
+}
+
+static int lmp_oom(char *err, size_t errlen)
+{
+    snprintf(err, errlen, "lammps engine: out of memory");
+    return -1;
+}
+
+static const dem_pair_law *type_law(const lahar_case *c, const lmp_setup *su, int t, int u)
+{
+    return &su->laws[su->tmat[t] * c->nmaterial + su->tmat[u]];
+}
+
+static const dem_pair_law *wall_law(const lahar_case *c, const lmp_setup *su, int t, const lmp_wall *wl)
+{
+    return &su->laws[su->tmat[t] * c->nmaterial + wl->material];
+}
+
+/* m* of two atom types for the linear law's c_n (Hertz types carry mass 0: LAMMPS computes m*) */
+static double type_mstar(const lmp_setup *su, int t, int u)
+{
+    const double *tmass = su->tmass;
+    return tmass[t] > 0.0 && tmass[u] > 0.0 ? tmass[t] * tmass[u] / (tmass[t] + tmass[u]) : 0.0;
+}
+
+/* What the engine cannot run whatever the bodies are. */
+static int check_case_sections(const lahar_case *c, char *err, size_t errlen)
+{
     if (c->checkpoint_interval > 0.0 || c->resume) {
         snprintf(err, errlen,
                  "%s: checkpoint: the lammps engine has no bitwise checkpoint/restart (lahar resume could not "
                  "continue the run bit for bit): remove the checkpoint: section or use dem.engine: spheropoly",
                  c->path);
-        return NULL;
+        return -1;
     }
     if (c->dim != 2 && c->dim != 3) {
         snprintf(err, errlen, "%s: dimensions %d", c->path, c->dim);
-        return NULL;
+        return -1;
     }
-    lahar_dem_engine *e = calloc(1, sizeof *e);
-    dem_pair_law *laws = NULL;
-    if (!e) goto oom;
+    return 0;
+}
+
+/* The per-body arrays are sized for every body: how many are free and how many are walls is known
+ * only once take_body has seen them all. */
+static int alloc_engine(lahar_dem_engine *e, const lahar_case *c, lmp_setup *su, char *err, size_t errlen)
+{
     e->dim = c->dim;
     e->nbody = c->nbody;
     e->max_overlap = c->stability.max_overlap > 0.0 ? c->stability.max_overlap : 0.5;
@@ -626,74 +668,86 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
     e->last_t = calloc(nb, sizeof *e->last_t);
     e->ncontact_body = calloc(nb, sizeof(int));
     int nm = c->nmaterial > 0 ? c->nmaterial : 1;
-    laws = calloc((size_t)nm * (size_t)nm, sizeof *laws);
+    su->laws = calloc((size_t)nm * (size_t)nm, sizeof *su->laws);
     if (!e->free_of_body || !e->body_of_free || !e->type_of_free || !e->mass || !e->radius || !e->inertia ||
         !e->walls || !e->st || !e->load_f || !e->load_t || !e->acc_f || !e->acc_t || !e->rep_f || !e->rep_t || !e->last_f || !e->last_t ||
         !e->wacc_f || !e->wacc_t || !e->wload_f || !e->wload_t || !e->wrep_f || !e->wrep_t ||
-        !e->ncontact_body || !laws)
-        goto oom;
+        !e->ncontact_body || !su->laws)
+        return lmp_oom(err, errlen);
+    return 0;
+}
+
+/* The laws of dem_contact.c, combined as spheropoly combines them, so both engines agree. */
+static int make_pair_laws(const lahar_case *c, dem_pair_law *laws, char *err, size_t errlen)
+{
     for (int a = 0; a < c->nmaterial; a++)
         for (int b = 0; b < c->nmaterial; b++)
             if (dem_pair_law_make(&c->materials[a], &c->materials[b], &laws[a * c->nmaterial + b], err, errlen) != 0)
-                goto fail;
+                return -1;
+    return 0;
+}
 
-    /* bodies: free spheres / discs, fixed walls */
-    for (int i = 0; i < c->nbody; i++) {
-        const lahar_body *b = &c->bodies[i];
-        e->free_of_body[i] = -1;
-        for (int a = 0; a < 3; a++) {
-            e->st[i].x[a] = b->x[a];
-            e->st[i].v[a] = b->v[a];
-            e->st[i].w[a] = b->w[a];
-        }
-        for (int a = 0; a < 4; a++) e->st[i].q[a] = b->q[a];
-        if (b->material < 0 || b->material >= c->nmaterial || c->materials[b->material].model == LAHAR_CONTACT_SOIL) {
-            snprintf(err, errlen, "%s: body '%s': needs a DEM material (linear or hertz)", c->path, b->name);
-            goto fail;
-        }
-        if (b->motion == LAHAR_MOTION_PRESCRIBED) {
-            snprintf(err, errlen,
-                     "%s: body '%s': the lammps engine has no prescribed motion; make it fixed or use dem.engine: "
-                     "spheropoly",
-                     c->path, b->name);
-            goto fail;
-        }
-        if (b->motion == LAHAR_MOTION_FIXED) {
-            if (make_wall(c, i, &e->walls[e->nwall], err, errlen) != 0) goto fail;
-            e->nwall++;
-            continue;
-        }
-        if (!is_sphere(&b->shape)) {
-            snprintf(err, errlen,
-                     "%s: body '%s': the lammps engine moves only spheres (3D) and discs (2D); this free body is a "
-                     "sphero-polyhedron (%d vertices): use dem.engine: spheropoly",
-                     c->path, b->name, b->shape.nv);
-            goto fail;
-        }
-        double r = b->shape.radius, m = b->mass;
-        double iref = (c->dim == 3 ? 0.4 : 0.5) * m * r * r, imom = c->dim == 3 ? b->inertia[0] : b->inertia[2];
-        if (!(m > 0.0) || fabs(imom - iref) > 1e-9 * iref) {
-            snprintf(err, errlen,
-                     "%s: body '%s': mass %g kg and moment of inertia %g are not those of a solid %s (LAMMPS uses "
-                     "%g); use dem.engine: spheropoly",
-                     c->path, b->name, m, imom, c->dim == 3 ? "sphere" : "disc", iref);
-            goto fail;
-        }
-        int k = e->nfree++;
-        e->free_of_body[i] = k;
-        e->body_of_free[k] = i;
-        e->mass[k] = m;
-        e->radius[k] = r;
-        e->inertia[k] = iref;
+/* Body i becomes a wall (fixed) or a free sphere/disc; anything else is refused by its name, since
+ * LAMMPS itself would end the process instead of answering. */
+static int take_body(lahar_dem_engine *e, const lahar_case *c, int i, char *err, size_t errlen)
+{
+    const lahar_body *b = &c->bodies[i];
+    e->free_of_body[i] = -1;
+    for (int a = 0; a < 3; a++) {
+        e->st[i].x[a] = b->x[a];
+        e->st[i].v[a] = b->v[a];
+        e->st[i].w[a] = b->w[a];
     }
-    /* atom types: one per material (Hertz) or per (material, mass) (linear: c_n depends on m*) */
-    int *tmat = malloc((size_t)LMP_MAX_TYPES * sizeof(int));
-    double *tmass = malloc((size_t)LMP_MAX_TYPES * sizeof(double));
-    if (!tmat || !tmass) {
-        free(tmat);
-        free(tmass);
-        goto oom;
+    for (int a = 0; a < 4; a++) e->st[i].q[a] = b->q[a];
+    if (b->material < 0 || b->material >= c->nmaterial || c->materials[b->material].model == LAHAR_CONTACT_SOIL) {
+        snprintf(err, errlen, "%s: body '%s': needs a DEM material (linear or hertz)", c->path, b->name);
+        return -1;
     }
+    if (b->motion == LAHAR_MOTION_PRESCRIBED) {
+        snprintf(err, errlen,
+                 "%s: body '%s': the lammps engine has no prescribed motion; make it fixed or use dem.engine: "
+                 "spheropoly",
+                 c->path, b->name);
+        return -1;
+    }
+    if (b->motion == LAHAR_MOTION_FIXED) {
+        if (make_wall(c, i, &e->walls[e->nwall], err, errlen) != 0) return -1;
+        e->nwall++;
+        return 0;
+    }
+    if (!is_sphere(&b->shape)) {
+        snprintf(err, errlen,
+                 "%s: body '%s': the lammps engine moves only spheres (3D) and discs (2D); this free body is a "
+                 "sphero-polyhedron (%d vertices): use dem.engine: spheropoly",
+                 c->path, b->name, b->shape.nv);
+        return -1;
+    }
+    /* LAMMPS derives the moment of inertia from mass and radius: a body whose case gives another
+     * would silently turn differently */
+    double r = b->shape.radius, m = b->mass;
+    double iref = (c->dim == 3 ? 0.4 : 0.5) * m * r * r, imom = c->dim == 3 ? b->inertia[0] : b->inertia[2];
+    if (!(m > 0.0) || fabs(imom - iref) > 1e-9 * iref) {
+        snprintf(err, errlen,
+                 "%s: body '%s': mass %g kg and moment of inertia %g are not those of a solid %s (LAMMPS uses "
+                 "%g); use dem.engine: spheropoly",
+                 c->path, b->name, m, imom, c->dim == 3 ? "sphere" : "disc", iref);
+        return -1;
+    }
+    int k = e->nfree++;
+    e->free_of_body[i] = k;
+    e->body_of_free[k] = i;
+    e->mass[k] = m;
+    e->radius[k] = r;
+    e->inertia[k] = iref;
+    return 0;
+}
+
+/* One atom type per material (Hertz) or per (material, mass) (linear: c_n depends on m*). */
+static int define_atom_types(lahar_dem_engine *e, const lahar_case *c, lmp_setup *su, char *err, size_t errlen)
+{
+    int *tmat = su->tmat = malloc((size_t)LMP_MAX_TYPES * sizeof(int));
+    double *tmass = su->tmass = malloc((size_t)LMP_MAX_TYPES * sizeof(double));
+    if (!tmat || !tmass) return lmp_oom(err, errlen);
     for (int k = 0; k < e->nfree; k++) {
         int mat = c->bodies[e->body_of_free[k]].material;
         double key = c->materials[mat].model == LAHAR_CONTACT_HERTZ ? 0.0 : e->mass[k];
@@ -706,9 +760,7 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
                          "lammps engine writes one LAMMPS atom type per class: use hertz materials, fewer sizes, or "
                          "dem.engine: spheropoly",
                          c->path, LMP_MAX_TYPES);
-                free(tmat);
-                free(tmass);
-                goto fail;
+                return -1;
             }
             tmat[t] = mat;
             tmass[t] = key;
@@ -716,63 +768,80 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
         }
         e->type_of_free[k] = t + 1;
     }
-    /* pair and wall coefficients (checked before LAMMPS starts) */
+    return 0;
+}
+
+/* Every coefficient start_lammps will write, made once here with the names of the materials and
+ * walls for the message: an argument LAMMPS refuses (a Tsuji restitution it cannot express) would
+ * end the process. */
+static int check_coefficients(const lahar_dem_engine *e, const lahar_case *c, const lmp_setup *su, char *err,
+                              size_t errlen)
+{
     char coeff[512];
     for (int t = 0; t < e->ntype; t++) {
         for (int u = t; u < e->ntype; u++) {
-            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + tmat[u]];
-            double ms = tmass[t] > 0.0 && tmass[u] > 0.0 ? tmass[t] * tmass[u] / (tmass[t] + tmass[u]) : 0.0;
             char what[1400];
-            snprintf(what, sizeof what, "%s: materials '%s'/'%s'", c->path, c->materials[tmat[t]].name,
-                     c->materials[tmat[u]].name);
-            if (law_coeffs(law, ms, coeff, sizeof coeff, err, errlen, what) != 0) {
-                free(tmat);
-                free(tmass);
-                goto fail;
-            }
+            snprintf(what, sizeof what, "%s: materials '%s'/'%s'", c->path, c->materials[su->tmat[t]].name,
+                     c->materials[su->tmat[u]].name);
+            if (law_coeffs(type_law(c, su, t, u), type_mstar(su, t, u), coeff, sizeof coeff, err, errlen, what) != 0)
+                return -1;
         }
         for (int w = 0; w < e->nwall; w++) {
-            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + e->walls[w].material];
             char what[1400];
             snprintf(what, sizeof what, "%s: body '%s'", c->path, c->bodies[e->walls[w].body].name);
-            if (law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, what) != 0) {
-                free(tmat);
-                free(tmass);
-                goto fail;
-            }
+            if (law_coeffs(wall_law(c, su, t, &e->walls[w]), su->tmass[t], coeff, sizeof coeff, err, errlen, what) != 0)
+                return -1;
         }
     }
-    /* room for the kept fixes: every wall x type (the Hertz ones are kept) and four more */
+    return 0;
+}
+
+/* The wall fixes (one per wall and atom type) and the fixes made again before an init: every
+ * wall x type (the Hertz ones are kept) and four more (external, gravity, integrator, enforce2d). */
+static int alloc_fix_tables(lahar_dem_engine *e, char *err, size_t errlen)
+{
     e->caprefix = e->nwall * e->ntype + 4;
     e->refix_id = calloc((size_t)e->caprefix, sizeof *e->refix_id);
     e->wfix_id = calloc((size_t)(e->nwall * e->ntype + 1), sizeof *e->wfix_id);
     e->wfix_wall = calloc((size_t)(e->nwall * e->ntype + 1), sizeof *e->wfix_wall);
     e->refix_cmd = calloc((size_t)e->caprefix, sizeof *e->refix_cmd);
-    if (!e->refix_id || !e->refix_cmd || !e->wfix_id || !e->wfix_wall) {
-        free(tmat);
-        free(tmass);
-        goto oom;
-    }
-    e->dt_stable = stable_dt_of(c, laws, err, errlen);
-    if (!(e->dt_stable > 0.0)) {
-        free(tmat);
-        free(tmass);
-        goto fail;
-    }
+    if (!e->refix_id || !e->refix_cmd || !e->wfix_id || !e->wfix_wall) return lmp_oom(err, errlen);
+    return 0;
+}
 
+/* Everything up to LAMMPS itself; with start = 0 the engine is returned before LAMMPS is opened,
+ * so that check_case can run every refusal without starting it. */
+static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, size_t errlen)
+{
+    /* everything LAMMPS could refuse is checked before LAMMPS starts (no exceptions in this build) */
+    if (check_case_sections(c, err, errlen) != 0) return NULL;
+    lahar_dem_engine *e = calloc(1, sizeof *e);
+    if (!e) {
+        lmp_oom(err, errlen);
+        return NULL;
+    }
+    lmp_setup su = {0};
+    if (alloc_engine(e, c, &su, err, errlen) != 0 || make_pair_laws(c, su.laws, err, errlen) != 0) goto fail;
+    for (int i = 0; i < c->nbody; i++)
+        if (take_body(e, c, i, err, errlen) != 0) goto fail;
+    if (define_atom_types(e, c, &su, err, errlen) != 0 || check_coefficients(e, c, &su, err, errlen) != 0 ||
+        alloc_fix_tables(e, err, errlen) != 0)
+        goto fail;
+    e->dt_stable = stable_dt_of(c, su.laws, err, errlen);
+    if (!(e->dt_stable > 0.0)) goto fail;
     if (!start) {
-        free(tmat);
-        free(tmass);
-        free(laws);
+        setup_free(&su);
         return e;
     }
+    const dem_pair_law *laws = su.laws;
+    const int *tmat = su.tmat;
+    const double *tmass = su.tmass;
+    char coeff[512];
     /* ---- LAMMPS ---- */
     const char *args[] = {"lahar-dem", "-log", "none", "-screen", "none", "-nocite"};
     e->lmp = lammps_open_no_mpi((int)(sizeof args / sizeof args[0]), (char **)args, NULL);
     if (!e->lmp) {
         snprintf(err, errlen, "lammps engine: lammps_open_no_mpi failed");
-        free(tmat);
-        free(tmass);
         goto fail;
     }
     lmp_cmd(e, "units si");
@@ -808,9 +877,8 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
             free(ids);
             free(xs);
             free(vs);
-            free(tmat);
-            free(tmass);
-            goto oom;
+            lmp_oom(err, errlen);
+            goto fail;
         }
         for (int k = 0; k < e->nfree; k++) {
             const lahar_body *b = &c->bodies[e->body_of_free[k]];
@@ -828,8 +896,6 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
         double **om = lammps_extract_atom(e->lmp, "omega");
         if (nlocal != e->nfree) {
             snprintf(err, errlen, "lammps engine: LAMMPS created %d of %d spheres", nlocal, e->nfree);
-            free(tmat);
-            free(tmass);
             goto fail;
         }
         for (int i = 0; i < nlocal; i++) {
@@ -881,8 +947,6 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
                          coeff, w);
         }
     }
-    free(tmat);
-    free(tmass);
     lmp_keep_fix(e, "lahar_ext", "fix lahar_ext all external pf/callback 1 1");
     lammps_set_fix_external_callback(e->lmp, "lahar_ext", lmp_callback, e);
     vec3 gv = v3(c->gravity[0], c->gravity[1], c->dim == 3 ? c->gravity[2] : 0.0);
@@ -894,12 +958,10 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
     if (c->dim == 2) lmp_keep_fix(e, "lahar_2d", "fix lahar_2d all enforce2d");
     lmp_cmd(e, "thermo_style custom step");
     lmp_cmd(e, "thermo 0");
-    free(laws);
+    setup_free(&su);
     return e;
-oom:
-    snprintf(err, errlen, "lammps engine: out of memory");
 fail:
-    free(laws);
+    setup_free(&su);
     lmp_destroy(e);
     return NULL;
 }
