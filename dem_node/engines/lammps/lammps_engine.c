@@ -809,6 +809,181 @@ static int alloc_fix_tables(lahar_dem_engine *e, char *err, size_t errlen)
     return 0;
 }
 
+/* ---- create: LAMMPS ---------------------------------------------------------------------------- */
+
+/* One serial instance that writes nothing of its own (no log, screen or citation file): the node's
+ * output is lahar's. The boundaries shrink-wrap, so that no atom can be lost (README.md "Limits of
+ * the build"); in 2D z is periodic. */
+static int open_lammps(lahar_dem_engine *e, const lahar_case *c, char *err, size_t errlen)
+{
+    const char *args[] = {"lahar-dem", "-log", "none", "-screen", "none", "-nocite"};
+    e->lmp = lammps_open_no_mpi((int)(sizeof args / sizeof args[0]), (char **)args, NULL);
+    if (!e->lmp) {
+        snprintf(err, errlen, "lammps engine: lammps_open_no_mpi failed");
+        return -1;
+    }
+    lmp_cmd(e, "units si");
+    lmp_cmd(e, "dimension %d", c->dim);
+    lmp_cmd(e, "atom_style sphere");
+    lmp_cmd(e, "atom_modify map array sort 0 0.0");
+    lmp_cmd(e, c->dim == 3 ? "boundary m m m" : "boundary m m p");
+    lmp_cmd(e, "comm_modify vel yes");
+    lmp_cmd(e, "newton off");
+    return 0;
+}
+
+/* The box only has to hold the free bodies at the start (it shrink-wraps from there), with one
+ * largest radius to spare. Returns the smallest radius, which sets the neighbour skin. */
+static double create_box(lahar_dem_engine *e, const lahar_case *c)
+{
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, rmin = DBL_MAX, rmax = 0.0;
+    for (int k = 0; k < e->nfree; k++) {
+        const double *x = c->bodies[e->body_of_free[k]].x;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], x[a] - e->radius[k]);
+            hi[a] = fmax(hi[a], x[a] + e->radius[k]);
+        }
+        rmin = fmin(rmin, e->radius[k]);
+        rmax = fmax(rmax, e->radius[k]);
+    }
+    if (e->nfree == 0) {
+        for (int a = 0; a < 3; a++) lo[a] = -1.0, hi[a] = 1.0;
+        rmin = rmax = 1.0;
+    }
+    /* 2D: z is periodic; its period (> 4 rmax) keeps the periodic images out of contact */
+    if (c->dim == 2) lo[2] = -2.0 * rmax - 0.5, hi[2] = 2.0 * rmax + 0.5;
+    for (int a = 0; a < c->dim; a++) lo[a] -= rmax, hi[a] += rmax;
+    lmp_cmd(e, "region lahar_box block %.17g %.17g %.17g %.17g %.17g %.17g", lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+    lmp_cmd(e, "create_box %d lahar_box", e->ntype > 0 ? e->ntype : 1);
+    return rmin;
+}
+
+/* The free bodies as atoms, tag = 1 + index among the free bodies; radius, mass and spin are set
+ * in LAMMPS' arrays afterwards (lammps_create_atoms takes positions and velocities only). */
+static int create_atoms(lahar_dem_engine *e, const lahar_case *c, char *err, size_t errlen)
+{
+    int *ids = malloc((size_t)e->nfree * sizeof(int));
+    double *xs = malloc((size_t)e->nfree * 3 * sizeof(double)), *vs = malloc((size_t)e->nfree * 3 * sizeof(double));
+    if (!ids || !xs || !vs) {
+        free(ids);
+        free(xs);
+        free(vs);
+        return lmp_oom(err, errlen);
+    }
+    for (int k = 0; k < e->nfree; k++) {
+        const lahar_body *b = &c->bodies[e->body_of_free[k]];
+        ids[k] = k + 1;
+        for (int a = 0; a < 3; a++) xs[3 * k + a] = b->x[a], vs[3 * k + a] = b->v[a];
+        if (c->dim == 2) xs[3 * k + 2] = vs[3 * k + 2] = 0.0;
+    }
+    lammps_create_atoms(e->lmp, e->nfree, ids, e->type_of_free, xs, vs, NULL, 0);
+    free(ids);
+    free(xs);
+    free(vs);
+    int nlocal = lammps_extract_setting(e->lmp, "nlocal");
+    int *id = lammps_extract_atom(e->lmp, "id");
+    double *rad = lammps_extract_atom(e->lmp, "radius"), *rm = lammps_extract_atom(e->lmp, "rmass");
+    double **om = lammps_extract_atom(e->lmp, "omega");
+    if (nlocal != e->nfree) {
+        snprintf(err, errlen, "lammps engine: LAMMPS created %d of %d spheres", nlocal, e->nfree);
+        return -1;
+    }
+    for (int i = 0; i < nlocal; i++) {
+        int k = id[i] - 1;
+        const lahar_body *b = &c->bodies[e->body_of_free[k]];
+        rad[i] = e->radius[k];
+        rm[i] = e->mass[k];
+        for (int a = 0; a < 3; a++) om[i][a] = c->dim == 2 && a < 2 ? 0.0 : b->w[a];
+    }
+    return 0;
+}
+
+/* Neighbour lists checked at every substep, and the contact law of every pair of atom types
+ * (without free bodies the box still has one type, and LAMMPS' init refuses a type without
+ * coefficients). law_coeffs cannot fail here: check_coefficients made the same calls. */
+static void write_pair_coeffs(lahar_dem_engine *e, const lahar_case *c, const lmp_setup *su, double rmin, char *err,
+                              size_t errlen)
+{
+    char coeff[512];
+    lmp_cmd(e, "neighbor %.17g bin", 0.25 * rmin);
+    lmp_cmd(e, "neigh_modify delay 0 every 1 check yes");
+    lmp_cmd(e, "pair_style granular");
+    if (e->ntype == 0) lmp_cmd(e, "pair_coeff * * hooke 1 0 tangential linear_nohistory 0 0");
+    for (int t = 0; t < e->ntype; t++)
+        for (int u = t; u < e->ntype; u++) {
+            law_coeffs(type_law(c, su, t, u), type_mstar(su, t, u), coeff, sizeof coeff, err, errlen, "");
+            lmp_cmd(e, "pair_coeff %d %d %s", t + 1, u + 1, coeff);
+        }
+}
+
+/* One fix wall/gran/region per wall and atom type (a wall's law depends on the free body's type),
+ * each with `contacts` so that accumulate_wall_forces can report the wall's force. The linear
+ * fixes come first; the Hertz ones follow and are kept, since lmp_refix must make them anew (and
+ * everything after them) before every init but the first (README.md "Step"). */
+static void create_walls(lahar_dem_engine *e, const lahar_case *c, const lmp_setup *su, char *err, size_t errlen)
+{
+    char coeff[512];
+    for (int t = 0; t < e->ntype; t++) lmp_cmd(e, "group lahar_t%d type %d", t + 1, t + 1);
+    for (int w = 0; w < e->nwall; w++) {
+        const lmp_wall *wl = &e->walls[w];
+        lmp_cmd(e, "region lahar_w%d plane %.17g %.17g %.17g %.17g %.17g %.17g side in", w, wl->p[0], wl->p[1], wl->p[2],
+                wl->n[0], wl->n[1], wl->n[2]);
+        for (int t = 0; t < e->ntype; t++) {
+            const dem_pair_law *law = wall_law(c, su, t, wl);
+            law_coeffs(law, su->tmass[t], coeff, sizeof coeff, err, errlen, "");
+            if (law->model == LAHAR_CONTACT_HERTZ) continue; /* after the linear ones, below */
+            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "lahar_w%d_%d", w, t + 1);
+            e->wfix_wall[e->nwfix++] = w;
+            lmp_cmd(e, "fix lahar_w%d_%d lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", w, t + 1,
+                    t + 1, coeff, w);
+        }
+    }
+    for (int w = 0; w < e->nwall; w++) {
+        const lmp_wall *wl = &e->walls[w];
+        for (int t = 0; t < e->ntype; t++) {
+            const dem_pair_law *law = wall_law(c, su, t, wl);
+            if (law->model != LAHAR_CONTACT_HERTZ) continue;
+            law_coeffs(law, su->tmass[t], coeff, sizeof coeff, err, errlen, "");
+            char id[32];
+            snprintf(id, sizeof id, "lahar_w%d_%d", w, t + 1);
+            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "%s", id);
+            e->wfix_wall[e->nwfix++] = w;
+            lmp_keep_fix(e, id, "fix %s lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", id, t + 1,
+                         coeff, w);
+        }
+    }
+}
+
+/* The fixes of the step, after the walls (post_force runs in this order: the callback must see
+ * the walls' forces and none of gravity) and kept for lmp_refix: the SPH loads and the report
+ * (fix external, lmp_callback), gravity, the integrator, and in 2D enforce2d. */
+static void add_step_fixes(lahar_dem_engine *e, const lahar_case *c)
+{
+    lmp_keep_fix(e, "lahar_ext", "fix lahar_ext all external pf/callback 1 1");
+    lammps_set_fix_external_callback(e->lmp, "lahar_ext", lmp_callback, e);
+    vec3 gv = v3(c->gravity[0], c->gravity[1], c->dim == 3 ? c->gravity[2] : 0.0);
+    double g = v3_norm(gv);
+    if (g > 0.0)
+        lmp_keep_fix(e, "lahar_g", "fix lahar_g all gravity %.17g vector %.17g %.17g %.17g", g, gv.x / g, gv.y / g,
+                     gv.z / g);
+    lmp_keep_fix(e, "lahar_nve", c->dim == 3 ? "fix lahar_nve all nve/sphere" : "fix lahar_nve all nve/sphere disc");
+    if (c->dim == 2) lmp_keep_fix(e, "lahar_2d", "fix lahar_2d all enforce2d");
+}
+
+/* LAMMPS from the checked engine: every command below has been made acceptable beforehand. */
+static int start_lammps(lahar_dem_engine *e, const lahar_case *c, const lmp_setup *su, char *err, size_t errlen)
+{
+    if (open_lammps(e, c, err, errlen) != 0) return -1;
+    double rmin = create_box(e, c);
+    if (e->nfree > 0 && create_atoms(e, c, err, errlen) != 0) return -1;
+    write_pair_coeffs(e, c, su, rmin, err, errlen);
+    create_walls(e, c, su, err, errlen);
+    add_step_fixes(e, c);
+    lmp_cmd(e, "thermo_style custom step");
+    lmp_cmd(e, "thermo 0");
+    return 0;
+}
+
 /* Everything up to LAMMPS itself; with start = 0 the engine is returned before LAMMPS is opened,
  * so that check_case can run every refusal without starting it. */
 static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, size_t errlen)
@@ -829,135 +1004,7 @@ static lahar_dem_engine *lmp_build(const lahar_case *c, int start, char *err, si
         goto fail;
     e->dt_stable = stable_dt_of(c, su.laws, err, errlen);
     if (!(e->dt_stable > 0.0)) goto fail;
-    if (!start) {
-        setup_free(&su);
-        return e;
-    }
-    const dem_pair_law *laws = su.laws;
-    const int *tmat = su.tmat;
-    const double *tmass = su.tmass;
-    char coeff[512];
-    /* ---- LAMMPS ---- */
-    const char *args[] = {"lahar-dem", "-log", "none", "-screen", "none", "-nocite"};
-    e->lmp = lammps_open_no_mpi((int)(sizeof args / sizeof args[0]), (char **)args, NULL);
-    if (!e->lmp) {
-        snprintf(err, errlen, "lammps engine: lammps_open_no_mpi failed");
-        goto fail;
-    }
-    lmp_cmd(e, "units si");
-    lmp_cmd(e, "dimension %d", c->dim);
-    lmp_cmd(e, "atom_style sphere");
-    lmp_cmd(e, "atom_modify map array sort 0 0.0");
-    lmp_cmd(e, c->dim == 3 ? "boundary m m m" : "boundary m m p");
-    lmp_cmd(e, "comm_modify vel yes");
-    lmp_cmd(e, "newton off");
-    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX}, rmin = DBL_MAX, rmax = 0.0;
-    for (int k = 0; k < e->nfree; k++) {
-        const double *x = c->bodies[e->body_of_free[k]].x;
-        for (int a = 0; a < 3; a++) {
-            lo[a] = fmin(lo[a], x[a] - e->radius[k]);
-            hi[a] = fmax(hi[a], x[a] + e->radius[k]);
-        }
-        rmin = fmin(rmin, e->radius[k]);
-        rmax = fmax(rmax, e->radius[k]);
-    }
-    if (e->nfree == 0) {
-        for (int a = 0; a < 3; a++) lo[a] = -1.0, hi[a] = 1.0;
-        rmin = rmax = 1.0;
-    }
-    /* 2D: z is periodic; its period (> 4 rmax) keeps the periodic images out of contact */
-    if (c->dim == 2) lo[2] = -2.0 * rmax - 0.5, hi[2] = 2.0 * rmax + 0.5;
-    for (int a = 0; a < c->dim; a++) lo[a] -= rmax, hi[a] += rmax;
-    lmp_cmd(e, "region lahar_box block %.17g %.17g %.17g %.17g %.17g %.17g", lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
-    lmp_cmd(e, "create_box %d lahar_box", e->ntype > 0 ? e->ntype : 1);
-    if (e->nfree > 0) {
-        int *ids = malloc((size_t)e->nfree * sizeof(int));
-        double *xs = malloc((size_t)e->nfree * 3 * sizeof(double)), *vs = malloc((size_t)e->nfree * 3 * sizeof(double));
-        if (!ids || !xs || !vs) {
-            free(ids);
-            free(xs);
-            free(vs);
-            lmp_oom(err, errlen);
-            goto fail;
-        }
-        for (int k = 0; k < e->nfree; k++) {
-            const lahar_body *b = &c->bodies[e->body_of_free[k]];
-            ids[k] = k + 1;
-            for (int a = 0; a < 3; a++) xs[3 * k + a] = b->x[a], vs[3 * k + a] = b->v[a];
-            if (c->dim == 2) xs[3 * k + 2] = vs[3 * k + 2] = 0.0;
-        }
-        lammps_create_atoms(e->lmp, e->nfree, ids, e->type_of_free, xs, vs, NULL, 0);
-        free(ids);
-        free(xs);
-        free(vs);
-        int nlocal = lammps_extract_setting(e->lmp, "nlocal");
-        int *id = lammps_extract_atom(e->lmp, "id");
-        double *rad = lammps_extract_atom(e->lmp, "radius"), *rm = lammps_extract_atom(e->lmp, "rmass");
-        double **om = lammps_extract_atom(e->lmp, "omega");
-        if (nlocal != e->nfree) {
-            snprintf(err, errlen, "lammps engine: LAMMPS created %d of %d spheres", nlocal, e->nfree);
-            goto fail;
-        }
-        for (int i = 0; i < nlocal; i++) {
-            int k = id[i] - 1;
-            const lahar_body *b = &c->bodies[e->body_of_free[k]];
-            rad[i] = e->radius[k];
-            rm[i] = e->mass[k];
-            for (int a = 0; a < 3; a++) om[i][a] = c->dim == 2 && a < 2 ? 0.0 : b->w[a];
-        }
-    }
-    lmp_cmd(e, "neighbor %.17g bin", 0.25 * rmin);
-    lmp_cmd(e, "neigh_modify delay 0 every 1 check yes");
-    lmp_cmd(e, "pair_style granular");
-    if (e->ntype == 0) lmp_cmd(e, "pair_coeff * * hooke 1 0 tangential linear_nohistory 0 0");
-    for (int t = 0; t < e->ntype; t++)
-        for (int u = t; u < e->ntype; u++) {
-            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + tmat[u]];
-            double ms = tmass[t] > 0.0 && tmass[u] > 0.0 ? tmass[t] * tmass[u] / (tmass[t] + tmass[u]) : 0.0;
-            law_coeffs(law, ms, coeff, sizeof coeff, err, errlen, "");
-            lmp_cmd(e, "pair_coeff %d %d %s", t + 1, u + 1, coeff);
-        }
-    /* walls first: their forces are in f when fix external's callback reads it */
-    for (int t = 0; t < e->ntype; t++) lmp_cmd(e, "group lahar_t%d type %d", t + 1, t + 1);
-    for (int w = 0; w < e->nwall; w++) {
-        const lmp_wall *wl = &e->walls[w];
-        lmp_cmd(e, "region lahar_w%d plane %.17g %.17g %.17g %.17g %.17g %.17g side in", w, wl->p[0], wl->p[1], wl->p[2],
-                wl->n[0], wl->n[1], wl->n[2]);
-        for (int t = 0; t < e->ntype; t++) {
-            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + wl->material];
-            law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
-            if (law->model == LAHAR_CONTACT_HERTZ) continue; /* after the linear ones, below */
-            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "lahar_w%d_%d", w, t + 1);
-            e->wfix_wall[e->nwfix++] = w;
-            lmp_cmd(e, "fix lahar_w%d_%d lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", w, t + 1,
-                    t + 1, coeff, w);
-        }
-    }
-    for (int w = 0; w < e->nwall; w++) {
-        const lmp_wall *wl = &e->walls[w];
-        for (int t = 0; t < e->ntype; t++) {
-            const dem_pair_law *law = &laws[tmat[t] * c->nmaterial + wl->material];
-            if (law->model != LAHAR_CONTACT_HERTZ) continue;
-            law_coeffs(law, tmass[t], coeff, sizeof coeff, err, errlen, "");
-            char id[32];
-            snprintf(id, sizeof id, "lahar_w%d_%d", w, t + 1);
-            snprintf(e->wfix_id[e->nwfix], sizeof e->wfix_id[0], "%s", id);
-            e->wfix_wall[e->nwfix++] = w;
-            lmp_keep_fix(e, id, "fix %s lahar_t%d wall/gran/region granular %s region lahar_w%d contacts", id, t + 1,
-                         coeff, w);
-        }
-    }
-    lmp_keep_fix(e, "lahar_ext", "fix lahar_ext all external pf/callback 1 1");
-    lammps_set_fix_external_callback(e->lmp, "lahar_ext", lmp_callback, e);
-    vec3 gv = v3(c->gravity[0], c->gravity[1], c->dim == 3 ? c->gravity[2] : 0.0);
-    double g = v3_norm(gv);
-    if (g > 0.0)
-        lmp_keep_fix(e, "lahar_g", "fix lahar_g all gravity %.17g vector %.17g %.17g %.17g", g, gv.x / g, gv.y / g,
-                     gv.z / g);
-    lmp_keep_fix(e, "lahar_nve", c->dim == 3 ? "fix lahar_nve all nve/sphere" : "fix lahar_nve all nve/sphere disc");
-    if (c->dim == 2) lmp_keep_fix(e, "lahar_2d", "fix lahar_2d all enforce2d");
-    lmp_cmd(e, "thermo_style custom step");
-    lmp_cmd(e, "thermo 0");
+    if (start && start_lammps(e, c, &su, err, errlen) != 0) goto fail;
     setup_free(&su);
     return e;
 fail:
