@@ -1019,49 +1019,69 @@ static int build_topology(lahar_dem_engine *e, int i, const lahar_shape *s, char
     return 0;
 }
 
-static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen)
+static int sp_oom(char *err, size_t errlen)
 {
-    lahar_dem_engine *e = calloc(1, sizeof *e);
-    if (!e) {
-        snprintf(err, errlen, "spheropoly: out of memory");
-        return NULL;
-    }
+    snprintf(err, errlen, "spheropoly: out of memory");
+    return -1;
+}
+
+/* Numbers of vertices, edges, faces and face-vertex entries: the pools' sizes, a body's offsets
+ * into them, or the largest body with a feature grid. */
+typedef struct {
+    int nv, ne, nf, nfv;
+} sp_counts;
+
+static void set_scene_constants(lahar_dem_engine *e, const lahar_case *c)
+{
     e->dim = c->dim == 2 ? 2 : 3;
     e->nbody = c->nbody;
     e->max_overlap = c->stability.max_overlap > 0.0 ? c->stability.max_overlap : 0.5; /* 0: a case built in code */
     e->nmat = c->nmaterial;
     e->g = v3_load(c->gravity);
     if (e->dim == 2) e->g.z = 0.0;
-    int nb = c->nbody > 0 ? c->nbody : 0;
+}
+
+/* Every body's refusals come before anything is sized by it; tot gets the pools' sizes. */
+static int check_bodies(const lahar_dem_engine *e, const lahar_case *c, int nb, sp_counts *tot, char *err,
+                        size_t errlen)
+{
     if (e->nmat <= 0 && nb > 0) {
         snprintf(err, errlen, "spheropoly: the case has bodies but no materials");
-        goto fail;
+        return -1;
     }
-    int nv = 0, ne = 0, nf = 0, nfv = 0;
+    *tot = (sp_counts){0, 0, 0, 0};
     for (int i = 0; i < nb; i++) {
         const lahar_body *b = &c->bodies[i];
         const lahar_shape *s = &b->shape;
         if (b->material < 0 || b->material >= c->nmaterial) {
             snprintf(err, errlen, "spheropoly: body %d '%s': material index %d out of range", i, b->name, b->material);
-            goto fail;
+            return -1;
         }
         if (s->nv < 1 || !(s->radius > 0.0)) {
             snprintf(err, errlen, "spheropoly: body %d '%s': needs at least one vertex and a sweep radius > 0", i, b->name);
-            goto fail;
+            return -1;
         }
         if (b->motion == LAHAR_MOTION_FREE) {
             int bad = !(b->mass > 0.0) || !(b->inertia[2] > 0.0);
             if (e->dim == 3) bad |= !(b->inertia[0] > 0.0) || !(b->inertia[1] > 0.0);
             if (bad) {
                 snprintf(err, errlen, "spheropoly: free body %d '%s' needs positive mass and principal inertia", i, b->name);
-                goto fail;
+                return -1;
             }
         }
-        nv += s->nv;
-        ne += s->ne;
-        nf += s->nf;
-        nfv += s->nf > 0 ? s->face_start[s->nf] : 0;
+        tot->nv += s->nv;
+        tot->ne += s->ne;
+        tot->nf += s->nf;
+        tot->nfv += s->nf > 0 ? s->face_start[s->nf] : 0;
     }
+    return 0;
+}
+
+/* One allocation per pool for all the bodies, sized by check_bodies (sp_geo holds each body's
+ * offsets into the pools). */
+static int alloc_pools(lahar_dem_engine *e, int nb, const sp_counts *tot, char *err, size_t errlen)
+{
+    int nv = tot->nv, ne = tot->ne, nf = tot->nf, nfv = tot->nfv;
     e->geo = xcalloc((size_t)nb, sizeof *e->geo);
     e->st = xcalloc((size_t)nb, sizeof *e->st);
     e->names = xcalloc((size_t)nb, sizeof *e->names);
@@ -1086,99 +1106,152 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
     e->ncontact_body = xcalloc((size_t)nb, sizeof(int));
     if (!e->geo || !e->st || !e->names || !e->laws || !e->vb || !e->vw || !e->vadj_start || !e->vadj || !e->edge ||
         !e->edge_face || !e->fstart || !e->fv || !e->fw || !e->nb || !e->nw || !e->free_ids || !e->large_ids ||
-        !e->cellc || !e->grids || !e->rep_f || !e->rep_t || !e->ncontact_body) {
-        snprintf(err, errlen, "spheropoly: out of memory");
-        goto fail;
-    }
+        !e->cellc || !e->grids || !e->rep_f || !e->rep_t || !e->ncontact_body)
+        return sp_oom(err, errlen);
+    return 0;
+}
+
+static int make_pair_laws(lahar_dem_engine *e, const lahar_case *c, char *err, size_t errlen)
+{
     for (int a = 0; a < e->nmat; a++)
         for (int b = 0; b < e->nmat; b++)
-            if (dem_pair_law_make(&c->materials[a], &c->materials[b], &e->laws[a * e->nmat + b], err, errlen)) goto fail;
-    int ov = 0, oe = 0, of = 0, ofv = 0, maxv = 0, maxe = 0, maxf = 0;
-    for (int i = 0; i < nb; i++) {
-        const lahar_body *b = &c->bodies[i];
-        const lahar_shape *s = &b->shape;
-        sp_geo *g = &e->geo[i];
-        snprintf(e->names[i], LAHAR_NAME_MAX, "%s", b->name);
-        g->nv = s->nv;
-        g->ne = s->ne;
-        g->nf = s->nf;
-        g->v0 = ov;
-        g->va0 = ov + i;
-        g->e0 = oe;
-        g->f0 = of;
-        g->fs0 = of + i;
-        g->radius = s->radius;
-        g->material = b->material;
-        g->motion = b->motion;
-        g->mass = b->mass;
-        memcpy(g->inertia, b->inertia, sizeof g->inertia);
-        g->isotropic = g->inertia[0] == g->inertia[1] && g->inertia[1] == g->inertia[2];
-        g->grid = -1;
-        double rb = 0.0;
-        for (int k = 0; k < s->nv; k++) {
-            e->vb[ov + k] = v3_load(s->v[k]);
-            rb = fmax(rb, v3_norm(e->vb[ov + k]));
-        }
-        g->bound = rb + s->radius;
-        for (int k = 0; k < s->ne; k++) {
-            e->edge[oe + k][0] = s->e[k][0];
-            e->edge[oe + k][1] = s->e[k][1];
-        }
-        for (int f = 0; f < s->nf; f++) {
-            e->fstart[g->fs0 + f] = ofv + s->face_start[f];
-            e->nb[of + f] = geom_face_normal(s, f);
-        }
-        e->fstart[g->fs0 + s->nf] = ofv + (s->nf > 0 ? s->face_start[s->nf] : 0);
-        int nfvi = s->nf > 0 ? s->face_start[s->nf] : 0;
-        for (int k = 0; k < nfvi; k++) {
-            if (s->face_v[k] < 0 || s->face_v[k] >= s->nv) {
-                snprintf(err, errlen, "spheropoly: body %d '%s': face uses a missing vertex", i, b->name);
-                goto fail;
-            }
-            e->fv[ofv + k] = s->face_v[k];
-        }
-        if (build_topology(e, i, s, err, errlen)) goto fail;
-        sp_state *st = &e->st[i];
-        st->x = v3_load(b->x);
-        st->q = q_normalize(q_load(b->q));
-        if (e->dim == 2) { /* keep 2D exactly planar */
-            st->x.z = 0.0;
-            st->q.x = st->q.y = 0.0;
-            st->q = q_normalize(st->q);
-        }
-        st->v = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->v);
-        st->w = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->w);
-        if (e->dim == 2) {
-            st->v.z = 0.0;
-            st->w.x = st->w.y = 0.0;
-        }
-        if (b->motion == LAHAR_MOTION_FREE) {
-            if (e->dim == 2) st->L = v3(0.0, 0.0, g->inertia[2] * st->w.z);
-            else {
-                vec3 wb = q_rotate_inv(st->q, st->w);
-                st->L = q_rotate(st->q, v3(g->inertia[0] * wb.x, g->inertia[1] * wb.y, g->inertia[2] * wb.z));
-            }
-            e->free_ids[e->nfree++] = i;
-        } else {
-            e->large_ids[e->nlarge++] = i;
-        }
-        if (s->nv + s->ne + s->nf > SP_GRID_MIN_FEATURES) {
-            if (geom_feature_grid_build(&e->grids[e->ngrid], s)) {
-                e->ngrid++;
-                snprintf(err, errlen, "spheropoly: out of memory for the feature grid of body '%s'", b->name);
-                goto fail;
-            }
-            g->grid = e->ngrid++;
-            maxv = s->nv > maxv ? s->nv : maxv;
-            maxe = s->ne > maxe ? s->ne : maxe;
-            maxf = s->nf > maxf ? s->nf : maxf;
-        }
-        ov += s->nv;
-        oe += s->ne;
-        of += s->nf;
-        ofv += nfvi;
-        body_update_world(e, i);
+            if (dem_pair_law_make(&c->materials[a], &c->materials[b], &e->laws[a * e->nmat + b], err, errlen))
+                return -1;
+    return 0;
+}
+
+/* Body i's constants into geo[i] and its shape into the pools at the offsets `at` (vertices in
+ * the body frame; fixed bodies arrive in world coordinates with x = 0, q = 1). */
+static int copy_shape(lahar_dem_engine *e, const lahar_case *c, int i, const sp_counts *at, char *err, size_t errlen)
+{
+    const lahar_body *b = &c->bodies[i];
+    const lahar_shape *s = &b->shape;
+    sp_geo *g = &e->geo[i];
+    const int ov = at->nv, oe = at->ne, of = at->nf, ofv = at->nfv;
+    snprintf(e->names[i], LAHAR_NAME_MAX, "%s", b->name);
+    g->nv = s->nv;
+    g->ne = s->ne;
+    g->nf = s->nf;
+    g->v0 = ov;
+    g->va0 = ov + i;
+    g->e0 = oe;
+    g->f0 = of;
+    g->fs0 = of + i;
+    g->radius = s->radius;
+    g->material = b->material;
+    g->motion = b->motion;
+    g->mass = b->mass;
+    memcpy(g->inertia, b->inertia, sizeof g->inertia);
+    g->isotropic = g->inertia[0] == g->inertia[1] && g->inertia[1] == g->inertia[2];
+    g->grid = -1;
+    double rb = 0.0;
+    for (int k = 0; k < s->nv; k++) {
+        e->vb[ov + k] = v3_load(s->v[k]);
+        rb = fmax(rb, v3_norm(e->vb[ov + k]));
     }
+    g->bound = rb + s->radius;
+    for (int k = 0; k < s->ne; k++) {
+        e->edge[oe + k][0] = s->e[k][0];
+        e->edge[oe + k][1] = s->e[k][1];
+    }
+    for (int f = 0; f < s->nf; f++) {
+        e->fstart[g->fs0 + f] = ofv + s->face_start[f];
+        e->nb[of + f] = geom_face_normal(s, f);
+    }
+    e->fstart[g->fs0 + s->nf] = ofv + (s->nf > 0 ? s->face_start[s->nf] : 0);
+    int nfvi = s->nf > 0 ? s->face_start[s->nf] : 0;
+    for (int k = 0; k < nfvi; k++) {
+        if (s->face_v[k] < 0 || s->face_v[k] >= s->nv) {
+            snprintf(err, errlen, "spheropoly: body %d '%s': face uses a missing vertex", i, b->name);
+            return -1;
+        }
+        e->fv[ofv + k] = s->face_v[k];
+    }
+    return build_topology(e, i, s, err, errlen);
+}
+
+/* Body i's state. 2D bodies stay exactly in the x-y plane; a free body also carries its angular
+ * momentum, which the rotation integrates (body_update_omega turns it back into w). */
+static void set_initial_state(lahar_dem_engine *e, const lahar_body *b, int i)
+{
+    const sp_geo *g = &e->geo[i];
+    sp_state *st = &e->st[i];
+    st->x = v3_load(b->x);
+    st->q = q_normalize(q_load(b->q));
+    if (e->dim == 2) { /* keep 2D exactly planar */
+        st->x.z = 0.0;
+        st->q.x = st->q.y = 0.0;
+        st->q = q_normalize(st->q);
+    }
+    st->v = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->v);
+    st->w = b->motion == LAHAR_MOTION_FIXED ? v3(0, 0, 0) : v3_load(b->w);
+    if (e->dim == 2) {
+        st->v.z = 0.0;
+        st->w.x = st->w.y = 0.0;
+    }
+    if (b->motion != LAHAR_MOTION_FREE) return;
+    if (e->dim == 2) st->L = v3(0.0, 0.0, g->inertia[2] * st->w.z);
+    else {
+        vec3 wb = q_rotate_inv(st->q, st->w);
+        st->L = q_rotate(st->q, v3(g->inertia[0] * wb.x, g->inertia[1] * wb.y, g->inertia[2] * wb.z));
+    }
+}
+
+/* A body with many features (a terrain, an STL) gets a feature grid, so that a contact looks only
+ * at the features near its partner; `big` keeps the largest such body, which sizes the threads'
+ * query scratch. */
+static int build_body_grid(lahar_dem_engine *e, int i, const lahar_body *b, sp_counts *big, char *err, size_t errlen)
+{
+    const lahar_shape *s = &b->shape;
+    if (s->nv + s->ne + s->nf <= SP_GRID_MIN_FEATURES) return 0;
+    if (geom_feature_grid_build(&e->grids[e->ngrid], s)) {
+        e->ngrid++; /* counted: sp_destroy frees a half-built grid */
+        snprintf(err, errlen, "spheropoly: out of memory for the feature grid of body '%s'", b->name);
+        return -1;
+    }
+    e->geo[i].grid = e->ngrid++;
+    big->nv = s->nv > big->nv ? s->nv : big->nv;
+    big->ne = s->ne > big->ne ? s->ne : big->ne;
+    big->nf = s->nf > big->nf ? s->nf : big->nf;
+    return 0;
+}
+
+/* Body i in full: shape, state, its side of the broad phase (free bodies are binned, the others
+ * are boxes), its grid and its world geometry. `at` moves on to the next body's offsets. */
+static int load_body(lahar_dem_engine *e, const lahar_case *c, int i, sp_counts *at, sp_counts *big, char *err,
+                     size_t errlen)
+{
+    const lahar_body *b = &c->bodies[i];
+    const lahar_shape *s = &b->shape;
+    if (copy_shape(e, c, i, at, err, errlen)) return -1;
+    set_initial_state(e, b, i);
+    if (b->motion == LAHAR_MOTION_FREE) e->free_ids[e->nfree++] = i;
+    else e->large_ids[e->nlarge++] = i;
+    if (build_body_grid(e, i, b, big, err, errlen)) return -1;
+    at->nv += s->nv;
+    at->ne += s->ne;
+    at->nf += s->nf;
+    at->nfv += s->nf > 0 ? s->face_start[s->nf] : 0;
+    body_update_world(e, i);
+    return 0;
+}
+
+static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen)
+{
+    lahar_dem_engine *e = calloc(1, sizeof *e);
+    if (!e) {
+        sp_oom(err, errlen);
+        return NULL;
+    }
+    set_scene_constants(e, c);
+    int nb = c->nbody > 0 ? c->nbody : 0;
+    sp_counts tot, at = {0, 0, 0, 0}, big = {0, 0, 0, 0};
+    if (check_bodies(e, c, nb, &tot, err, errlen) || alloc_pools(e, nb, &tot, err, errlen) ||
+        make_pair_laws(e, c, err, errlen))
+        goto fail;
+    for (int i = 0; i < nb; i++)
+        if (load_body(e, c, i, &at, &big, err, errlen)) goto fail;
+    int maxv = big.nv, maxe = big.ne, maxf = big.nf;
     /* grid levels: the largest bounding diameter D sets the coarsest cell; a body lives in the
      * finest cell D / 2^h that still holds its diameter, so a boulder among gravel does not blow
      * the cell up for everybody, while sizes within a factor 2 share one level */
