@@ -1236,6 +1236,103 @@ static int load_body(lahar_dem_engine *e, const lahar_case *c, int i, sp_counts 
     return 0;
 }
 
+/* Grid levels: the largest bounding diameter D sets the coarsest cell; a body lives in the finest
+ * cell D / 2^h that still holds its diameter, so a boulder among gravel does not blow the cell up
+ * for everybody, while sizes within a factor 2 share one level. */
+static int make_grid_levels(lahar_dem_engine *e, int nb, char *err, size_t errlen)
+{
+    double dmax = 0.0;
+    for (int k = 0; k < e->nfree; k++) dmax = fmax(dmax, 2.0 * e->geo[e->free_ids[k]].bound);
+    dmax = dmax > 0.0 ? dmax * (1.0 + 1e-9) : 1.0;
+    e->level = xcalloc((size_t)nb, sizeof(int));
+    if (!e->level) return sp_oom(err, errlen);
+    int hmax = 0;
+    for (int k = 0; k < e->nfree; k++) {
+        double dk = 2.0 * e->geo[e->free_ids[k]].bound;
+        int hk = 0; /* halvings of D that still hold dk */
+        while (hk < 20 && ldexp(dmax, -(hk + 1)) >= dk) hk++;
+        e->level[k] = hk;
+        hmax = hk > hmax ? hk : hmax;
+    }
+    e->nlevel = hmax + 1;
+    for (int k = 0; k < e->nfree; k++) {
+        e->level[k] = hmax - e->level[k]; /* level 0 = finest, nlevel - 1 = coarsest (cell D) */
+        e->level_count[e->level[k]]++;
+    }
+    for (int l = 0; l < e->nlevel; l++) e->cell_inv[l] = 1.0 / ldexp(dmax, -(hmax - l));
+    return 0;
+}
+
+/* The broad phase's buckets, sized for the largest dense grid it builds (8 nfree + 1024 cells) and
+ * for the hash (at least 2 nfree entries), so that binning does not grow them. */
+static int alloc_broad_phase(lahar_dem_engine *e, int nb, char *err, size_t errlen)
+{
+    e->nhash = 16;
+    while (e->nhash < 2 * e->nfree) e->nhash *= 2;
+    e->bucket_cap = 8 * e->nfree + 1026 > e->nhash + 1 ? 8 * e->nfree + 1026 : e->nhash + 1;
+    e->bucket_start = xcalloc((size_t)e->bucket_cap, sizeof(int));
+    e->bucket_of = xcalloc((size_t)nb, sizeof(int));
+    e->bins = xcalloc((size_t)nb, sizeof(sp_bin));
+    if (!e->bucket_start || !e->bucket_of || !e->bins) return sp_oom(err, errlen);
+    return 0;
+}
+
+/* Per thread of the narrow phase: a feature-grid query able to serve the largest gridded body
+ * (big) and the feature culling's scratch for the largest body of all. */
+static int alloc_thread_scratch(lahar_dem_engine *e, int nb, const sp_counts *big, char *err, size_t errlen)
+{
+    e->nthr = omp_get_max_threads();
+    if (e->nthr < 1) e->nthr = 1;
+    e->thr = xcalloc((size_t)e->nthr, sizeof(sp_thread));
+    if (!e->thr) return sp_oom(err, errlen);
+    int allv = 1, alle = 1, allf = 1;
+    for (int i = 0; i < nb; i++) {
+        allv = e->geo[i].nv > allv ? e->geo[i].nv : allv;
+        alle = e->geo[i].ne > alle ? e->geo[i].ne : alle;
+        allf = e->geo[i].nf > allf ? e->geo[i].nf : allf;
+    }
+    for (int t = 0; t < e->nthr; t++) {
+        sp_thread *th = &e->thr[t];
+        int bad = geom_feature_query_init(&th->fq, big->nv, big->ne, big->nf);
+        th->emid = malloc(sizeof(vec3) * (size_t)alle);
+        th->ehalf = malloc(sizeof(double) * (size_t)alle);
+        bad |= !th->emid || !th->ehalf;
+        for (int sd = 0; sd < 2; sd++) {
+            th->keep[sd][0] = malloc(sizeof(int) * (size_t)allv);
+            th->keep[sd][1] = malloc(sizeof(int) * (size_t)alle);
+            th->keep[sd][2] = malloc(sizeof(int) * (size_t)allf);
+            bad |= !th->keep[sd][0] || !th->keep[sd][1] || !th->keep[sd][2];
+        }
+        if (bad) return sp_oom(err, errlen);
+    }
+    return 0;
+}
+
+/* Pre-size the per-step arrays for a dense pile (about 3 contacts and 4 pairs per body, up to
+ * 4 points for a face on a face) so that the steady state never grows them; they still double
+ * when a scene needs more (test_dem_noalloc checks that advance allocates nothing). */
+static int presize_step_arrays(lahar_dem_engine *e, int nb, char *err, size_t errlen)
+{
+    int ccap = 4 * nb + 64, pcap = 8 * e->nfree + 64;
+    e->pairs = malloc(sizeof(int[2]) * (size_t)pcap);
+    e->cur = malloc(sizeof(sp_contact) * (size_t)ccap);
+    e->prev = malloc(sizeof(sp_contact) * (size_t)ccap);
+    int hcap = 16;
+    while (hcap < 2 * ccap) hcap *= 2;
+    e->hash = malloc(sizeof(int) * (size_t)hcap);
+    e->vhash = malloc(sizeof(int) * (size_t)hcap);
+    if (!e->pairs || !e->cur || !e->prev || !e->hash || !e->vhash) return sp_oom(err, errlen);
+    e->pair_cap = pcap;
+    e->contact_cap = ccap;
+    e->hash_cap = hcap;
+    for (int t = 0; t < e->nthr; t++) { /* one static block of pairs may hold most contacts */
+        e->thr[t].c = malloc(sizeof(sp_contact) * (size_t)ccap);
+        if (!e->thr[t].c) return sp_oom(err, errlen);
+        e->thr[t].cap = ccap;
+    }
+    return 0;
+}
+
 static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen)
 {
     lahar_dem_engine *e = calloc(1, sizeof *e);
@@ -1251,97 +1348,12 @@ static lahar_dem_engine *sp_create(const lahar_case *c, char *err, size_t errlen
         goto fail;
     for (int i = 0; i < nb; i++)
         if (load_body(e, c, i, &at, &big, err, errlen)) goto fail;
-    int maxv = big.nv, maxe = big.ne, maxf = big.nf;
-    /* grid levels: the largest bounding diameter D sets the coarsest cell; a body lives in the
-     * finest cell D / 2^h that still holds its diameter, so a boulder among gravel does not blow
-     * the cell up for everybody, while sizes within a factor 2 share one level */
-    double dmax = 0.0;
-    for (int k = 0; k < e->nfree; k++) dmax = fmax(dmax, 2.0 * e->geo[e->free_ids[k]].bound);
-    dmax = dmax > 0.0 ? dmax * (1.0 + 1e-9) : 1.0;
-    e->level = xcalloc((size_t)nb, sizeof(int));
-    if (!e->level) {
-        snprintf(err, errlen, "spheropoly: out of memory");
+    if (make_grid_levels(e, nb, err, errlen) || alloc_broad_phase(e, nb, err, errlen) ||
+        alloc_thread_scratch(e, nb, &big, err, errlen) || presize_step_arrays(e, nb, err, errlen))
         goto fail;
-    }
-    int hmax = 0;
-    for (int k = 0; k < e->nfree; k++) {
-        double dk = 2.0 * e->geo[e->free_ids[k]].bound;
-        int hk = 0; /* halvings of D that still hold dk */
-        while (hk < 20 && ldexp(dmax, -(hk + 1)) >= dk) hk++;
-        e->level[k] = hk;
-        hmax = hk > hmax ? hk : hmax;
-    }
-    e->nlevel = hmax + 1;
-    for (int k = 0; k < e->nfree; k++) {
-        e->level[k] = hmax - e->level[k]; /* level 0 = finest, nlevel - 1 = coarsest (cell D) */
-        e->level_count[e->level[k]]++;
-    }
-    for (int l = 0; l < e->nlevel; l++) e->cell_inv[l] = 1.0 / ldexp(dmax, -(hmax - l));
-    e->nhash = 16;
-    while (e->nhash < 2 * e->nfree) e->nhash *= 2;
-    e->bucket_cap = 8 * e->nfree + 1026 > e->nhash + 1 ? 8 * e->nfree + 1026 : e->nhash + 1;
-    e->bucket_start = xcalloc((size_t)e->bucket_cap, sizeof(int));
-    e->bucket_of = xcalloc((size_t)nb, sizeof(int));
-    e->bins = xcalloc((size_t)nb, sizeof(sp_bin));
-    e->nthr = omp_get_max_threads();
-    if (e->nthr < 1) e->nthr = 1;
-    e->thr = xcalloc((size_t)e->nthr, sizeof(sp_thread));
-    if (!e->bucket_start || !e->bucket_of || !e->bins || !e->thr) {
-        snprintf(err, errlen, "spheropoly: out of memory");
-        goto fail;
-    }
-    int allv = 1, alle = 1, allf = 1;
-    for (int i = 0; i < nb; i++) {
-        allv = e->geo[i].nv > allv ? e->geo[i].nv : allv;
-        alle = e->geo[i].ne > alle ? e->geo[i].ne : alle;
-        allf = e->geo[i].nf > allf ? e->geo[i].nf : allf;
-    }
-    for (int t = 0; t < e->nthr; t++) {
-        sp_thread *th = &e->thr[t];
-        int bad = geom_feature_query_init(&th->fq, maxv, maxe, maxf);
-        th->emid = malloc(sizeof(vec3) * (size_t)alle);
-        th->ehalf = malloc(sizeof(double) * (size_t)alle);
-        bad |= !th->emid || !th->ehalf;
-        for (int sd = 0; sd < 2; sd++) {
-            th->keep[sd][0] = malloc(sizeof(int) * (size_t)allv);
-            th->keep[sd][1] = malloc(sizeof(int) * (size_t)alle);
-            th->keep[sd][2] = malloc(sizeof(int) * (size_t)allf);
-            bad |= !th->keep[sd][0] || !th->keep[sd][1] || !th->keep[sd][2];
-        }
-        if (bad) {
-            snprintf(err, errlen, "spheropoly: out of memory");
-            goto fail;
-        }
-    }
-    /* Pre-size the per-step arrays for a dense pile (about 3 contacts and 4 pairs per body, up to
-     * 4 points for a face on a face) so that the steady state never grows them; they still double
-     * when a scene needs more (test_dem_noalloc checks that advance allocates nothing). */
-    int ccap = 4 * nb + 64, pcap = 8 * e->nfree + 64;
-    e->pairs = malloc(sizeof(int[2]) * (size_t)pcap);
-    e->cur = malloc(sizeof(sp_contact) * (size_t)ccap);
-    e->prev = malloc(sizeof(sp_contact) * (size_t)ccap);
-    int hcap = 16;
-    while (hcap < 2 * ccap) hcap *= 2;
-    e->hash = malloc(sizeof(int) * (size_t)hcap);
-    e->vhash = malloc(sizeof(int) * (size_t)hcap);
-    if (!e->pairs || !e->cur || !e->prev || !e->hash || !e->vhash) {
-        snprintf(err, errlen, "spheropoly: out of memory");
-        goto fail;
-    }
-    e->pair_cap = pcap;
-    e->contact_cap = ccap;
-    e->hash_cap = hcap;
-    for (int t = 0; t < e->nthr; t++) { /* one static block of pairs may hold most contacts */
-        e->thr[t].c = malloc(sizeof(sp_contact) * (size_t)ccap);
-        if (!e->thr[t].c) {
-            snprintf(err, errlen, "spheropoly: out of memory");
-            goto fail;
-        }
-        e->thr[t].cap = ccap;
-    }
     e->dt_stable = stable_dt_of(e, c);
     if (!(e->dt_stable > 0.0)) {
-        snprintf(err, errlen, "spheropoly: out of memory");
+        sp_oom(err, errlen);
         goto fail;
     }
     if (sps_create(e, err, errlen)) goto fail;
