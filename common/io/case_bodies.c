@@ -203,10 +203,152 @@ static int mass_cache_apply(mass_cache *mc, lahar_shape *s, int dim, lahar_mass_
 
 /* Build the body's shape in its local frame (coordinates relative to `position`, before the
  * orientation). Returns 0 or -1 (message already reported). */
-static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
+/* shape: box, size: the OUTER size; the core is size - 2 radius. */
+static int shape_from_box(reader *r, rmap *m, double radius, lahar_shape *s)
+{
+    const int dim = r->dim;
+    double size[3] = {0, 0, 0}, half[3] = {0, 0, 0};
+    rmap_vec(m, "size", dim, size, 1, dim == 3 ? "[0.2, 0.1, 0.1]" : "[0.2, 0.1]");
+    if (r->failed)
+        return -1;
+    for (int k = 0; k < dim; k++) {
+        if (!(size[k] > 2.0 * radius)) {
+            rmap_fail(m, "size", "every side must be > 2 radius = %g m (got %g); size is the OUTER size, the "
+                      "core is size - 2 radius", 2.0 * radius, size[k]);
+            return -1;
+        }
+        half[k] = 0.5 * size[k] - radius;
+    }
+    return dim == 3 ? lahar_shape_make_box(s, half, radius) : lahar_shape_make_box2d(s, half, radius);
+}
+
+/* shape: plane, a rectangle of `size` with outward `normal`. */
+static int shape_from_plane(reader *r, rmap *m, double radius, lahar_shape *s)
+{
+    double size[2] = {0, 0}, nrm[3] = {0, 0, 0}, zero[3] = {0, 0, 0};
+    rmap_vec(m, "normal", 3, nrm, 1, "[0, 0, 1]");
+    rmap_vec(m, "size", 2, size, 1, "[1.0, 1.0]");
+    if (r->failed)
+        return -1;
+    if (!(v3_norm(v3_load(nrm)) > 0)) {
+        rmap_fail(m, "normal", "must not be the zero vector; it is the outward normal of the rectangle");
+        return -1;
+    }
+    if (!(size[0] > 0 && size[1] > 0)) {
+        rmap_fail(m, "size", "both sides must be > 0 m (got [%g, %g])", size[0], size[1]);
+        return -1;
+    }
+    return lahar_shape_make_plane(s, zero, nrm, size, radius);
+}
+
+/* shape: polyhedron with `faces:` (counter-clockwise seen from outside); a moving body must be
+ * convex. */
+static int shape_from_faces(reader *r, rmap *m, yaml_node_t *fn, const double (*p)[3], int np, int motion,
+                            double radius, lahar_shape *s)
+{
+    int *fs = NULL, *fv = NULL, nf = 0, rc = -1;
+    char fkey[KEY_MAX], err[512] = "";
+    rd_key_join(m->prefix, "faces", fkey);
+    if (read_faces(r, fn, fkey, &fs, &fv, &nf) != 0)
+        return -1;
+    rc = lahar_shape_make_polyhedron(s, p, np, fs, fv, nf, radius, err, sizeof err);
+    if (rc != 0)
+        rd_fail(r, fn, fkey, "%s; fix the faces or drop `faces:` to use the convex hull of the vertices", err);
+    else if (lahar_shape_core_volume(s) <= 0) {
+        rd_fail(r, fn, fkey, "the faces are clockwise seen from outside (the core volume is %g); list every "
+                "face's vertices counter-clockwise seen from outside", lahar_shape_core_volume(s));
+        lahar_shape_free(s);
+        rc = -1;
+    } else if (motion != LAHAR_MOTION_FIXED) {
+        double L = 0;
+        for (int i = 0; i < np; i++)
+            L = fmax(L, v3_norm(v3_load(p[i])));
+        if (!lahar_shape_is_convex(s, 3, 1e-9 * (L > 0 ? L : 1))) {
+            rd_fail(r, fn, fkey, "the polyhedron is not convex, but moving bodies must be convex; drop `faces:` to "
+                    "use the convex hull, or split the body");
+            lahar_shape_free(s);
+            rc = -1;
+        }
+    }
+    free(fs);
+    free(fv);
+    return rc;
+}
+
+/* The shapes made of `vertices:`: segment (2 points), polyline (open or `closed`), polygon (their
+ * convex hull, 2D), polyhedron (their convex hull, or `faces:`). */
+static int shape_from_points(reader *r, rmap *m, int kind, int motion, double radius, lahar_shape *s)
 {
     const int dim = r->dim;
     char key[KEY_MAX], err[512] = "";
+    yaml_node_t *vn = rmap_get(m, "vertices");
+    if (!vn) {
+        rmap_missing(m, "vertices", dim == 3 ? "[[0, 0, 0], [1, 0, 0], ...]" : "[[0, 0], [1, 0], ...]");
+        return -1;
+    }
+    rd_key_join(m->prefix, "vertices", key);
+    int np = 0, rc = -1;
+    double (*p)[3] = case_read_points(r, vn, key, dim, &np);
+    if (!p)
+        return -1;
+    const double(*cp)[3] = (const double(*)[3])p;
+    if (kind == SH_SEGMENT) {
+        if (np != 2)
+            rd_fail(r, vn, key, "a segment has exactly 2 vertices (got %d)", np);
+        else if (v3_norm(v3_sub(v3_load(p[0]), v3_load(p[1]))) == 0.0)
+            rd_fail(r, vn, key, "the two vertices coincide; use shape: %s for a single point",
+                    dim == 3 ? "sphere" : "disc");
+        else
+            rc = lahar_shape_make_segment(s, p[0], p[1], radius);
+    } else if (kind == SH_POLYLINE) {
+        int closed = rd_key_bool(m, "closed");
+        if (!r->failed) {
+            rc = lahar_shape_make_polyline(s, cp, np, closed, radius, err, sizeof err);
+            if (rc != 0)
+                rd_fail(r, vn, key, "%s; fix the points", err);
+        }
+    } else if (kind == SH_POLYGON) {
+        rc = lahar_shape_make_polygon_hull(s, cp, np, radius, err, sizeof err);
+        if (rc != 0)
+            rd_fail(r, vn, key, "%s; a polygon needs 3 or more points not on one line", err);
+    } else if (rmap_get(m, "faces")) {
+        rc = shape_from_faces(r, m, rmap_get(m, "faces"), cp, np, motion, radius, s);
+    } else {
+        rc = lahar_shape_make_hull(s, cp, np, radius, err, sizeof err);
+        if (rc != 0)
+            rd_fail(r, vn, key, "%s; a polyhedron needs 4 or more points not all in one plane", err);
+    }
+    free(p);
+    return rc;
+}
+
+/* shape: stl, `file` relative to the case file's directory, coordinates times `scale`. */
+static int shape_from_stl(reader *r, rmap *m, double radius, lahar_shape *s)
+{
+    char err[512] = "";
+    const char *file = rmap_str(m, "file", 1, NULL, "terrain.stl");
+    double scale = rmap_num(m, "scale", 0, 1.0, "0.001");
+    if (r->failed)
+        return -1;
+    if (!(scale > 0)) {
+        rmap_fail(m, "scale", "must be > 0 (got %g); it multiplies the STL coordinates, e.g. 0.001 for mm", scale);
+        return -1;
+    }
+    char full[2048];
+    if (file[0] == '/')
+        snprintf(full, sizeof full, "%s", file);
+    else
+        snprintf(full, sizeof full, "%s%s", r->dir, file);
+    int rc = lahar_shape_read_stl(s, full, radius, err, sizeof err);
+    if (rc != 0)
+        rmap_fail(m, "file", "%s; STL paths are relative to the case file's directory", err);
+    else
+        lahar_shape_transform(s, NULL, NULL, scale);
+    return rc;
+}
+
+static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
+{
     double radius = rmap_num(m, "radius", 1, 0.0, kind == SH_SPHERE || kind == SH_DISC ? "0.05" : "0.005");
     if (r->failed)
         return -1;
@@ -223,139 +365,167 @@ static int build_shape(reader *r, rmap *m, int kind, int motion, lahar_shape *s)
     case SH_DISC:
         rc = lahar_shape_make_sphere(s, radius);
         break;
-    case SH_BOX: {
-        double size[3] = {0, 0, 0}, half[3] = {0, 0, 0};
-        rmap_vec(m, "size", dim, size, 1, dim == 3 ? "[0.2, 0.1, 0.1]" : "[0.2, 0.1]");
-        if (r->failed)
-            return -1;
-        for (int k = 0; k < dim; k++) {
-            if (!(size[k] > 2.0 * radius)) {
-                rmap_fail(m, "size", "every side must be > 2 radius = %g m (got %g); size is the OUTER size, the "
-                          "core is size - 2 radius", 2.0 * radius, size[k]);
-                return -1;
-            }
-            half[k] = 0.5 * size[k] - radius;
-        }
-        rc = dim == 3 ? lahar_shape_make_box(s, half, radius) : lahar_shape_make_box2d(s, half, radius);
+    case SH_BOX:
+        rc = shape_from_box(r, m, radius, s);
         break;
-    }
-    case SH_PLANE: {
-        double size[2] = {0, 0}, nrm[3] = {0, 0, 0}, zero[3] = {0, 0, 0};
-        rmap_vec(m, "normal", 3, nrm, 1, "[0, 0, 1]");
-        rmap_vec(m, "size", 2, size, 1, "[1.0, 1.0]");
-        if (r->failed)
-            return -1;
-        if (!(v3_norm(v3_load(nrm)) > 0)) {
-            rmap_fail(m, "normal", "must not be the zero vector; it is the outward normal of the rectangle");
-            return -1;
-        }
-        if (!(size[0] > 0 && size[1] > 0)) {
-            rmap_fail(m, "size", "both sides must be > 0 m (got [%g, %g])", size[0], size[1]);
-            return -1;
-        }
-        rc = lahar_shape_make_plane(s, zero, nrm, size, radius);
+    case SH_PLANE:
+        rc = shape_from_plane(r, m, radius, s);
         break;
-    }
     case SH_SEGMENT:
     case SH_POLYLINE:
     case SH_POLYGON:
-    case SH_POLYHEDRON: {
-        yaml_node_t *vn = rmap_get(m, "vertices");
-        if (!vn) {
-            rmap_missing(m, "vertices", dim == 3 ? "[[0, 0, 0], [1, 0, 0], ...]" : "[[0, 0], [1, 0], ...]");
-            return -1;
-        }
-        rd_key_join(m->prefix, "vertices", key);
-        int np = 0;
-        double (*p)[3] = case_read_points(r, vn, key, dim, &np);
-        if (!p)
-            return -1;
-        if (kind == SH_SEGMENT) {
-            if (np != 2)
-                rd_fail(r, vn, key, "a segment has exactly 2 vertices (got %d)", np);
-            else if (v3_norm(v3_sub(v3_load(p[0]), v3_load(p[1]))) == 0.0)
-                rd_fail(r, vn, key, "the two vertices coincide; use shape: %s for a single point",
-                        dim == 3 ? "sphere" : "disc");
-            else
-                rc = lahar_shape_make_segment(s, p[0], p[1], radius);
-        } else if (kind == SH_POLYLINE) {
-            int closed = rd_key_bool(m, "closed");
-            if (!r->failed) {
-                rc = lahar_shape_make_polyline(s, (const double(*)[3])p, np, closed, radius, err, sizeof err);
-                if (rc != 0)
-                    rd_fail(r, vn, key, "%s; fix the points", err);
-            }
-        } else if (kind == SH_POLYGON) {
-            rc = lahar_shape_make_polygon_hull(s, (const double(*)[3])p, np, radius, err, sizeof err);
-            if (rc != 0)
-                rd_fail(r, vn, key, "%s; a polygon needs 3 or more points not on one line", err);
-        } else {
-            yaml_node_t *fn = rmap_get(m, "faces");
-            if (!fn) {
-                rc = lahar_shape_make_hull(s, (const double(*)[3])p, np, radius, err, sizeof err);
-                if (rc != 0)
-                    rd_fail(r, vn, key, "%s; a polyhedron needs 4 or more points not all in one plane", err);
-            } else {
-                int *fs = NULL, *fv = NULL, nf = 0;
-                char fkey[KEY_MAX];
-                rd_key_join(m->prefix, "faces", fkey);
-                if (read_faces(r, fn, fkey, &fs, &fv, &nf) == 0) {
-                    rc = lahar_shape_make_polyhedron(s, (const double(*)[3])p, np, fs, fv, nf, radius, err, sizeof err);
-                    if (rc != 0)
-                        rd_fail(r, fn, fkey, "%s; fix the faces or drop `faces:` to use the "
-                                "convex hull of the vertices", err);
-                    else if (lahar_shape_core_volume(s) <= 0) {
-                        rd_fail(r, fn, fkey, "the faces are clockwise seen from outside (the core volume is %g); "
-                                "list every face's vertices counter-clockwise seen from outside",
-                                lahar_shape_core_volume(s));
-                        lahar_shape_free(s);
-                        rc = -1;
-                    } else if (motion != LAHAR_MOTION_FIXED) {
-                        double L = 0;
-                        for (int i = 0; i < np; i++)
-                            L = fmax(L, v3_norm(v3_load(p[i])));
-                        if (!lahar_shape_is_convex(s, 3, 1e-9 * (L > 0 ? L : 1))) {
-                            rd_fail(r, fn, fkey, "the polyhedron is not convex, but moving bodies must be convex; "
-                                    "drop `faces:` to use the convex hull, or split the body");
-                            lahar_shape_free(s);
-                            rc = -1;
-                        }
-                    }
-                    free(fs);
-                    free(fv);
-                }
-            }
-        }
-        free(p);
+    case SH_POLYHEDRON:
+        rc = shape_from_points(r, m, kind, motion, radius, s);
         break;
-    }
-    case SH_STL: {
-        const char *file = rmap_str(m, "file", 1, NULL, "terrain.stl");
-        double scale = rmap_num(m, "scale", 0, 1.0, "0.001");
-        if (r->failed)
-            return -1;
-        if (!(scale > 0)) {
-            rmap_fail(m, "scale", "must be > 0 (got %g); it multiplies the STL coordinates, e.g. 0.001 for mm", scale);
-            return -1;
-        }
-        char full[2048];
-        if (file[0] == '/')
-            snprintf(full, sizeof full, "%s", file);
-        else
-            snprintf(full, sizeof full, "%s%s", r->dir, file);
-        rc = lahar_shape_read_stl(s, full, radius, err, sizeof err);
-        if (rc != 0)
-            rmap_fail(m, "file", "%s; STL paths are relative to the case file's directory", err);
-        else
-            lahar_shape_transform(s, NULL, NULL, scale);
+    case SH_STL:
+        rc = shape_from_stl(r, m, radius, s);
         break;
-    }
     default:
         break;
     }
     if (rc != 0 && !r->failed)
         rd_fail(r, m->node, m->prefix, "out of memory building the shape");
     return r->failed ? -1 : 0;
+}
+
+/* bodies[i].shape, and the keys of bodies[] (case_keys.c) that belong to it: -1 on error. */
+static int read_body_shape_kind(rmap *m)
+{
+    const lahar_key_section *sec = lahar_key_section_find("bodies[]");
+    m->sec = sec;
+    int kind = rd_key_choice(m, "shape");
+    if (m->r->failed)
+        return -1;
+    const char *keys[32];
+    int nk = 0;
+    for (const lahar_key *k = sec ? sec->keys : NULL; k && k->name && nk < 31; k++)
+        if (lahar_key_applies(k, shape_name(kind)))
+            keys[nk++] = k->name;
+    keys[nk] = NULL;
+    rmap_check_keys(m, keys);
+    m->sec = sec;
+    return kind;
+}
+
+/* bodies[i].material (read as mat): a DEM material of the materials: section, or the error naming
+ * the closest one. */
+static int find_body_material(rmap *m, const char *mat, const lahar_case *c, lahar_body *b)
+{
+    b->material = lahar_case_find_material(c, mat);
+    if (b->material < 0) {
+        const char *names[64];
+        int nn = 0;
+        for (int k = 0; k < c->nmaterial && nn < 63; k++)
+            names[nn++] = c->materials[k].name;
+        names[nn] = NULL;
+        char list[512];
+        rd_join_names(names, list, sizeof list);
+        const char *near = rd_closest_name(mat, names);
+        if (nn == 0)
+            rmap_fail(m, "material", "unknown material '%s'; define it in the materials: section", mat);
+        else if (near)
+            rmap_fail(m, "material", "unknown material '%s'; did you mean '%s'? (materials: %s)", mat, near, list);
+        else
+            rmap_fail(m, "material", "unknown material '%s'; define it in materials: (defined: %s)", mat, list);
+        return -1;
+    }
+    if (c->materials[b->material].model == LAHAR_CONTACT_SOIL) {
+        rmap_fail(m, "material", "'%s' is an SPH soil (model: soil); a body needs a DEM material (model: hertz or "
+                  "linear)", mat);
+        return -1;
+    }
+    return 0;
+}
+
+/* Where a body starts and how it moves: bodies[i].position, orientation, velocity and
+ * angular_velocity (the velocities: has_v, has_w when given). */
+typedef struct {
+    double pos[3], vel[3], omega[3];
+    quat q;
+    int has_v, has_w;
+} body_start;
+
+static void read_body_orientation(rmap *m, yaml_node_t *on, quat *q)
+{
+    static const char *const okeys3[] = {"axis", "angle_deg", NULL};
+    static const char *const okeys2[] = {"angle_deg", NULL};
+    const int dim = m->r->dim;
+    char ok[KEY_MAX];
+    rd_key_join(m->prefix, "orientation", ok);
+    rmap om;
+    if (rmap_open(m->r, on, ok, &om) != 0)
+        return;
+    rmap_check_keys(&om, dim == 3 ? okeys3 : okeys2);
+    double axis[3] = {0, 0, 1};
+    if (dim == 3)
+        rmap_vec(&om, "axis", 3, axis, 0, "");
+    double ang = rmap_num(&om, "angle_deg", 1, 0.0, "30");
+    if (!m->r->failed && !(v3_norm(v3_load(axis)) > 0))
+        rmap_fail(&om, "axis", "must not be the zero vector");
+    *q = q_axis_angle(v3_normalize(v3_load(axis)), ang * M_PI / 180.0);
+}
+
+static int read_body_start(rmap *m, lahar_motion motion, body_start *bs)
+{
+    const int dim = m->r->dim;
+    memset(bs, 0, sizeof *bs);
+    rmap_vec(m, "position", dim, bs->pos, 0, "");
+    bs->q = q_identity();
+    yaml_node_t *on = rmap_get(m, "orientation");
+    if (on && !m->r->failed)
+        read_body_orientation(m, on, &bs->q);
+    bs->has_v = rmap_vec(m, "velocity", dim, bs->vel, 0, "");
+    if (dim == 3)
+        bs->has_w = rmap_vec(m, "angular_velocity", 3, bs->omega, 0, "");
+    else if (rmap_get(m, "angular_velocity")) {
+        bs->omega[2] = rmap_num(m, "angular_velocity", 0, 0.0, "");
+        bs->has_w = 1;
+    }
+    if (m->r->failed)
+        return -1;
+    if (motion == LAHAR_MOTION_FIXED && (bs->has_v || bs->has_w)) {
+        rmap_fail(m, bs->has_v ? "velocity" : "angular_velocity", "a fixed body does not move; remove it, or use "
+                  "`motion: prescribed` for a wall that moves at a given velocity");
+        return -1;
+    }
+    return 0;
+}
+
+/* A wall keeps world-frame geometry with identity orientation; mass 0 marks it immovable. The
+ * convexity test costs faces x vertices: large meshes (terrain) are marked non-convex, which only
+ * means the engine treats them with the general mesh path. */
+static void place_fixed_body(lahar_body *b, const body_start *bs, int dim)
+{
+    double R[3][3];
+    q_to_rotmat(bs->q, R);
+    lahar_shape *s = &b->shape;
+    lahar_shape_transform(s, (const double(*)[3])R, bs->pos, 1.0);
+    b->q[0] = 1.0;
+    b->convex = (double)s->nf * s->nv <= 5e7 && lahar_shape_is_convex(s, dim, 1e-9 * (s->radius + 1.0));
+}
+
+/* A moving body: its mass properties from the shape and the material's density, its position at
+ * the centre of mass and its orientation along the principal axes. */
+static void place_moving_body(reader *r, yaml_node_t *n, const char *prefix, const lahar_case *c, mass_cache *mc,
+                              lahar_body *b, const body_start *bs)
+{
+    char err[256] = "";
+    lahar_mass_props mp;
+    if (mass_cache_apply(mc, &b->shape, r->dim, &mp, err, sizeof err) != 0) {
+        rd_fail(r, n, prefix, "cannot compute mass properties: %s", err[0] ? err : "out of memory");
+        return;
+    }
+    double rho = c->materials[b->material].density;
+    b->convex = 1;
+    b->mass = rho * mp.volume;
+    for (int k = 0; k < 3; k++)
+        b->inertia[k] = rho * mp.inertia[k];
+    vec3 com = q_rotate(bs->q, v3_load(mp.com));
+    v3_store(v3_add(v3_load(bs->pos), com), b->x);
+    quat qb = q_normalize(q_mul(bs->q, q_from_rotmat((const double(*)[3])mp.axes)));
+    q_store(qb, b->q);
+    memcpy(b->v, bs->vel, sizeof bs->vel);
+    memcpy(b->w, bs->omega, sizeof bs->omega);
 }
 
 static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cache *mc)
@@ -367,21 +537,9 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
     if (rmap_open(r, n, prefix, &m) != 0)
         return;
     lahar_body *b = &c->bodies[i];
-    const lahar_key_section *sec = lahar_key_section_find("bodies[]");
-    m.sec = sec;
-    int kind = rd_key_choice(&m, "shape");
-    if (r->failed)
+    int kind = read_body_shape_kind(&m);
+    if (kind < 0)
         return;
-    /* the keys of bodies[] (case_keys.c) that belong to this shape */
-    const char *keys[32];
-    int nk = 0;
-    for (const lahar_key *k = sec ? sec->keys : NULL; k && k->name && nk < 31; k++)
-        if (lahar_key_applies(k, shape_name(kind)))
-            keys[nk++] = k->name;
-    keys[nk] = NULL;
-    rmap_check_keys(&m, keys);
-    m.sec = sec;
-
     char defname[LAHAR_NAME_MAX];
     snprintf(defname, sizeof defname, "body%d", i);
     rmap_name(&m, "name", 0, defname, b->name);
@@ -407,98 +565,14 @@ static void read_body(reader *r, yaml_node_t *n, int i, lahar_case *c, mass_cach
                   kind == SH_STL ? " (STL surfaces may be open and non-convex)" : "");
         return;
     }
-    b->material = lahar_case_find_material(c, mat);
-    if (b->material < 0) {
-        const char *names[64];
-        int nn = 0;
-        for (int k = 0; k < c->nmaterial && nn < 63; k++)
-            names[nn++] = c->materials[k].name;
-        names[nn] = NULL;
-        char list[512];
-        rd_join_names(names, list, sizeof list);
-        const char *near = rd_closest_name(mat, names);
-        if (nn == 0)
-            rmap_fail(&m, "material", "unknown material '%s'; define it in the materials: section", mat);
-        else if (near)
-            rmap_fail(&m, "material", "unknown material '%s'; did you mean '%s'? (materials: %s)", mat, near, list);
-        else
-            rmap_fail(&m, "material", "unknown material '%s'; define it in materials: (defined: %s)", mat, list);
+    body_start bs;
+    if (find_body_material(&m, mat, c, b) != 0 || read_body_start(&m, b->motion, &bs) != 0 ||
+        build_shape(r, &m, kind, b->motion, &b->shape) != 0)
         return;
-    }
-    if (c->materials[b->material].model == LAHAR_CONTACT_SOIL) {
-        rmap_fail(&m, "material", "'%s' is an SPH soil (model: soil); a body needs a DEM material (model: hertz or "
-                  "linear)", mat);
-        return;
-    }
-
-    double pos[3] = {0, 0, 0}, vel[3] = {0, 0, 0}, omega[3] = {0, 0, 0};
-    rmap_vec(&m, "position", dim, pos, 0, "");
-    quat qu = q_identity();
-    yaml_node_t *on = rmap_get(&m, "orientation");
-    if (on && !r->failed) {
-        static const char *const okeys3[] = {"axis", "angle_deg", NULL};
-        static const char *const okeys2[] = {"angle_deg", NULL};
-        char ok[KEY_MAX];
-        rd_key_join(prefix, "orientation", ok);
-        rmap om;
-        if (rmap_open(r, on, ok, &om) == 0) {
-            rmap_check_keys(&om, dim == 3 ? okeys3 : okeys2);
-            double axis[3] = {0, 0, 1};
-            if (dim == 3)
-                rmap_vec(&om, "axis", 3, axis, 0, "");
-            double ang = rmap_num(&om, "angle_deg", 1, 0.0, "30");
-            if (!r->failed && !(v3_norm(v3_load(axis)) > 0))
-                rmap_fail(&om, "axis", "must not be the zero vector");
-            qu = q_axis_angle(v3_normalize(v3_load(axis)), ang * M_PI / 180.0);
-        }
-    }
-    int has_v = rmap_vec(&m, "velocity", dim, vel, 0, "");
-    int has_w = 0;
-    if (dim == 3)
-        has_w = rmap_vec(&m, "angular_velocity", 3, omega, 0, "");
-    else if (rmap_get(&m, "angular_velocity")) {
-        omega[2] = rmap_num(&m, "angular_velocity", 0, 0.0, "");
-        has_w = 1;
-    }
-    if (r->failed)
-        return;
-    if (b->motion == LAHAR_MOTION_FIXED && (has_v || has_w)) {
-        rmap_fail(&m, has_v ? "velocity" : "angular_velocity", "a fixed body does not move; remove it, or use "
-                  "`motion: prescribed` for a wall that moves at a given velocity");
-        return;
-    }
-
-    lahar_shape *s = &b->shape;
-    if (build_shape(r, &m, kind, b->motion, s) != 0)
-        return;
-    double R[3][3];
-    q_to_rotmat(qu, R);
-    if (b->motion == LAHAR_MOTION_FIXED) {
-        /* walls keep world-frame geometry with identity orientation, mass 0 marks "immovable" */
-        lahar_shape_transform(s, (const double(*)[3])R, pos, 1.0);
-        b->q[0] = 1.0;
-        /* the test costs faces x vertices: large meshes (terrain) are marked non-convex, which
-         * only means the engine treats them with the general mesh path */
-        b->convex = (double)s->nf * s->nv <= 5e7 && lahar_shape_is_convex(s, dim, 1e-9 * (s->radius + 1.0));
-        return;
-    }
-    char err[256] = "";
-    lahar_mass_props mp;
-    if (mass_cache_apply(mc, s, dim, &mp, err, sizeof err) != 0) {
-        rd_fail(r, n, prefix, "cannot compute mass properties: %s", err[0] ? err : "out of memory");
-        return;
-    }
-    double rho = c->materials[b->material].density;
-    b->convex = 1;
-    b->mass = rho * mp.volume;
-    for (int k = 0; k < 3; k++)
-        b->inertia[k] = rho * mp.inertia[k];
-    vec3 com = q_rotate(qu, v3_load(mp.com));
-    v3_store(v3_add(v3_load(pos), com), b->x);
-    quat qb = q_normalize(q_mul(qu, q_from_rotmat((const double(*)[3])mp.axes)));
-    q_store(qb, b->q);
-    memcpy(b->v, vel, sizeof vel);
-    memcpy(b->w, omega, sizeof omega);
+    if (b->motion == LAHAR_MOTION_FIXED)
+        place_fixed_body(b, &bs, dim);
+    else
+        place_moving_body(r, n, prefix, c, mc, b, &bs);
 }
 
 static void read_body_list(reader *r, yaml_node_t *n, lahar_case *c, mass_cache *mc, int *line)
