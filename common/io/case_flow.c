@@ -81,6 +81,146 @@ static int inflow_csv(rmap *m, const char *key, char *full, size_t n)
     return 0;
 }
 
+/* inlets[i].level (constant) or level_hydrograph (a t,h table: the level is its largest value, the
+ * slots of the section). */
+static int read_inlet_level(rmap *m, lahar_inlet *in)
+{
+    const int has_lt = rmap_get(m, "level_hydrograph") != NULL;
+    if (has_lt && rmap_get(m, "level")) {
+        rmap_fail(m, "level_hydrograph", "give either level: H (constant) or level_hydrograph: FILE.csv (t,h), "
+                  "not both");
+        return -1;
+    }
+    in->level = has_lt ? 1.0 : rd_key_num_req(m, "level", 1, NAN);
+    if (!has_lt)
+        return 0;
+    char full[2048], err[1400];
+    if (inflow_csv(m, "level_hydrograph", full, sizeof full) != 0)
+        return -1;
+    int kind = 0;
+    in->nlevel = lahar_hydrograph_read_csv(full, &kind, &in->level_t, &in->level_h, err, (int)sizeof err);
+    if (in->nlevel < 0) {
+        in->nlevel = 0;
+        rmap_fail(m, "level_hydrograph", "%s (paths are relative to the case file's directory)", err);
+        return -1;
+    }
+    if (kind != LAHAR_HYDRO_TABLE_H) {
+        rmap_fail(m, "level_hydrograph", "%s: the header must be `t,h` (a level table)", full);
+        return -1;
+    }
+    in->level = 0.0;
+    for (int k = 0; k < in->nlevel; k++) {
+        if (!(in->level_h[k] >= 0.0)) {
+            rmap_fail(m, "level_hydrograph", "%s: row %d (t = %g s) has a negative level %g m", full, k + 1,
+                      in->level_t[k], in->level_h[k]);
+            return -1;
+        }
+        in->level = fmax(in->level, in->level_h[k]);
+    }
+    return 0;
+}
+
+/* When the inlet runs, and its buffer's size: defaults and ranges from the key table (inlets[]);
+ * 0 layers / max_particles: computed at set-up. */
+static int read_inlet_window(rmap *m, lahar_inlet *in)
+{
+    in->t_start = rd_key_num(m, "start");
+    in->t_end = rd_key_num_def(m, "end", 1e300);
+    const double layers = rd_key_num_def(m, "layers", 0.0);
+    const double maxp = rd_key_num_def(m, "max_particles", 0.0);
+    if (m->r->failed)
+        return -1;
+    if (!(in->level > 0.0)) {
+        rmap_fail(m, in->nlevel ? "level_hydrograph" : "level", "must be > 0 (got %g%s): the water depth above the "
+                  "section's lowest point, m", in->level, in->nlevel ? " at most" : "");
+        return -1;
+    }
+    if (!(in->t_end > in->t_start)) {
+        rmap_fail(m, "end", "must be after start (%g s; got %g s): the inflow runs in [start, end)", in->t_start,
+                  in->t_end);
+        return -1;
+    }
+    in->layers = (int)layers;
+    in->max_particles = (int64_t)maxp;
+    return 0;
+}
+
+/* hydrograph: FILE.csv, a t,u or t,Q table of non-negative values. */
+static int read_inlet_hydrograph(rmap *m, lahar_inlet *in)
+{
+    char full[2048], err[1400];
+    if (inflow_csv(m, "hydrograph", full, sizeof full) != 0)
+        return -1;
+    in->ntable = lahar_hydrograph_read_csv(full, &in->kind, &in->table_t, &in->table_v, err, (int)sizeof err);
+    if (in->ntable < 0) {
+        in->ntable = 0;
+        rmap_fail(m, "hydrograph", "%s (paths are relative to the case file's directory)", err);
+        return -1;
+    }
+    if (in->kind == LAHAR_HYDRO_TABLE_H) {
+        rmap_fail(m, "hydrograph", "%s holds a level (header t,h); give it as level_hydrograph:, and the inflow as "
+                  "t,u or t,Q", full);
+        return -1;
+    }
+    for (int k = 0; k < in->ntable; k++)
+        if (!(in->table_v[k] >= 0.0)) {
+            rmap_fail(m, "hydrograph", "%s: row %d (t = %g s) has a negative value %g; the inflow is along the "
+                      "inward normal (no backflow through an inlet)", full, k + 1, in->table_t[k], in->table_v[k]);
+            return -1;
+        }
+    return 0;
+}
+
+/* The inflow: exactly one of velocity, gumbel or hydrograph. The buffer only moves forward (rows
+ * are created behind it): no backflow through an inlet. */
+static int read_inlet_flow(rmap *m, const char *prefix, lahar_inlet *in)
+{
+    reader *r = m->r;
+    const int has_v = rmap_get(m, "velocity") != NULL, has_g = rmap_get(m, "gumbel") != NULL,
+              has_h = rmap_get(m, "hydrograph") != NULL;
+    if (has_v + has_g + has_h != 1) {
+        rd_fail(r, m->node, prefix, "give exactly one of velocity: U (m/s), gumbel: [a_G, beta_G, mu_G] "
+                "(Trujillo-Vela et al. 2020, eq. 36) or hydrograph: FILE.csv (header t,u or t,Q)%s",
+                has_v + has_g + has_h ? "; it has more than one" : "");
+        return -1;
+    }
+    if (has_h)
+        return read_inlet_hydrograph(m, in);
+    if (has_v) {
+        in->kind = LAHAR_HYDRO_CONSTANT;
+        in->velocity = rd_key_num_req(m, "velocity", 1, NAN);
+        return 0;
+    }
+    in->kind = LAHAR_HYDRO_GUMBEL;
+    rmap_vec(m, "gumbel", 3, in->gumbel, 1, "[35, 2, 3]");
+    if (!r->failed && !(in->gumbel[1] > 0.0)) {
+        rmap_fail(m, "gumbel", "beta_G (the second number) must be > 0 (got %g s)", in->gumbel[1]);
+        return -1;
+    }
+    if (!r->failed && !(in->gumbel[0] >= 0.0)) {
+        rmap_fail(m, "gumbel", "a_G (the first number) must be >= 0 (got %g m): the inflow is along the inward "
+                  "normal", in->gumbel[0]);
+        return -1;
+    }
+    return 0;
+}
+
+static int read_inlet(reader *r, yaml_node_t *item, int i, lahar_inlet *in)
+{
+    char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
+    snprintf(prefix, sizeof prefix, "inlets[%d]", i);
+    snprintf(def, sizeof def, "inlet%d", i);
+    rmap m;
+    if (rmap_open(r, item, prefix, &m) != 0)
+        return -1;
+    rmap_section(&m, "inlets[]");
+    rmap_name(&m, "name", 0, def, in->name);
+    if (read_section(&m, r->dim, in->x0, in->e1, in->e2, in->n, "inward") != 0 || read_inlet_level(&m, in) != 0 ||
+        read_inlet_window(&m, in) != 0)
+        return -1;
+    return read_inlet_flow(&m, prefix, in);
+}
+
 void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
 {
     if (!n || r->failed)
@@ -103,117 +243,10 @@ void case_read_inlets(reader *r, yaml_node_t *n, lahar_case *c)
         rd_fail(r, n, "inlets", "out of memory");
         return;
     }
-    const int dim = r->dim;
     for (int i = 0; i < ni && !r->failed; i++) {
-        lahar_inlet *in = &c->inlets[i];
         c->ninlet = i + 1;
-        char prefix[KEY_MAX], def[LAHAR_NAME_MAX];
-        snprintf(prefix, sizeof prefix, "inlets[%d]", i);
-        snprintf(def, sizeof def, "inlet%d", i);
-        rmap m;
-        if (rmap_open(r, rd_seq_item(r, n, i), prefix, &m) != 0)
+        if (read_inlet(r, rd_seq_item(r, n, i), i, &c->inlets[i]) != 0)
             return;
-        rmap_section(&m, "inlets[]");
-        rmap_name(&m, "name", 0, def, in->name);
-        if (read_section(&m, dim, in->x0, in->e1, in->e2, in->n, "inward") != 0)
-            return;
-        const int has_lt = rmap_get(&m, "level_hydrograph") != NULL;
-        if (has_lt && rmap_get(&m, "level")) {
-            rmap_fail(&m, "level_hydrograph", "give either level: H (constant) or level_hydrograph: FILE.csv (t,h), "
-                      "not both");
-            return;
-        }
-        in->level = has_lt ? 1.0 : rd_key_num_req(&m, "level", 1, NAN);
-        if (has_lt) { /* a level table t,h: the level is its largest value (the slots of the section) */
-            char full[2048], err[1400];
-            if (inflow_csv(&m, "level_hydrograph", full, sizeof full) != 0)
-                return;
-            int kind = 0;
-            in->nlevel = lahar_hydrograph_read_csv(full, &kind, &in->level_t, &in->level_h, err, (int)sizeof err);
-            if (in->nlevel < 0) {
-                in->nlevel = 0;
-                rmap_fail(&m, "level_hydrograph", "%s (paths are relative to the case file's directory)", err);
-                return;
-            }
-            if (kind != LAHAR_HYDRO_TABLE_H) {
-                rmap_fail(&m, "level_hydrograph", "%s: the header must be `t,h` (a level table)", full);
-                return;
-            }
-            in->level = 0.0;
-            for (int k = 0; k < in->nlevel; k++) {
-                if (!(in->level_h[k] >= 0.0)) {
-                    rmap_fail(&m, "level_hydrograph", "%s: row %d (t = %g s) has a negative level %g m", full, k + 1,
-                              in->level_t[k], in->level_h[k]);
-                    return;
-                }
-                in->level = fmax(in->level, in->level_h[k]);
-            }
-        }
-        /* defaults and ranges: the key table (inlets[]); 0 layers / max_particles: computed at set-up */
-        in->t_start = rd_key_num(&m, "start");
-        in->t_end = rd_key_num_def(&m, "end", 1e300);
-        const double layers = rd_key_num_def(&m, "layers", 0.0);
-        const double maxp = rd_key_num_def(&m, "max_particles", 0.0);
-        if (r->failed)
-            return;
-        if (!(in->level > 0.0)) {
-            rmap_fail(&m, in->nlevel ? "level_hydrograph" : "level", "must be > 0 (got %g%s): the water depth above the "
-                      "section's lowest point, m", in->level, in->nlevel ? " at most" : "");
-            return;
-        }
-        if (!(in->t_end > in->t_start)) {
-            rmap_fail(&m, "end", "must be after start (%g s; got %g s): the inflow runs in [start, end)", in->t_start,
-                      in->t_end);
-            return;
-        }
-        in->layers = (int)layers;
-        in->max_particles = (int64_t)maxp;
-        const int has_v = rmap_get(&m, "velocity") != NULL, has_g = rmap_get(&m, "gumbel") != NULL,
-                  has_h = rmap_get(&m, "hydrograph") != NULL;
-        if (has_v + has_g + has_h != 1) {
-            rd_fail(r, m.node, prefix, "give exactly one of velocity: U (m/s), gumbel: [a_G, beta_G, mu_G] "
-                    "(Trujillo-Vela et al. 2020, eq. 36) or hydrograph: FILE.csv (header t,u or t,Q)%s",
-                    has_v + has_g + has_h ? "; it has more than one" : "");
-            return;
-        }
-        /* the buffer only moves forward (rows are created behind it): no backflow through an inlet */
-        if (has_v) {
-            in->kind = LAHAR_HYDRO_CONSTANT;
-            in->velocity = rd_key_num_req(&m, "velocity", 1, NAN);
-        } else if (has_g) {
-            in->kind = LAHAR_HYDRO_GUMBEL;
-            rmap_vec(&m, "gumbel", 3, in->gumbel, 1, "[35, 2, 3]");
-            if (!r->failed && !(in->gumbel[1] > 0.0)) {
-                rmap_fail(&m, "gumbel", "beta_G (the second number) must be > 0 (got %g s)", in->gumbel[1]);
-                return;
-            }
-            if (!r->failed && !(in->gumbel[0] >= 0.0)) {
-                rmap_fail(&m, "gumbel", "a_G (the first number) must be >= 0 (got %g m): the inflow is along the inward "
-                          "normal", in->gumbel[0]);
-                return;
-            }
-        } else {
-            char full[2048], err[1400];
-            if (inflow_csv(&m, "hydrograph", full, sizeof full) != 0)
-                return;
-            in->ntable = lahar_hydrograph_read_csv(full, &in->kind, &in->table_t, &in->table_v, err, (int)sizeof err);
-            if (in->ntable < 0) {
-                in->ntable = 0;
-                rmap_fail(&m, "hydrograph", "%s (paths are relative to the case file's directory)", err);
-                return;
-            }
-            if (in->kind == LAHAR_HYDRO_TABLE_H) {
-                rmap_fail(&m, "hydrograph", "%s holds a level (header t,h); give it as level_hydrograph:, and the "
-                          "inflow as t,u or t,Q", full);
-                return;
-            }
-            for (int k = 0; k < in->ntable; k++)
-                if (!(in->table_v[k] >= 0.0)) {
-                    rmap_fail(&m, "hydrograph", "%s: row %d (t = %g s) has a negative value %g; the inflow is along the "
-                              "inward normal (no backflow through an inlet)", full, k + 1, in->table_t[k], in->table_v[k]);
-                    return;
-                }
-        }
     }
 }
 
