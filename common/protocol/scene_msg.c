@@ -50,12 +50,9 @@ static void scene_sph_from_msg(const lahar_sph_options_t *from, lahar_sph_option
         to->periodic[a] = from->periodic[a] != 0;
 }
 
-int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
-                              int64_t run_id, lahar_scene_t *m)
+/* The case's scalars: time, output, engine, stability limits and the sph options. */
+static void scene_settings_to_msg(const lahar_case *c, lahar_scene_t *m)
 {
-    memset(m, 0, sizeof *m);
-    m->run_id = run_id;
-    m->step = -1;
     m->dim = c->dim;
     memcpy(m->gravity, c->gravity, sizeof m->gravity);
     m->t_end = c->t_end;
@@ -63,14 +60,11 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->dt_min = c->dt_min;
     m->output_interval = c->output_interval;
     m->forces_interval = c->forces_interval;
-    m->output_dir = (char *)output_dir;
     m->case_path = (char *)c->path;
     m->resume_dir = (char *)(c->resume ? c->resume_dir : "");
     m->resume_step = c->resume ? c->resume_step : -1;
     m->output_fields = (int32_t)c->output_fields;
     m->output_forces = (int8_t)(c->output_forces != 0);
-    m->has_dem = (int8_t)(has_dem != 0);
-    m->has_sph = (int8_t)(has_sph != 0);
     m->dem_engine = (char *)c->dem_engine;
     m->dem_dt_safety = c->dem_dt_safety;
     memcpy(m->stability_density_band, c->stability.density_band, sizeof m->stability_density_band);
@@ -79,6 +73,102 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     m->sph_dx = c->sph_dx;
     m->sph_density = c->sph_density;
     scene_sph_to_msg(&c->sph, &m->sph);
+}
+
+static void scene_probe_to_msg(const lahar_probe *a, lahar_probe_t *b)
+{
+    b->name = (char *)a->name;
+    b->kind = (int8_t)a->kind;
+    b->top = a->top;
+    memcpy(b->x, a->x, sizeof b->x);
+    memcpy(b->n, a->n, sizeof b->n);
+    b->body = a->body;
+    b->size = a->size;
+    b->rate = a->rate;
+    memcpy(b->hi, a->hi, sizeof b->hi);
+    b->axis = (int8_t)a->axis;
+}
+
+/* Body i: its shape's arrays by reference (the message's row pointers are allocated here), its
+ * mass properties and state. */
+static int scene_body_to_msg(const lahar_case *c, int i, lahar_scene_t *m)
+{
+    const lahar_body *a = &c->bodies[i];
+    const lahar_shape *s = &a->shape;
+    lahar_body_t *b = &m->bodies[i];
+    b->id = i;
+    b->name = (char *)a->name;
+    b->material = a->material;
+    b->motion = (int8_t)a->motion;
+    b->convex = (int8_t)(a->convex != 0);
+    b->radius = s->radius;
+    b->nv = s->nv;
+    b->v = calloc((size_t)(s->nv > 0 ? s->nv : 1), sizeof *b->v);
+    b->ne = s->ne;
+    b->e = calloc((size_t)(s->ne > 0 ? s->ne : 1), sizeof *b->e);
+    b->nf = s->nf;
+    b->face_start = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_start);
+    b->face_nv = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_nv);
+    if (!b->v || !b->e || !b->face_start || !b->face_nv)
+        return -1;
+    for (int k = 0; k < s->nv; k++)
+        b->v[k] = (double *)s->v[k];
+    for (int k = 0; k < s->ne; k++)
+        b->e[k] = (int32_t *)s->e[k];
+    for (int f = 0; f < s->nf; f++) {
+        b->face_start[f] = s->face_start[f];
+        b->face_nv[f] = s->face_start[f + 1] - s->face_start[f];
+    }
+    b->nfv = s->nf > 0 ? s->face_start[s->nf] : 0;
+    b->face_v = (int32_t *)s->face_v;
+    b->mass = a->mass;
+    memcpy(b->inertia, a->inertia, sizeof b->inertia);
+    memcpy(b->x, a->x, sizeof b->x);
+    memcpy(b->q, a->q, sizeof b->q);
+    memcpy(b->vel, a->v, sizeof b->vel);
+    memcpy(b->w, a->w, sizeof b->w);
+    m->body_record_contacts[i] = a->record_contacts != 0;
+    return 0;
+}
+
+/* Particle block i: its expressions and mesh by reference (row pointers allocated here). */
+static int scene_block_to_msg(const lahar_particle_block *a, lahar_particle_block_t *b)
+{
+    b->name = (char *)a->name;
+    b->kind = (int8_t)a->kind;
+    memcpy(b->lo, a->lo, sizeof b->lo);
+    memcpy(b->hi, a->hi, sizeof b->hi);
+    memcpy(b->v, a->v, sizeof b->v);
+    b->source = (char *)a->source;
+    b->phase = (int8_t)a->phase;
+    b->material = a->material;
+    for (int k = 0; k < 3; k++)
+        b->velocity_expr[k] = (char *)a->vexpr[k];
+    b->pressure_expr = (char *)a->pexpr;
+    b->initial_file = (char *)a->init_file;
+    b->nvert = a->nvert;
+    b->ntri = a->ntri;
+    b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
+    b->tri = calloc((size_t)(a->ntri > 0 ? a->ntri : 1), sizeof *b->tri);
+    if (!b->vert || !b->tri)
+        return -1;
+    for (int k = 0; k < a->nvert; k++)
+        b->vert[k] = (double *)a->vert[k];
+    for (int k = 0; k < a->ntri; k++)
+        b->tri[k] = (int32_t *)a->tri[k];
+    return 0;
+}
+
+int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int has_dem, int has_sph,
+                              int64_t run_id, lahar_scene_t *m)
+{
+    memset(m, 0, sizeof *m);
+    m->run_id = run_id;
+    m->step = -1;
+    m->output_dir = (char *)output_dir;
+    m->has_dem = (int8_t)(has_dem != 0);
+    m->has_sph = (int8_t)(has_sph != 0);
+    scene_settings_to_msg(c, m);
 
     m->nmaterial = c->nmaterial;
     m->materials = calloc((size_t)(c->nmaterial > 0 ? c->nmaterial : 1), sizeof *m->materials);
@@ -92,20 +182,8 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
     if (!m->materials || !m->bodies || !m->body_record_contacts || !m->blocks || !m->probes ||
         lahar_scene_msg_inflow_from_case(c, m) != 0)
         goto fail;
-    for (int i = 0; i < c->nprobe; i++) {
-        const lahar_probe *a = &c->probes[i];
-        lahar_probe_t *b = &m->probes[i];
-        b->name = (char *)a->name;
-        b->kind = (int8_t)a->kind;
-        b->top = a->top;
-        memcpy(b->x, a->x, sizeof b->x);
-        memcpy(b->n, a->n, sizeof b->n);
-        b->body = a->body;
-        b->size = a->size;
-        b->rate = a->rate;
-        memcpy(b->hi, a->hi, sizeof b->hi);
-        b->axis = (int8_t)a->axis;
-    }
+    for (int i = 0; i < c->nprobe; i++)
+        scene_probe_to_msg(&c->probes[i], &m->probes[i]);
     for (int i = 0; i < c->nmaterial; i++) {
         const lahar_material *from = &c->materials[i];
         lahar_material_t *to = &m->materials[i];
@@ -113,69 +191,12 @@ int lahar_scene_msg_from_case(const lahar_case *c, const char *output_dir, int h
         MATERIAL_NUM_FIELDS(TO_MSG_NUM)
         MATERIAL_CODE_FIELDS(TO_MSG_CODE)
     }
-    for (int i = 0; i < c->nbody; i++) {
-        const lahar_body *a = &c->bodies[i];
-        const lahar_shape *s = &a->shape;
-        lahar_body_t *b = &m->bodies[i];
-        b->id = i;
-        b->name = (char *)a->name;
-        b->material = a->material;
-        b->motion = (int8_t)a->motion;
-        b->convex = (int8_t)(a->convex != 0);
-        b->radius = s->radius;
-        b->nv = s->nv;
-        b->v = calloc((size_t)(s->nv > 0 ? s->nv : 1), sizeof *b->v);
-        b->ne = s->ne;
-        b->e = calloc((size_t)(s->ne > 0 ? s->ne : 1), sizeof *b->e);
-        b->nf = s->nf;
-        b->face_start = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_start);
-        b->face_nv = calloc((size_t)(s->nf > 0 ? s->nf : 1), sizeof *b->face_nv);
-        if (!b->v || !b->e || !b->face_start || !b->face_nv)
+    for (int i = 0; i < c->nbody; i++)
+        if (scene_body_to_msg(c, i, m) != 0)
             goto fail;
-        for (int k = 0; k < s->nv; k++)
-            b->v[k] = (double *)s->v[k];
-        for (int k = 0; k < s->ne; k++)
-            b->e[k] = (int32_t *)s->e[k];
-        for (int f = 0; f < s->nf; f++) {
-            b->face_start[f] = s->face_start[f];
-            b->face_nv[f] = s->face_start[f + 1] - s->face_start[f];
-        }
-        b->nfv = s->nf > 0 ? s->face_start[s->nf] : 0;
-        b->face_v = (int32_t *)s->face_v;
-        b->mass = a->mass;
-        memcpy(b->inertia, a->inertia, sizeof b->inertia);
-        memcpy(b->x, a->x, sizeof b->x);
-        memcpy(b->q, a->q, sizeof b->q);
-        memcpy(b->vel, a->v, sizeof b->vel);
-        memcpy(b->w, a->w, sizeof b->w);
-        m->body_record_contacts[i] = a->record_contacts != 0;
-    }
-    for (int i = 0; i < c->nblock; i++) {
-        const lahar_particle_block *a = &c->blocks[i];
-        lahar_particle_block_t *b = &m->blocks[i];
-        b->name = (char *)a->name;
-        b->kind = (int8_t)a->kind;
-        memcpy(b->lo, a->lo, sizeof b->lo);
-        memcpy(b->hi, a->hi, sizeof b->hi);
-        memcpy(b->v, a->v, sizeof b->v);
-        b->source = (char *)a->source;
-        b->phase = (int8_t)a->phase;
-        b->material = a->material;
-        for (int k = 0; k < 3; k++)
-            b->velocity_expr[k] = (char *)a->vexpr[k];
-        b->pressure_expr = (char *)a->pexpr;
-        b->initial_file = (char *)a->init_file;
-        b->nvert = a->nvert;
-        b->ntri = a->ntri;
-        b->vert = calloc((size_t)(a->nvert > 0 ? a->nvert : 1), sizeof *b->vert);
-        b->tri = calloc((size_t)(a->ntri > 0 ? a->ntri : 1), sizeof *b->tri);
-        if (!b->vert || !b->tri)
+    for (int i = 0; i < c->nblock; i++)
+        if (scene_block_to_msg(&c->blocks[i], &m->blocks[i]) != 0)
             goto fail;
-        for (int k = 0; k < a->nvert; k++)
-            b->vert[k] = (double *)a->vert[k];
-        for (int k = 0; k < a->ntri; k++)
-            b->tri[k] = (int32_t *)a->tri[k];
-    }
     return 0;
 fail:
     lahar_scene_msg_release(m);
