@@ -505,13 +505,10 @@ static int out_write_geometry(hid_t f, const lahar_body_output *o, const lahar_c
     return rc ? -1 : 0;
 }
 
-static int forces_open(forces_stream *fs, const char *path, const lahar_case *c, char *err, size_t n)
+/* The write buffers: as many rows as fit in FORCES_BUFFER_BYTES (1 to 1024). */
+static int forces_buffers(forces_stream *fs)
 {
-    memset(fs, 0, sizeof *fs);
-    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = fs->energy = H5I_INVALID_HID;
-    int nb = c->nbody;
-    fs->nbody = nb;
-    fs->interval = c->forces_interval > 0.0 ? c->forces_interval : 0.0;
+    const int nb = fs->nbody;
     size_t row_bytes = (size_t)(nb > 0 ? nb : 1) * 76 + 16;
     fs->cap = (int)(FORCES_BUFFER_BYTES / row_bytes);
     if (fs->cap < 1)
@@ -525,58 +522,61 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     fs->btorque = malloc(nrow * nb3 * sizeof *fs->btorque);
     fs->benergy = malloc(nrow * nb3 * sizeof *fs->benergy);
     fs->bncont = malloc(nrow * (size_t)(nb > 0 ? nb : 1) * sizeof *fs->bncont);
-    if (!fs->bt || !fs->bstep || !fs->bforce || !fs->btorque || !fs->bncont || !fs->benergy) {
-        snprintf(err, n, "out of memory for the force stream buffer");
-        return -1;
-    }
-    /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
-    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
-    snprintf(fs->path, sizeof fs->path, "%s", path);
-    if (c->resume) {
-        /* a resumed run appends to the stream as lahar_output_resume_trim left it (cut at the
-         * checkpoint): the rows on disk, and the next forces_interval slot after the last row */
-        fs->file = lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
-        H5Pclose(fapl);
-        if (fs->file < 0) {
-            snprintf(err, n, "%s: cannot reopen the force stream to continue it", path);
-            return -1;
-        }
-        hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts, &fs->energy};
-        const char *names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
-        for (int k = 0; k < 6; k++)
-            if ((*ids[k] = H5Dopen2(fs->file, names[k], H5P_DEFAULT)) < 0) {
-                snprintf(err, n, "%s: no dataset %s to continue", path, names[k]);
-                return -1;
-            }
-        hid_t sp = H5Dget_space(fs->t);
-        hsize_t rows = 0;
-        H5Sget_simple_extent_dims(sp, &rows, NULL);
-        H5Sclose(sp);
-        fs->rows = (int64_t)rows;
-        if (rows > 0 && fs->interval > 0.0) {
-            double last = 0.0;
-            hsize_t off = rows - 1, one = 1;
-            hid_t fsp = H5Dget_space(fs->t), msp = H5Screate_simple(1, &one, NULL);
-            H5Sselect_hyperslab(fsp, H5S_SELECT_SET, &off, NULL, &one, NULL);
-            H5Dread(fs->t, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, &last);
-            H5Sclose(msp);
-            H5Sclose(fsp);
-            fs->next_slot = (int64_t)floor(last / fs->interval * (1.0 + 1e-12)) + 1;
-        }
-        if (H5Fstart_swmr_write(fs->file) < 0) {
-            snprintf(err, n, "%s: cannot start SWMR writing", path);
-            return -1;
-        }
-        fs->last_flush = out_wall_seconds();
-        return 0;
-    }
-    fs->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
-    H5Pclose(fapl);
+    return fs->bt && fs->bstep && fs->bforce && fs->btorque && fs->bncont && fs->benergy ? 0 : -1;
+}
+
+/* A resumed run appends to the stream as lahar_output_resume_trim left it (cut at the checkpoint):
+ * the rows on disk, and the next forces_interval slot after the last row. */
+static int forces_reopen(forces_stream *fs, hid_t fapl, char *err, size_t n)
+{
+    const char *path = fs->path;
+    fs->file = lahar_h5_file_open(path, H5F_ACC_RDWR, fapl, 0);
     if (fs->file < 0) {
-        snprintf(err, n, "%s: cannot create HDF5 file", path);
+        snprintf(err, n, "%s: cannot reopen the force stream to continue it", path);
         return -1;
     }
+    hid_t *ids[] = {&fs->t, &fs->step, &fs->force, &fs->torque, &fs->ncontacts, &fs->energy};
+    const char *names[] = {"t", "step", "force", "torque", "ncontacts", "energy"};
+    for (int k = 0; k < 6; k++)
+        if ((*ids[k] = H5Dopen2(fs->file, names[k], H5P_DEFAULT)) < 0) {
+            snprintf(err, n, "%s: no dataset %s to continue", path, names[k]);
+            return -1;
+        }
+    hid_t sp = H5Dget_space(fs->t);
+    hsize_t rows = 0;
+    H5Sget_simple_extent_dims(sp, &rows, NULL);
+    H5Sclose(sp);
+    fs->rows = (int64_t)rows;
+    if (rows > 0 && fs->interval > 0.0) {
+        double last = 0.0;
+        hsize_t off = rows - 1, one = 1;
+        hid_t fsp = H5Dget_space(fs->t), msp = H5Screate_simple(1, &one, NULL);
+        H5Sselect_hyperslab(fsp, H5S_SELECT_SET, &off, NULL, &one, NULL);
+        H5Dread(fs->t, H5T_NATIVE_DOUBLE, msp, fsp, H5P_DEFAULT, &last);
+        H5Sclose(msp);
+        H5Sclose(fsp);
+        fs->next_slot = (int64_t)floor(last / fs->interval * (1.0 + 1e-12)) + 1;
+    }
+    if (H5Fstart_swmr_write(fs->file) < 0) {
+        snprintf(err, n, "%s: cannot start SWMR writing", path);
+        return -1;
+    }
+    return 0;
+}
+
+/* The description attribute of forces.h5. */
+static const char forces_file_description[] =
+    "contact + external force and torque (about the centre of mass) on each body, time "
+    "average over the step; fixed bodies: the contact force they receive. energy: per body "
+    "[E_P, E_K, E_R] at the end of the step: potential energy -m g . x (m g y_B for gravity "
+    "along -y, Trujillo-Vela et al. 2020 eq. 37; 0 at the origin), translational kinetic "
+    "energy m |v|^2 / 2 (eq. 38) and rotational kinetic energy w . I w / 2 (0 for fixed "
+    "bodies)";
+
+/* A new stream: its extendible datasets (chunks of the buffer's rows) and attributes. */
+static int forces_create(forces_stream *fs, const lahar_case *c)
+{
+    const int nb = fs->nbody;
     hsize_t chunk_rows = (hsize_t)fs->cap;
     struct {
         hid_t *id;
@@ -616,17 +616,41 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
         free(names);
     }
     rc |= out_attr_string(fs->file, "units", "SI");
-    rc |= out_attr_string(fs->file, "description",
-                          "contact + external force and torque (about the centre of mass) on each body, time "
-                          "average over the step; fixed bodies: the contact force they receive. energy: per body "
-                          "[E_P, E_K, E_R] at the end of the step: potential energy -m g . x (m g y_B for gravity "
-                          "along -y, Trujillo-Vela et al. 2020 eq. 37; 0 at the origin), translational kinetic "
-                          "energy m |v|^2 / 2 (eq. 38) and rotational kinetic energy w . I w / 2 (0 for fixed "
-                          "bodies)");
+    rc |= out_attr_string(fs->file, "description", forces_file_description);
     rc |= out_attr_string(fs->file, "lahar_version", LAHAR_VERSION);
-    if (rc || H5Fstart_swmr_write(fs->file) < 0) {
-        snprintf(err, n, "%s: cannot create the force datasets / start SWMR writing", path);
+    return rc;
+}
+
+static int forces_open(forces_stream *fs, const char *path, const lahar_case *c, char *err, size_t n)
+{
+    memset(fs, 0, sizeof *fs);
+    fs->file = fs->t = fs->step = fs->force = fs->torque = fs->ncontacts = fs->energy = H5I_INVALID_HID;
+    fs->nbody = c->nbody;
+    fs->interval = c->forces_interval > 0.0 ? c->forces_interval : 0.0;
+    if (forces_buffers(fs) != 0) {
+        snprintf(err, n, "out of memory for the force stream buffer");
         return -1;
+    }
+    /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    snprintf(fs->path, sizeof fs->path, "%s", path);
+    if (c->resume) {
+        int rc = forces_reopen(fs, fapl, err, n);
+        H5Pclose(fapl);
+        if (rc != 0)
+            return -1;
+    } else {
+        fs->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, fapl, 1);
+        H5Pclose(fapl);
+        if (fs->file < 0) {
+            snprintf(err, n, "%s: cannot create HDF5 file", path);
+            return -1;
+        }
+        if (forces_create(fs, c) != 0 || H5Fstart_swmr_write(fs->file) < 0) {
+            snprintf(err, n, "%s: cannot create the force datasets / start SWMR writing", path);
+            return -1;
+        }
     }
     fs->last_flush = out_wall_seconds();
     return 0;
