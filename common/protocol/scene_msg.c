@@ -25,6 +25,9 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 #define MATERIAL_NUM_FIELDS(X) X(density) X(young) X(poisson) X(kn) X(kt_ratio) X(restitution) X(friction) \
     X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
 #define MATERIAL_CODE_FIELDS(X) X(model) X(constitutive)
+#define PROBE_NUM_FIELDS(X) X(top) X(body) X(size) X(rate)
+#define PROBE_CODE_FIELDS(X) X(kind) X(axis)
+#define PROBE_ARRAY_FIELDS(X) X(x) X(n) X(hi)
 
 
 /* The kernel string points into from (keep it alive while to is used). */
@@ -75,18 +78,12 @@ static void scene_settings_to_msg(const lahar_case *c, lahar_scene_t *m)
     scene_sph_to_msg(&c->sph, &m->sph);
 }
 
-static void scene_probe_to_msg(const lahar_probe *a, lahar_probe_t *b)
+static void scene_probe_to_msg(const lahar_probe *from, lahar_probe_t *to)
 {
-    b->name = (char *)a->name;
-    b->kind = (int8_t)a->kind;
-    b->top = a->top;
-    memcpy(b->x, a->x, sizeof b->x);
-    memcpy(b->n, a->n, sizeof b->n);
-    b->body = a->body;
-    b->size = a->size;
-    b->rate = a->rate;
-    memcpy(b->hi, a->hi, sizeof b->hi);
-    b->axis = (int8_t)a->axis;
+    to->name = (char *)from->name;
+    PROBE_NUM_FIELDS(TO_MSG_NUM)
+    PROBE_CODE_FIELDS(TO_MSG_CODE)
+    PROBE_ARRAY_FIELDS(COPY_ARRAY)
 }
 
 /* Body i: its shape's arrays by reference (the message's row pointers are allocated here), its
@@ -404,25 +401,20 @@ static int scene_block_from_msg(const lahar_scene_t *m, int i, lahar_particle_bl
     return 0;
 }
 
-static int scene_probe_from_msg(const lahar_scene_t *m, int i, lahar_probe *b, char *err, size_t errlen)
+static int scene_probe_from_msg(const lahar_scene_t *m, int i, lahar_probe *to, char *err, size_t errlen)
 {
-    const lahar_probe_t *a = &m->probes[i];
-    if (a->body < -1 || a->body >= m->nbody || !(a->size >= 0.0) || !(a->rate >= 0.0) ||
-        a->kind < LAHAR_PROBE_PRESSURE || a->kind > LAHAR_PROBE_CONTROL_VOLUME || a->axis < 0 || a->axis >= m->dim ||
-        (a->kind == LAHAR_PROBE_LEVEL && (a->body != -1 || !(a->top > a->x[m->dim - 1])))) {
+    const lahar_probe_t *from = &m->probes[i];
+    if (from->body < -1 || from->body >= m->nbody || !(from->size >= 0.0) || !(from->rate >= 0.0) ||
+        from->kind < LAHAR_PROBE_PRESSURE || from->kind > LAHAR_PROBE_CONTROL_VOLUME || from->axis < 0 ||
+        from->axis >= m->dim ||
+        (from->kind == LAHAR_PROBE_LEVEL && (from->body != -1 || !(from->top > from->x[m->dim - 1])))) {
         lahar_errf(err, errlen, "malformed scene message (probe %d)", i);
         return SCENE_BAD;
     }
-    scene_copy_name(b->name, a->name);
-    b->kind = a->kind;
-    b->top = a->top;
-    memcpy(b->x, a->x, sizeof b->x);
-    memcpy(b->n, a->n, sizeof b->n);
-    b->body = a->body;
-    b->size = a->size;
-    b->rate = a->rate;
-    memcpy(b->hi, a->hi, sizeof b->hi);
-    b->axis = a->axis;
+    scene_copy_name(to->name, from->name);
+    PROBE_NUM_FIELDS(TO_MSG_NUM)
+    PROBE_CODE_FIELDS(FROM_MSG_CODE)
+    PROBE_ARRAY_FIELDS(COPY_ARRAY)
     return 0;
 }
 
