@@ -25,6 +25,8 @@ static void scene_copy_name(char dst[LAHAR_NAME_MAX], const char *src)
 #define MATERIAL_NUM_FIELDS(X) X(density) X(young) X(poisson) X(kn) X(kt_ratio) X(restitution) X(friction) \
     X(friction_angle) X(cohesion) X(dilatancy) X(permeability) X(damping) X(av_alpha) X(av_beta)
 #define MATERIAL_CODE_FIELDS(X) X(model) X(constitutive)
+#define BODY_NUM_FIELDS(X) X(mass)
+#define BODY_ARRAY_FIELDS(X) X(inertia) X(x) X(q) X(w) /* the velocity: v in the case, vel in the message */
 #define PROBE_NUM_FIELDS(X) X(top) X(body) X(size) X(rate)
 #define PROBE_CODE_FIELDS(X) X(kind) X(axis)
 #define PROBE_ARRAY_FIELDS(X) X(x) X(n) X(hi)
@@ -118,12 +120,11 @@ static int scene_body_to_msg(const lahar_case *c, int i, lahar_scene_t *m)
     }
     b->nfv = s->nf > 0 ? s->face_start[s->nf] : 0;
     b->face_v = (int32_t *)s->face_v;
-    b->mass = a->mass;
-    memcpy(b->inertia, a->inertia, sizeof b->inertia);
-    memcpy(b->x, a->x, sizeof b->x);
-    memcpy(b->q, a->q, sizeof b->q);
-    memcpy(b->vel, a->v, sizeof b->vel);
-    memcpy(b->w, a->w, sizeof b->w);
+    const lahar_body *from = a;
+    lahar_body_t *to = b;
+    BODY_NUM_FIELDS(TO_MSG_NUM)
+    BODY_ARRAY_FIELDS(COPY_ARRAY)
+    memcpy(to->vel, from->v, sizeof to->vel);
     m->body_record_contacts[i] = a->record_contacts != 0;
     return 0;
 }
@@ -332,12 +333,11 @@ static int scene_body_from_msg(const lahar_scene_t *m, int i, lahar_body *b, cha
     s->face_start[a->nf] = a->nfv;
     for (int k = 0; k < a->nfv; k++)
         s->face_v[k] = a->face_v[k];
-    b->mass = a->mass;
-    memcpy(b->inertia, a->inertia, sizeof b->inertia);
-    memcpy(b->x, a->x, sizeof b->x);
-    memcpy(b->q, a->q, sizeof b->q);
-    memcpy(b->v, a->vel, sizeof b->v);
-    memcpy(b->w, a->w, sizeof b->w);
+    const lahar_body_t *from = a;
+    lahar_body *to = b;
+    BODY_NUM_FIELDS(TO_MSG_NUM)
+    BODY_ARRAY_FIELDS(COPY_ARRAY)
+    memcpy(to->v, from->vel, sizeof to->v);
     b->record_contacts = m->body_record_contacts[i] != 0;
     return 0;
 }
