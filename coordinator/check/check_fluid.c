@@ -308,11 +308,33 @@ double lahar_check_poiseuille_wall_stress(double t, double H, double a, double n
  *  - plate_force_rel_error: per plate, the late-window mean of the force-stream force along the
  *    flow minus the mean of the series' wall stress tau(t) L W over the same rows, relative to the
  *    steady tau L W = rho a H L W / 2; the worse plate. */
-int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+
+/* What poiseuille measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    /* the drive and the fluid */
+    double a, rho, nu, dx;     /* |gravity + sph.body_force|, density, mu / rho, spacing */
+    vec3 ex;                   /* along the flow: the driving acceleration's direction */
+    vec3 centre;               /* the fluid's centroid at the first snapshot */
+    /* the plates and the channel */
+    int lo, hi;                /* the plates' bodies, lo at y = 0 */
+    double gap_lo, gap_hi, H;  /* from the centre to each plate's swept surface; H = their sum */
+    vec3 ny;                   /* across the channel, from the lower plate up */
+    double Lx, W;              /* the period along the flow, the width across (1 in 2D) */
+    double umax, tau_s;        /* steady centreline velocity a H^2 / (8 nu), wall stress rho a H / 2 */
+    /* the velocity profiles */
+    int nb;                    /* bins of about dx across the channel */
+    double *bin_u;             /* [nb] sum of u per bin */
+    int *bin_n;                /* [nb] particles per bin */
+    double l2_last, l2_max, u_meas_max, dev;
+    /* the plate forces (NAN without a force stream) */
+    double perr, f_lo, f_hi, f_ref;
+} poiseuille;
+
+/* The driving acceleration and the fluid's properties: 0, or -1 with r->err. */
+static int poiseuille_drive(const lahar_case *c, const lahar_check_data *d, poiseuille *pw, lahar_check_result *r)
 {
     if (fluid_need(d, LAHAR_PFIELD_VELOCITY, "poiseuille", r))
         return -1;
-    lahar_check_particles *p = d->particles;
     vec3 av = fluid_accel(c);
     double a = v3_norm(av), rho = c->sph_density, mu = c->sph.mu, dx = fluid_dx(c, d);
     if (!(a > 0.0) || !(rho > 0.0) || !(mu > 0.0) || !(dx > 0.0)) {
@@ -322,15 +344,29 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
                  a, rho, mu, dx);
         return -1;
     }
-    double nu = mu / rho;
-    vec3 ex = v3_scale(av, 1.0 / a);
+    pw->a = a, pw->rho = rho, pw->nu = mu / rho, pw->dx = dx;
+    pw->ex = v3_scale(av, 1.0 / a);
+    return 0;
+}
+
+/* The fluid's centroid at the first snapshot (left in the buffers): the plates are found from it. */
+static int poiseuille_centre(const lahar_check_data *d, poiseuille *pw, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
     if (fluid_read(d, 0, r))
         return -1;
     vec3 centre = v3(0, 0, 0);
     for (int64_t i = 0; i < p->cur_n; i++)
         centre = v3_add(centre, fluid_pos(p, i));
-    centre = v3_scale(centre, 1.0 / (double)(p->cur_n ? p->cur_n : 1));
-    /* the plates: nearest fixed body, then the nearest one on the opposite side */
+    pw->centre = v3_scale(centre, 1.0 / (double)(p->cur_n ? p->cur_n : 1));
+    return 0;
+}
+
+/* The plates: the fixed body nearest the centre, then the nearest one on the opposite side; both
+ * parallel to the flow. y = 0 at the plate on the low side of the axes. 0, or -1 with r->err. */
+static int poiseuille_plates(const lahar_case *c, const lahar_check_data *d, poiseuille *pw, lahar_check_result *r)
+{
+    const vec3 centre = pw->centre;
     int lo = -1, hi = -1;
     double gap_lo = INFINITY, gap_hi = INFINITY;
     vec3 ny = v3(0, 0, 0);
@@ -346,7 +382,7 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
             if (pass == 1 && j != lo && v3_dot(n, ny) < -0.99 && gap < gap_hi)
                 gap_hi = gap, hi = j;
         }
-    if (lo < 0 || hi < 0 || fabs(v3_dot(ny, ex)) > 1e-6) {
+    if (lo < 0 || hi < 0 || fabs(v3_dot(ny, pw->ex)) > 1e-6) {
         snprintf(r->err, sizeof r->err,
                  "poiseuille: needs two fixed parallel plates on opposite sides of the fluid, parallel to the driving "
                  "acceleration (found %s%s%s)",
@@ -360,9 +396,17 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
         gap_lo = gap_hi, gap_hi = tg;
         ny = v3_neg(ny);
     }
-    double H = gap_lo + gap_hi;
-    /* period along the flow and the width across (3D) */
-    vec3 ez = v3_cross(ex, ny);
+    pw->lo = lo, pw->hi = hi, pw->gap_lo = gap_lo, pw->gap_hi = gap_hi, pw->ny = ny;
+    pw->H = gap_lo + gap_hi;
+    pw->umax = pw->a * pw->H * pw->H / (8.0 * pw->nu), pw->tau_s = pw->rho * pw->a * pw->H / 2.0;
+    return 0;
+}
+
+/* The period along the flow and the width across (3D): the periodic box's where an axis lies
+ * along them, else the extent of the particles of the first snapshot (in the buffers) + dx. */
+static void poiseuille_period(const lahar_case *c, const lahar_check_particles *p, poiseuille *pw)
+{
+    const vec3 ex = pw->ex, ez = v3_cross(ex, pw->ny);
     double Lx = NAN, W = 1.0;
     for (int ax = 0; ax < 3; ax++) {
         vec3 e = v3(ax == 0, ax == 1, ax == 2);
@@ -379,18 +423,67 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
             zlo = fmin(zlo, v3_dot(x, ez)), zhi = fmax(zhi, v3_dot(x, ez));
         }
         if (!(Lx > 0.0))
-            Lx = xhi - xlo + dx;
+            Lx = xhi - xlo + pw->dx;
         if (c->dim == 3 && W == 1.0)
-            W = zhi - zlo + dx;
+            W = zhi - zlo + pw->dx;
     }
-    double umax = a * H * H / (8.0 * nu), tau_s = rho * a * H / 2.0;
-    /* profiles: every snapshot with t > 0 */
-    int nb = (int)lround(H / dx);
-    nb = nb < 1 ? 1 : (nb > 400 ? 400 : nb);
-    double *bin_u = calloc((size_t)nb, sizeof *bin_u);
-    int *bin_n = calloc((size_t)nb, sizeof *bin_n);
-    if (!bin_u || !bin_n) {
-        free(bin_u), free(bin_n);
+    pw->Lx = Lx, pw->W = W;
+}
+
+/* The snapshot in the buffers at time t: every particle's velocity along the flow against the
+ * series at its height (the relative L2 error, returned) and the profile binned across the
+ * channel; on the last snapshot also the largest velocity. */
+static double poiseuille_snapshot(const lahar_check_particles *p, double t, int last, poiseuille *pw)
+{
+    const double H = pw->H;
+    const int nb = pw->nb;
+    double se = 0.0, sr = 0.0;
+    memset(pw->bin_u, 0, (size_t)nb * sizeof *pw->bin_u), memset(pw->bin_n, 0, (size_t)nb * sizeof *pw->bin_n);
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        vec3 x = fluid_pos(p, i);
+        double y = v3_dot(v3_sub(x, pw->centre), pw->ny) + pw->gap_lo, u = v3_dot(fluid_vel(p, i), pw->ex);
+        double ur = lahar_check_poiseuille_u(y, t, H, pw->a, pw->nu);
+        se += (u - ur) * (u - ur), sr += ur * ur;
+        int b = (int)floor(y / H * nb);
+        b = b < 0 ? 0 : (b >= nb ? nb - 1 : b);
+        pw->bin_u[b] += u, pw->bin_n[b]++;
+        if (last)
+            pw->u_meas_max = fmax(pw->u_meas_max, u);
+    }
+    return sr > 0.0 ? sqrt(se / sr) : NAN;
+}
+
+/* The binned profile of the last poiseuille_snapshot next to the series at t. */
+static void poiseuille_plot_profile(lahar_check_result *r, int pv, const poiseuille *pw, double t)
+{
+    const double H = pw->H;
+    const int nb = pw->nb;
+    char label[96];
+    snprintf(label, sizeof label, "t = %.4g s", t);
+    lahar_check_curve(r, pv, 1, label);
+    for (int b = 0; b < nb; b++)
+        if (pw->bin_n[b])
+            lahar_check_point(r, pw->bin_u[b] / pw->bin_n[b], (b + 0.5) * H / nb);
+    snprintf(label, sizeof label, "series t = %.4g s", t);
+    lahar_check_curve(r, pv, 0, label);
+    for (int s = 0; s <= 100; s++)
+        lahar_check_point(r, lahar_check_poiseuille_u(s * H / 100.0, t, H, pw->a, pw->nu), s * H / 100.0);
+}
+
+/* The velocity profiles of every snapshot with t > 0 against the transient series (Morris et al.
+ * 1997 eq. 21): the steady error at the last snapshot, the worst transient error once the flow
+ * has reached 10 % of its steady maximum (before, the relative error divides by ~0), and up to 6
+ * profiles spread over the run for the plot (always the last). 0, or -1 with r->err. */
+static int poiseuille_profiles(const lahar_check_data *d, poiseuille *pw, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    const double H = pw->H, umax = pw->umax;
+    int nb = (int)lround(H / pw->dx);
+    pw->nb = nb = nb < 1 ? 1 : (nb > 400 ? 400 : nb);
+    pw->bin_u = calloc((size_t)nb, sizeof *pw->bin_u);
+    pw->bin_n = calloc((size_t)nb, sizeof *pw->bin_n);
+    if (!pw->bin_u || !pw->bin_n) {
+        free(pw->bin_u), free(pw->bin_n);
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
@@ -399,12 +492,11 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
     int64_t first = 0;
     while (first < p->nsnap && p->t[first] <= 0.0)
         first++;
-    double l2_last = NAN, l2_max = 0.0, u_meas_max = 0.0, dev = NAN;
+    pw->l2_last = NAN, pw->l2_max = 0.0, pw->u_meas_max = 0.0, pw->dev = NAN;
     int nprof = 0, rc = 0;
-    for (int64_t k = first; k < p->nsnap && rc == 0; k++) {
-        double t = p->t[k], uref_max = lahar_check_poiseuille_u(0.5 * H, t, H, a, nu);
+    for (int64_t k = first; k < p->nsnap; k++) {
+        double t = p->t[k], uref_max = lahar_check_poiseuille_u(0.5 * H, t, H, pw->a, pw->nu);
         int last = k == p->nsnap - 1;
-        /* plotted: up to 6 snapshots spread over the run, always the last */
         int64_t span = p->nsnap - first, stride = span > 6 ? (span + 5) / 6 : 1;
         int plot = last || ((k - first) % stride == 0 && nprof < 5);
         if (!last && !plot && uref_max < 0.1 * umax)
@@ -413,83 +505,77 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
             rc = -1;
             break;
         }
-        double se = 0.0, sr = 0.0;
-        memset(bin_u, 0, (size_t)nb * sizeof *bin_u), memset(bin_n, 0, (size_t)nb * sizeof *bin_n);
-        for (int64_t i = 0; i < p->cur_n; i++) {
-            vec3 x = fluid_pos(p, i);
-            double y = v3_dot(v3_sub(x, centre), ny) + gap_lo, u = v3_dot(fluid_vel(p, i), ex);
-            double ur = lahar_check_poiseuille_u(y, t, H, a, nu);
-            se += (u - ur) * (u - ur), sr += ur * ur;
-            int b = (int)floor(y / H * nb);
-            b = b < 0 ? 0 : (b >= nb ? nb - 1 : b);
-            bin_u[b] += u, bin_n[b]++;
-            if (last)
-                u_meas_max = fmax(u_meas_max, u);
-        }
-        double l2 = sr > 0.0 ? sqrt(se / sr) : NAN;
+        double l2 = poiseuille_snapshot(p, t, last, pw);
         if (uref_max >= 0.1 * umax)
-            l2_max = fmax(l2_max, l2);
+            pw->l2_max = fmax(pw->l2_max, l2);
         if (last)
-            l2_last = l2, dev = uref_max / umax;
+            pw->l2_last = l2, pw->dev = uref_max / umax;
         if (plot) {
-            char label[96];
-            snprintf(label, sizeof label, "t = %.4g s", t);
-            lahar_check_curve(r, pv, 1, label);
-            for (int b = 0; b < nb; b++)
-                if (bin_n[b])
-                    lahar_check_point(r, bin_u[b] / bin_n[b], (b + 0.5) * H / nb);
-            snprintf(label, sizeof label, "series t = %.4g s", t);
-            lahar_check_curve(r, pv, 0, label);
-            for (int s = 0; s <= 100; s++)
-                lahar_check_point(r, lahar_check_poiseuille_u(s * H / 100.0, t, H, a, nu), s * H / 100.0);
+            poiseuille_plot_profile(r, pv, pw, t);
             nprof++;
         }
     }
-    free(bin_u), free(bin_n);
+    free(pw->bin_u), free(pw->bin_n);
+    pw->bin_u = NULL, pw->bin_n = NULL;
     if (rc)
         return -1;
     if (first >= p->nsnap) {
         snprintf(r->err, sizeof r->err, "poiseuille: no particle snapshot after t = 0");
         return -1;
     }
-    /* plate forces */
-    double perr = NAN, f_lo = NAN, f_hi = NAN, f_ref = NAN;
-    if (d->nrow > 0) {
-        int64_t k0 = fluid_late_row(d);
-        double LW = Lx * W, sref = 0.0;
-        for (int64_t k = k0; k < d->nrow; k++)
-            sref += lahar_check_poiseuille_wall_stress(d->ft[k], H, a, nu, rho) * LW;
-        f_ref = sref / (double)(d->nrow - k0);
-        f_lo = fluid_force_mean(d, k0, lo, ex), f_hi = fluid_force_mean(d, k0, hi, ex);
-        perr = fmax(fabs(f_lo - f_ref), fabs(f_hi - f_ref)) / (tau_s * LW);
-        int pf = lahar_check_panel(r, "plate force along the flow per unit plate length (= tau W)", "t [s]",
-                                   "F / L [N/m^2 in 2D, N/m in 3D]");
-        char label[96];
-        snprintf(label, sizeof label, "%s", c->bodies[lo].name);
-        fluid_plot_force(r, pf, d, lo, ex, Lx, label);
-        snprintf(label, sizeof label, "%s", c->bodies[hi].name);
-        fluid_plot_force(r, pf, d, hi, ex, Lx, label);
-        lahar_check_curve(r, pf, 0, "tau(t) W (series), steady rho a H W/2");
-        double t0 = d->ft[0], t1 = d->ft[d->nrow - 1];
-        for (int s = 0; s <= 200; s++) {
-            double t = t0 + (t1 - t0) * s / 200.0;
-            lahar_check_point(r, t, lahar_check_poiseuille_wall_stress(t, H, a, nu, rho) * W);
-        }
+    return 0;
+}
+
+/* Each plate's late-window mean force along the flow against the series' wall stress tau(t) L W
+ * averaged over the same rows (Trujillo-Vela et al. 2020 eq. 31-32), and their plot; nothing
+ * without a force stream. */
+static void poiseuille_plate_forces(const lahar_case *c, const lahar_check_data *d, poiseuille *pw,
+                                    lahar_check_result *r)
+{
+    const double H = pw->H, a = pw->a, nu = pw->nu, rho = pw->rho, Lx = pw->Lx, W = pw->W;
+    pw->perr = NAN, pw->f_lo = NAN, pw->f_hi = NAN, pw->f_ref = NAN;
+    if (d->nrow == 0)
+        return;
+    int64_t k0 = fluid_late_row(d);
+    double LW = Lx * W, sref = 0.0;
+    for (int64_t k = k0; k < d->nrow; k++)
+        sref += lahar_check_poiseuille_wall_stress(d->ft[k], H, a, nu, rho) * LW;
+    pw->f_ref = sref / (double)(d->nrow - k0);
+    pw->f_lo = fluid_force_mean(d, k0, pw->lo, pw->ex), pw->f_hi = fluid_force_mean(d, k0, pw->hi, pw->ex);
+    pw->perr = fmax(fabs(pw->f_lo - pw->f_ref), fabs(pw->f_hi - pw->f_ref)) / (pw->tau_s * LW);
+    int pf = lahar_check_panel(r, "plate force along the flow per unit plate length (= tau W)", "t [s]",
+                               "F / L [N/m^2 in 2D, N/m in 3D]");
+    char label[96];
+    snprintf(label, sizeof label, "%s", c->bodies[pw->lo].name);
+    fluid_plot_force(r, pf, d, pw->lo, pw->ex, Lx, label);
+    snprintf(label, sizeof label, "%s", c->bodies[pw->hi].name);
+    fluid_plot_force(r, pf, d, pw->hi, pw->ex, Lx, label);
+    lahar_check_curve(r, pf, 0, "tau(t) W (series), steady rho a H W/2");
+    double t0 = d->ft[0], t1 = d->ft[d->nrow - 1];
+    for (int s = 0; s <= 200; s++) {
+        double t = t0 + (t1 - t0) * s / 200.0;
+        lahar_check_point(r, t, lahar_check_poiseuille_wall_stress(t, H, a, nu, rho) * W);
     }
-    lahar_check_value(r, "steady_l2_rel_error", l2_last);
-    lahar_check_value(r, "transient_l2_rel_error_max", l2_max);
-    lahar_check_value(r, "plate_force_rel_error", perr);
-    lahar_check_value(r, "u_max_measured", u_meas_max);
-    lahar_check_value(r, "u_max_steady", umax);
-    lahar_check_value(r, "developed_fraction", dev);
-    lahar_check_value(r, "plate_force_lower", f_lo);
-    lahar_check_value(r, "plate_force_upper", f_hi);
-    lahar_check_value(r, "plate_force_reference", f_ref);
-    lahar_check_value(r, "plate_force_steady", tau_s * Lx * W);
-    lahar_check_value(r, "H", H);
-    lahar_check_value(r, "period_L", Lx);
-    lahar_check_value(r, "nu", nu);
-    lahar_check_value(r, "accel", a);
+}
+
+/* The metrics and the information values (check.json), the convention, the note and the title. */
+static void poiseuille_report(const lahar_case *c, const lahar_check_particles *p, const poiseuille *pw,
+                              lahar_check_result *r)
+{
+    lahar_check_value(r, "steady_l2_rel_error", pw->l2_last);
+    lahar_check_value(r, "transient_l2_rel_error_max", pw->l2_max);
+    lahar_check_value(r, "plate_force_rel_error", pw->perr);
+    lahar_check_value(r, "u_max_measured", pw->u_meas_max);
+    lahar_check_value(r, "u_max_steady", pw->umax);
+    lahar_check_value(r, "developed_fraction", pw->dev);
+    lahar_check_value(r, "plate_force_lower", pw->f_lo);
+    lahar_check_value(r, "plate_force_upper", pw->f_hi);
+    lahar_check_value(r, "plate_force_reference", pw->f_ref);
+    lahar_check_value(r, "plate_force_steady", pw->tau_s * pw->Lx * pw->W);
+    lahar_check_value(r, "H", pw->H);
+    lahar_check_value(r, "period_L", pw->Lx);
+    lahar_check_value(r, "nu", pw->nu);
+    lahar_check_value(r, "accel", pw->a);
     lahar_check_value(r, "t_last", p->t[p->nsnap - 1]);
     snprintf(r->convention, sizeof r->convention,
              "u along the driving acceleration, y from the lower plate's surface; plate force per unit plate length "
@@ -498,8 +584,21 @@ int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar
              "plates %s (y = 0) and %s; u(y,t): transient series (Morris et al. "
              "1997 eq. 21); plate force: late-window mean along the flow vs tau(t) L W, steady tau = rho a H/2 "
              "(Trujillo-Vela et al. 2020 eq. 31-32)",
-             c->bodies[lo].name, c->bodies[hi].name);
-    snprintf(r->title, sizeof r->title, "poiseuille: H = %.4g m, a = %.3g m/s^2, nu = %.3g m^2/s", H, a, nu);
+             c->bodies[pw->lo].name, c->bodies[pw->hi].name);
+    snprintf(r->title, sizeof r->title, "poiseuille: H = %.4g m, a = %.3g m/s^2, nu = %.3g m^2/s", pw->H, pw->a,
+             pw->nu);
+}
+
+int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    poiseuille pw = {0};
+    if (poiseuille_drive(c, d, &pw, r) || poiseuille_centre(d, &pw, r) || poiseuille_plates(c, d, &pw, r))
+        return -1;
+    poiseuille_period(c, d->particles, &pw);
+    if (poiseuille_profiles(d, &pw, r))
+        return -1;
+    poiseuille_plate_forces(c, d, &pw, r);
+    poiseuille_report(c, d->particles, &pw, r);
     return 0;
 }
 
