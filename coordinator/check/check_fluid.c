@@ -197,17 +197,28 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
     return nc;
 }
 
-/* First row of the late window of the force stream. */
-static int64_t fluid_late_row(const lahar_check_data *d)
+/* Where the late window of the times t[0, n) starts (see the top of the file; n > 0). */
+static double fluid_late_from(const double *t, int64_t n)
 {
-    if (d->nrow == 0)
+    double t0 = t[0], t1 = t[n - 1];
+    return t1 - 0.1 * (t1 - t0);
+}
+
+/* First index of the late window of the times t[0, n): the last one and the run of those before it
+ * that are in the window (0 when n = 0). */
+static int64_t fluid_late_start(const double *t, int64_t n)
+{
+    if (n == 0)
         return 0;
-    double t0 = d->ft[0], t1 = d->ft[d->nrow - 1], from = t1 - 0.1 * (t1 - t0);
-    int64_t k = d->nrow - 1;
-    while (k > 0 && d->ft[k - 1] >= from)
+    double from = fluid_late_from(t, n);
+    int64_t k = n - 1;
+    while (k > 0 && t[k - 1] >= from)
         k--;
     return k;
 }
+
+/* First row of the late window of the force stream. */
+static int64_t fluid_late_row(const lahar_check_data *d) { return fluid_late_start(d->ft, d->nrow); }
 
 static double fluid_force(const lahar_check_data *d, int64_t row, int j, vec3 dir)
 {
@@ -1063,7 +1074,7 @@ int lahar_check_floating_box(const lahar_case *c, const lahar_check_data *d, lah
     const lahar_body *box = &c->bodies[b];
     int m = box->material;
     double rho_b = m >= 0 && m < c->nmaterial ? c->materials[m].density : NAN, R = box->shape.radius;
-    double t0 = p->t[0], t1 = p->t[p->nsnap - 1], from = t1 - 0.1 * (t1 - t0);
+    double t0 = p->t[0], t1 = p->t[p->nsnap - 1], from = fluid_late_from(p->t, p->nsnap);
     double tol = c->output_interval > 0.0 ? 0.25 * c->output_interval : 1e-9;
     int pd = lahar_check_panel(r, "draft of the box", "t [s]", "draft [m]");
     lahar_check_curve(r, pd, 1, box->name);
