@@ -220,6 +220,9 @@ static int64_t fluid_late_start(const double *t, int64_t n)
 /* First row of the late window of the force stream. */
 static int64_t fluid_late_row(const lahar_check_data *d) { return fluid_late_start(d->ft, d->nrow); }
 
+/* First particle snapshot of the late window. */
+static int64_t fluid_late_snapshot(const lahar_check_particles *p) { return fluid_late_start(p->t, p->nsnap); }
+
 static double fluid_force(const lahar_check_data *d, int64_t row, int j, vec3 dir)
 {
     return v3_dot(v3_load(d->force + ((size_t)row * (size_t)d->nbody + (size_t)j) * 3), dir);
@@ -853,19 +856,58 @@ int lahar_check_sphere_array(const lahar_case *c, const lahar_check_data *d, lah
  *    least 3 dx from the floor and from the surface (where kernels are not cut by them).
  *  - free_surface_spread_rel: (highest - lowest column top) / h, mean over the window;
  *    max_speed_rel: largest particle speed at the last snapshot / sqrt(g h) (nothing drifts). */
-int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+
+/* What hydrostatic measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    double rho, dx, g;
+    vec3 up, e1, e2;           /* against gravity; the horizontal directions */
+    int64_t kl;                /* the last snapshot */
+    vec3 centre;               /* the fluid's centroid at the last snapshot */
+    int floor_j;               /* the fixed body under the lowest particle */
+    double y_floor;            /* its surface's height */
+    fluid_columns cols;
+    double tmax;               /* the highest column top at the last snapshot */
+    /* the late window: pressures in rows of dx above the floor */
+    int nb;
+    double *bp, *by;           /* [nb] sums of the pressures and the heights of a row's samples */
+    int64_t *bn;               /* [nb] its samples */
+    double level_sum, spread_sum, vmax;
+    int nwin;
+    double level, h;           /* the window's mean free-surface level, the depth above the floor */
+    double se, sr, sei, sri;   /* sums of the pressure errors and references (all rows, interior) */
+    /* the side walls */
+    double werr, wforce, wref; /* the worst wall's relative error, its force and reference per width */
+    int nwall;
+} hydrostatic;
+
+static void hydrostatic_free(hydrostatic *hs)
+{
+    free(hs->bp), free(hs->by), free(hs->bn), free(hs->cols.top);
+    hs->bp = hs->by = NULL, hs->bn = NULL, hs->cols.top = NULL;
+}
+
+/* The fields, gravity's frame and dx: 0, or -1 with r->err. */
+static int hydrostatic_frame(const lahar_case *c, const lahar_check_data *d, hydrostatic *hs, lahar_check_result *r)
 {
     if (fluid_need(d, LAHAR_PFIELD_PRESSURE, "hydrostatic", r))
         return -1;
-    lahar_check_particles *p = d->particles;
-    vec3 up, e1, e2;
-    double rho = c->sph_density, dx = fluid_dx(c, d), g = v3_norm(v3_load(c->gravity));
-    if (fluid_frame(c, &up, &e1, &e2) || !(dx > 0.0)) {
+    hs->rho = c->sph_density, hs->dx = fluid_dx(c, d), hs->g = v3_norm(v3_load(c->gravity));
+    if (fluid_frame(c, &hs->up, &hs->e1, &hs->e2) || !(hs->dx > 0.0)) {
         snprintf(r->err, sizeof r->err, "hydrostatic: needs gravity and sph.dx > 0");
         return -1;
     }
-    int64_t kl = p->nsnap - 1;
-    if (fluid_read(d, kl, r))
+    return 0;
+}
+
+/* At the last snapshot (left in the buffers): the fluid's centroid, the floor (the fixed body
+ * whose surface faces up under the lowest particle) and the height of the free surface's highest
+ * column, which sizes the rows. 0, or -1 with r->err. */
+static int hydrostatic_floor(const lahar_case *c, const lahar_check_data *d, hydrostatic *hs, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    const vec3 up = hs->up;
+    hs->kl = p->nsnap - 1;
+    if (fluid_read(d, hs->kl, r))
         return -1;
     if (p->cur_n == 0) {
         snprintf(r->err, sizeof r->err, "hydrostatic: no particles in the last snapshot");
@@ -878,7 +920,7 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
             ilow = i;
         centre = v3_add(centre, fluid_pos(p, i));
     }
-    centre = v3_scale(centre, 1.0 / (double)p->cur_n);
+    hs->centre = v3_scale(centre, 1.0 / (double)p->cur_n);
     int floor_j = -1;
     double best = INFINITY, y_floor = 0.0;
     for (int j = 0; j < c->nbody; j++) {
@@ -890,123 +932,192 @@ int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, laha
         if (v3_dot(n, up) > 0.9 && gap < best)
             best = gap, floor_j = j, y_floor = v3_dot(v3_axpy(c->bodies[j].shape.radius, n, cp), up);
     }
-    double level = 0.0, tmin = 0.0, tmax = 0.0;
-    fluid_columns cols = {NULL, 0};
-    if (floor_j < 0 || !fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &cols, &level, &tmin, &tmax)) {
-        free(cols.top);
+    hs->floor_j = floor_j, hs->y_floor = y_floor;
+    double level = 0.0, tmin = 0.0;
+    hs->tmax = 0.0;
+    if (floor_j < 0 ||
+        !fluid_surface(p, c->dim, up, hs->e1, hs->e2, hs->dx, INFINITY, -INFINITY, &hs->cols, &level, &tmin,
+                       &hs->tmax)) {
         snprintf(r->err, sizeof r->err, "hydrostatic: no fixed floor under the fluid");
         return -1;
     }
-    /* late-window snapshots: mean level, and pressures binned by height (rows of dx above the
-     * floor) and averaged over the window, so that the column's start-up oscillation averages
-     * out as it does in the wall force */
-    int nb = (int)ceil((tmax - y_floor) / dx) + 4;
-    nb = nb < 1 ? 1 : (nb > 4000 ? 4000 : nb);
-    double *bp = calloc((size_t)nb, sizeof *bp), *by = calloc((size_t)nb, sizeof *by);
-    int64_t *bn = calloc((size_t)nb, sizeof *bn);
-    if (!bp || !by || !bn) {
-        free(bp), free(by), free(bn), free(cols.top);
+    return 0;
+}
+
+/* The snapshot k in the buffers: its particles' pressures and heights into the rows; on the last
+ * snapshot also the largest speed (when the velocities are there). */
+static void hydrostatic_bin_snapshot(const lahar_check_particles *p, int64_t k, hydrostatic *hs)
+{
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        double y = v3_dot(fluid_pos(p, i), hs->up);
+        int b = (int)floor((y - hs->y_floor) / hs->dx);
+        b = b < 0 ? 0 : (b >= hs->nb ? hs->nb - 1 : b);
+        hs->bp[b] += p->pressure[i], hs->by[b] += y, hs->bn[b]++;
+        if (p->vx && k == hs->kl)
+            hs->vmax = fmax(hs->vmax, v3_norm(fluid_vel(p, i)));
+    }
+}
+
+/* Late-window snapshots (latest first): the mean level and its spread, and the pressures binned
+ * by height (rows of dx above the floor) and averaged over the window, so that the column's
+ * start-up oscillation averages out as it does in the wall force. 0, or -1 with r->err. */
+static int hydrostatic_window(const lahar_case *c, const lahar_check_data *d, hydrostatic *hs,
+                              lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    int nb = (int)ceil((hs->tmax - hs->y_floor) / hs->dx) + 4;
+    hs->nb = nb = nb < 1 ? 1 : (nb > 4000 ? 4000 : nb);
+    hs->bp = calloc((size_t)nb, sizeof *hs->bp), hs->by = calloc((size_t)nb, sizeof *hs->by);
+    hs->bn = calloc((size_t)nb, sizeof *hs->bn);
+    if (!hs->bp || !hs->by || !hs->bn) {
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
-    double t_from = p->t[kl] - 0.1 * (p->t[kl] - p->t[0]), level_sum = 0.0, spread_sum = 0.0, vmax = 0.0;
-    int nwin = 0;
-    for (int64_t k = kl; k >= 0 && (k == kl || p->t[k] >= t_from); k--) {
-        if (fluid_read(d, k, r)) {
-            free(bp), free(by), free(bn), free(cols.top);
+    const int64_t k0 = fluid_late_snapshot(p);
+    double level = 0.0, tmin = 0.0, tmax = 0.0;
+    for (int64_t k = hs->kl; k >= k0; k--) {
+        if (fluid_read(d, k, r))
             return -1;
-        }
-        if (!fluid_surface(p, c->dim, up, e1, e2, dx, INFINITY, -INFINITY, &cols, &level, &tmin, &tmax))
+        if (!fluid_surface(p, c->dim, hs->up, hs->e1, hs->e2, hs->dx, INFINITY, -INFINITY, &hs->cols, &level, &tmin,
+                           &tmax))
             continue;
-        level_sum += level, spread_sum += tmax - tmin, nwin++;
-        for (int64_t i = 0; i < p->cur_n; i++) {
-            double y = v3_dot(fluid_pos(p, i), up);
-            int b = (int)floor((y - y_floor) / dx);
-            b = b < 0 ? 0 : (b >= nb ? nb - 1 : b);
-            bp[b] += p->pressure[i], by[b] += y, bn[b]++;
-            if (p->vx && k == kl)
-                vmax = fmax(vmax, v3_norm(fluid_vel(p, i)));
-        }
+        hs->level_sum += level, hs->spread_sum += tmax - tmin, hs->nwin++;
+        hydrostatic_bin_snapshot(p, k, hs);
     }
-    level = level_sum / (nwin ? nwin : 1);
-    double h = level - y_floor, se = 0.0, sr = 0.0, sei = 0.0, sri = 0.0;
+    hs->level = hs->level_sum / (hs->nwin ? hs->nwin : 1);
+    hs->h = hs->level - hs->y_floor;
+    return 0;
+}
+
+/* The rows' mean pressures against rho g (level - y): over every row, and over the interior rows
+ * at least 3 dx from the floor and from the surface (where the kernels are not cut by them). */
+static void hydrostatic_pressure_profile(hydrostatic *hs, lahar_check_result *r)
+{
+    const double rho = hs->rho, g = hs->g, level = hs->level, y_floor = hs->y_floor, dx = hs->dx;
+    double se = 0.0, sr = 0.0, sei = 0.0, sri = 0.0;
     int pp = lahar_check_panel(r, "pressure, late-window mean per row of dx", "p [Pa]", "height above the floor [m]");
     lahar_check_curve(r, pp, 1, "lahar");
-    for (int b = 0; b < nb; b++) {
-        if (!bn[b])
+    for (int b = 0; b < hs->nb; b++) {
+        if (!hs->bn[b])
             continue;
-        double pm = bp[b] / (double)bn[b], ym = by[b] / (double)bn[b], pr = rho * g * (level - ym);
-        se += (double)bn[b] * (pm - pr) * (pm - pr), sr += (double)bn[b] * pr * pr;
+        const double n = (double)hs->bn[b];
+        double pm = hs->bp[b] / n, ym = hs->by[b] / n, pr = rho * g * (level - ym);
+        se += n * (pm - pr) * (pm - pr), sr += n * pr * pr;
         if (ym - y_floor >= 3.0 * dx && level - ym >= 3.0 * dx)
-            sei += (double)bn[b] * (pm - pr) * (pm - pr), sri += (double)bn[b] * pr * pr;
+            sei += n * (pm - pr) * (pm - pr), sri += n * pr * pr;
         lahar_check_point(r, pm, ym - y_floor);
     }
     lahar_check_curve(r, pp, 0, "rho g (h - y)");
-    lahar_check_point(r, rho * g * h, 0.0);
-    lahar_check_point(r, 0.0, h);
-    free(bp), free(by), free(bn), free(cols.top);
-    if (fluid_read(d, kl, r))
+    lahar_check_point(r, rho * g * hs->h, 0.0);
+    lahar_check_point(r, 0.0, hs->h);
+    hs->se = se, hs->sr = sr, hs->sei = sei, hs->sri = sri;
+}
+
+/* Side wall j at the last snapshot (in the buffers): its outward horizontal normal and its width
+ * W (1 in 2D, the fluid's extent along it + dx in 3D) into *n, *W; 0 when j is no side wall (its
+ * normal towards the fluid is not horizontal, or the fluid does not reach it within 2 dx). */
+static int hydrostatic_side_wall(const lahar_case *c, const lahar_check_data *d, const hydrostatic *hs, int j,
+                                 vec3 *n_out, double *W)
+{
+    const lahar_check_particles *p = d->particles;
+    const vec3 up = hs->up;
+    vec3 cp;
+    fluid_core_dist(c, d, j, -1, hs->centre, &cp);
+    vec3 n = v3_normalize(v3_sub(hs->centre, cp));
+    if (fabs(v3_dot(n, up)) > 0.1)
+        return 0;
+    n = v3_normalize(v3_sub(n, v3_scale(up, v3_dot(n, up))));
+    double near = INFINITY, tlo = INFINITY, thi = -INFINITY;
+    vec3 et = v3_cross(up, n);
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        vec3 x = fluid_pos(p, i);
+        near = fmin(near, fluid_core_dist(c, d, j, -1, x, NULL) - c->bodies[j].shape.radius);
+        tlo = fmin(tlo, v3_dot(x, et)), thi = fmax(thi, v3_dot(x, et));
+    }
+    if (near > 2.0 * hs->dx)
+        return 0;
+    *n_out = n;
+    *W = c->dim == 3 ? thi - tlo + hs->dx : 1.0;
+    return 1;
+}
+
+/* Every side wall's late-window mean force pushing it outwards against rho g h^2 W / 2; the worst
+ * wall is kept. 0, or -1 with r->err when there is none (no force stream, or the walls are not
+ * bodies of their own: one body holding floor and walls gets horizontal forces that cancel). */
+static int hydrostatic_side_walls(const lahar_case *c, const lahar_check_data *d, hydrostatic *hs,
+                                  lahar_check_result *r)
+{
+    if (fluid_read(d, hs->kl, r))
         return -1;
-    /* side walls */
-    double werr = NAN, wforce = NAN, wref = NAN;
-    int nwall = 0;
-    int pw = -1;
+    const double rho = hs->rho, g = hs->g, h = hs->h;
+    hs->werr = NAN, hs->wforce = NAN, hs->wref = NAN, hs->nwall = 0;
     if (d->nrow > 0) {
         int64_t k0 = fluid_late_row(d);
-        pw = lahar_check_panel(r, "side wall force per unit width", "t [s]", "F / W [N/m]");
+        int pw = lahar_check_panel(r, "side wall force per unit width", "t [s]", "F / W [N/m]");
         for (int j = 0; j < c->nbody; j++) {
-            if (j == floor_j || c->bodies[j].motion != LAHAR_MOTION_FIXED)
+            vec3 n;
+            double W;
+            if (j == hs->floor_j || c->bodies[j].motion != LAHAR_MOTION_FIXED ||
+                !hydrostatic_side_wall(c, d, hs, j, &n, &W))
                 continue;
-            vec3 cp;
-            fluid_core_dist(c, d, j, -1, centre, &cp);
-            vec3 n = v3_normalize(v3_sub(centre, cp));
-            if (fabs(v3_dot(n, up)) > 0.1)
-                continue;
-            n = v3_normalize(v3_sub(n, v3_scale(up, v3_dot(n, up))));
-            double near = INFINITY, tlo = INFINITY, thi = -INFINITY;
-            vec3 et = v3_cross(up, n);
-            for (int64_t i = 0; i < p->cur_n; i++) {
-                vec3 x = fluid_pos(p, i);
-                near = fmin(near, fluid_core_dist(c, d, j, -1, x, NULL) - c->bodies[j].shape.radius);
-                tlo = fmin(tlo, v3_dot(x, et)), thi = fmax(thi, v3_dot(x, et));
-            }
-            if (near > 2.0 * dx)
-                continue;
-            double W = c->dim == 3 ? thi - tlo + dx : 1.0, ref = 0.5 * rho * g * h * h * W;
+            double ref = 0.5 * rho * g * h * h * W;
             double F = fluid_force_mean(d, k0, j, v3_neg(n)), e = fabs(F - ref) / ref;
-            if (nwall == 0 || e > werr)
-                werr = e, wforce = F / W, wref = ref / W;
-            nwall++;
+            if (hs->nwall == 0 || e > hs->werr)
+                hs->werr = e, hs->wforce = F / W, hs->wref = ref / W;
+            hs->nwall++;
             fluid_plot_force(r, pw, d, j, v3_neg(n), W, c->bodies[j].name);
         }
-        if (nwall > 0) {
+        if (hs->nwall > 0) {
             lahar_check_curve(r, pw, 0, "rho g h^2 / 2");
-            lahar_check_point(r, d->ft[0], wref);
-            lahar_check_point(r, d->ft[d->nrow - 1], wref);
+            lahar_check_point(r, d->ft[0], hs->wref);
+            lahar_check_point(r, d->ft[d->nrow - 1], hs->wref);
         }
     }
-    if (nwall == 0) {
+    if (hs->nwall == 0) {
         snprintf(r->err, sizeof r->err,
                  "hydrostatic: no side wall force: needs forces.h5 and side walls as fixed bodies of their own that "
                  "the water touches");
         return -1;
     }
-    lahar_check_value(r, "wall_force_rel_error", werr);
-    lahar_check_value(r, "pressure_l2_rel_error", sr > 0.0 ? sqrt(se / sr) : NAN);
-    lahar_check_value(r, "pressure_l2_rel_error_interior", sri > 0.0 ? sqrt(sei / sri) : NAN);
-    lahar_check_value(r, "free_surface_spread_rel", spread_sum / (nwin ? nwin : 1) / h);
+    return 0;
+}
+
+/* The metrics and the information values (check.json), the note and the title. */
+static void hydrostatic_report(const lahar_case *c, const lahar_check_particles *p, const hydrostatic *hs,
+                               lahar_check_result *r)
+{
+    const double h = hs->h;
+    lahar_check_value(r, "wall_force_rel_error", hs->werr);
+    lahar_check_value(r, "pressure_l2_rel_error", hs->sr > 0.0 ? sqrt(hs->se / hs->sr) : NAN);
+    lahar_check_value(r, "pressure_l2_rel_error_interior", hs->sri > 0.0 ? sqrt(hs->sei / hs->sri) : NAN);
+    lahar_check_value(r, "free_surface_spread_rel", hs->spread_sum / (hs->nwin ? hs->nwin : 1) / h);
     if (p->vx)
-        lahar_check_value(r, "max_speed_rel", vmax / sqrt(g * h));
+        lahar_check_value(r, "max_speed_rel", hs->vmax / sqrt(hs->g * h));
     lahar_check_value(r, "depth", h);
-    lahar_check_value(r, "wall_force_per_width", wforce);
-    lahar_check_value(r, "wall_force_reference", wref);
-    lahar_check_value(r, "side_walls", nwall);
-    lahar_check_value(r, "t_last", p->t[kl]);
+    lahar_check_value(r, "wall_force_per_width", hs->wforce);
+    lahar_check_value(r, "wall_force_reference", hs->wref);
+    lahar_check_value(r, "side_walls", hs->nwall);
+    lahar_check_value(r, "t_last", p->t[hs->kl]);
     snprintf(r->note, sizeof r->note,
              "floor %s; h from the free-surface level (mean column top + dx/2); wall force: late-window mean, worst "
              "side wall, reference rho g h^2/2 per unit width",
-             c->bodies[floor_j].name);
-    snprintf(r->title, sizeof r->title, "hydrostatic: h = %.4g m, worst wall force error %.3g %%", h, 100.0 * werr);
+             c->bodies[hs->floor_j].name);
+    snprintf(r->title, sizeof r->title, "hydrostatic: h = %.4g m, worst wall force error %.3g %%", h,
+             100.0 * hs->werr);
+}
+
+int lahar_check_hydrostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    hydrostatic hs = {0};
+    if (hydrostatic_frame(c, d, &hs, r) || hydrostatic_floor(c, d, &hs, r) || hydrostatic_window(c, d, &hs, r)) {
+        hydrostatic_free(&hs);
+        return -1;
+    }
+    hydrostatic_pressure_profile(&hs, r);
+    hydrostatic_free(&hs);
+    if (hydrostatic_side_walls(c, d, &hs, r))
+        return -1;
+    hydrostatic_report(c, d->particles, &hs, r);
     return 0;
 }
 
