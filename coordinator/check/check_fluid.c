@@ -1665,6 +1665,10 @@ static const double ghia_v[] = {-0.05906, -0.07391, -0.08864, -0.10313, -0.16914
 #define GHIA_NU ((int)(sizeof ghia_y / sizeof ghia_y[0]))
 #define GHIA_NV ((int)(sizeof ghia_x / sizeof ghia_x[0]))
 #define CAVITY_NPROF 81 /* plotted profile points per centreline */
+/* The sample points: Ghia's (u, then v), then the plotted profiles (u, then v). */
+#define CAVITY_NPT (GHIA_NU + GHIA_NV + 2 * CAVITY_NPROF)
+#define CAVITY_PROF_U (GHIA_NU + GHIA_NV)            /* first point of the plotted u profile */
+#define CAVITY_PROF_V (CAVITY_PROF_U + CAVITY_NPROF) /* first point of the plotted v profile */
 
 /* Lid-driven square cavity (2D): the fluid fills a square of side L (the particles' extent at the
  * first snapshot plus dx/2 each side) closed by fixed walls and a lid, the prescribed body moving
@@ -1682,32 +1686,59 @@ static const double ghia_v[] = {-0.05906, -0.07391, -0.08864, -0.10313, -0.16914
  *    compresses the fluid by a few 1e-3 for about a second: a sound wave, not a drift).
  *  - information: the Reynolds number, V at the end over the box area L^2, mean and max rho/rho0
  *    at the end, the mean u/U of the particles within dx of the lid in its middle half at the end. */
-int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+
+/* What lid_driven_cavity measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    double dx, rho0, U;        /* spacing, rest density, the lid's speed */
+    int lid;                   /* the moving prescribed body */
+    double x0, x1, y0, y1, L, Re; /* the box the fluid fills at t = 0, its side, rho0 U L / mu */
+    /* the sample points and their Shepard sums over the late window */
+    double px[CAVITY_NPT], py[CAVITY_NPT], su[CAVITY_NPT], sw[CAVITY_NPT];
+    double val[CAVITY_NPT];    /* the sampled velocity component / U (NAN: no particle within 2 dx) */
+    /* the volume sum m/rho over the snapshots, the state at the end */
+    double V0, V, dev, Vwin, rho_mean, rho_max, ulid;
+    int nwin;
+    /* the centreline errors against Ghia's points */
+    double umax, u2, vmax, v2;
+} cavity;
+
+/* The fields, the lid (moving along +x) and the fluid's properties: 0, or -1 with r->err. */
+static int cavity_lid(const lahar_case *c, const lahar_check_data *d, cavity *cv, lahar_check_result *r)
 {
     if (fluid_need(d, LAHAR_PFIELD_VELOCITY, "lid_driven_cavity", r))
         return -1;
-    lahar_check_particles *p = d->particles;
-    if (!(p->fields & LAHAR_PFIELD_DENSITY)) {
+    if (!(d->particles->fields & LAHAR_PFIELD_DENSITY)) {
         snprintf(r->err, sizeof r->err, "lid_driven_cavity: particles.h5 lacks the density; add density to output: fields");
         return -1;
     }
-    const double dx = fluid_dx(c, d), rho0 = c->sph_density, mu = c->sph.mu;
+    cv->dx = fluid_dx(c, d), cv->rho0 = c->sph_density;
     int lid = -1;
     for (int j = 0; j < c->nbody && lid < 0; j++)
         if (c->bodies[j].motion == LAHAR_MOTION_PRESCRIBED && v3_norm(v3_load(c->bodies[j].v)) > 0.0)
             lid = j;
-    if (c->dim != 2 || lid < 0 || !(dx > 0.0) || !(mu > 0.0) || c->sph.initial_pressure != LAHAR_SPH_INITIAL_PRESSURE_NONE) {
+    if (c->dim != 2 || lid < 0 || !(cv->dx > 0.0) || !(c->sph.mu > 0.0) ||
+        c->sph.initial_pressure != LAHAR_SPH_INITIAL_PRESSURE_NONE) {
         snprintf(r->err, sizeof r->err,
                  "lid_driven_cavity: needs a 2D case with a moving prescribed body (the lid), sph.viscosity > 0 and "
                  "no hydrostatic start");
         return -1;
     }
-    const double *lv = c->bodies[lid].v, U = fabs(lv[0]);
-    if (!(lv[0] > 0.0) || fabs(lv[1]) > 1e-9 * U) {
+    const double *lv = c->bodies[lid].v;
+    cv->lid = lid, cv->U = fabs(lv[0]);
+    if (!(lv[0] > 0.0) || fabs(lv[1]) > 1e-9 * cv->U) {
         snprintf(r->err, sizeof r->err, "lid_driven_cavity: the lid '%s' must move along +x (velocity %g, %g)",
                  c->bodies[lid].name, lv[0], lv[1]);
         return -1;
     }
+    return 0;
+}
+
+/* The square the fluid fills at the first snapshot (the particles' extent plus dx/2 each side)
+ * under the lid, and its Reynolds number, which Ghia's tables fix at 100. 0, or -1 with r->err. */
+static int cavity_box(const lahar_case *c, const lahar_check_data *d, cavity *cv, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    const double dx = cv->dx;
     if (fluid_read(d, 0, r))
         return -1;
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
@@ -1716,129 +1747,188 @@ int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d
         y0 = fmin(y0, p->y[i]), y1 = fmax(y1, p->y[i]);
     }
     x0 -= 0.5 * dx, x1 += 0.5 * dx, y0 -= 0.5 * dx, y1 += 0.5 * dx;
-    const double L = x1 - x0, Re = rho0 * U * L / mu;
-    if (!(fabs(y1 - y0 - L) < dx) || !(c->bodies[lid].x[1] > y1)) {
+    const double L = x1 - x0, Re = cv->rho0 * cv->U * L / c->sph.mu;
+    cv->x0 = x0, cv->x1 = x1, cv->y0 = y0, cv->y1 = y1, cv->L = L, cv->Re = Re;
+    if (!(fabs(y1 - y0 - L) < dx) || !(c->bodies[cv->lid].x[1] > y1)) {
         snprintf(r->err, sizeof r->err,
                  "lid_driven_cavity: the fluid must fill a square (%g x %g m) under the lid '%s'", L, y1 - y0,
-                 c->bodies[lid].name);
+                 c->bodies[cv->lid].name);
         return -1;
     }
     if (fabs(Re - 100.0) > 1.0) {
         snprintf(r->err, sizeof r->err,
                  "lid_driven_cavity: Ghia et al.'s tables here are for Re = 100; rho U L / mu = %g (U = %g m/s, L = "
                  "%g m)",
-                 Re, U, L);
+                 Re, cv->U, L);
         return -1;
     }
-    /* sample points: Ghia's (u then v), then the plotted profiles (u then v) */
-    enum { NPT = GHIA_NU + GHIA_NV + 2 * CAVITY_NPROF };
-    double px[NPT], py[NPT], su[NPT], sw[NPT];
+    return 0;
+}
+
+/* The sample points: Ghia's interior heights on x = L/2 and abscissae on y = L/2, then the
+ * plotted profiles along both centrelines (from dx/2 to L - dx/2); their sums start at 0. */
+static void cavity_sample_points(cavity *cv)
+{
+    const double x0 = cv->x0, y0 = cv->y0, L = cv->L, dx = cv->dx;
     int np = 0;
     for (int k = 0; k < GHIA_NU; k++, np++)
-        px[np] = x0 + 0.5 * L, py[np] = y0 + ghia_y[k] * L;
+        cv->px[np] = x0 + 0.5 * L, cv->py[np] = y0 + ghia_y[k] * L;
     for (int k = 0; k < GHIA_NV; k++, np++)
-        px[np] = x0 + ghia_x[k] * L, py[np] = y0 + 0.5 * L;
+        cv->px[np] = x0 + ghia_x[k] * L, cv->py[np] = y0 + 0.5 * L;
     for (int k = 0; k < 2 * CAVITY_NPROF; k++, np++) {
         double s = (0.5 * dx + (L - dx) * (k % CAVITY_NPROF) / (CAVITY_NPROF - 1.0));
-        px[np] = k < CAVITY_NPROF ? x0 + 0.5 * L : x0 + s;
-        py[np] = k < CAVITY_NPROF ? y0 + s : y0 + 0.5 * L;
+        cv->px[np] = k < CAVITY_NPROF ? x0 + 0.5 * L : x0 + s;
+        cv->py[np] = k < CAVITY_NPROF ? y0 + s : y0 + 0.5 * L;
     }
-    for (int k = 0; k < NPT; k++)
-        su[k] = sw[k] = 0.0;
-    const double m = rho0 * dx * dx, R2 = 4.0 * dx * dx;
-    const double tfirst = p->t[0], tlast = p->t[p->nsnap - 1], twin = tlast - 0.1 * (tlast - tfirst);
-    double V0 = NAN, V = NAN, dev = 0.0, Vwin = 0.0, rho_mean = NAN, rho_max = NAN, ulid = NAN;
-    int nwin = 0;
+    for (int k = 0; k < CAVITY_NPT; k++)
+        cv->su[k] = cv->sw[k] = 0.0;
+}
+
+/* The snapshot k in the buffers: the volume V = sum m/rho (m = rho0 dx^2, the lattice's mass) and
+ * its largest deviation from V(0) so far; the mean and largest density and the mean u/U within dx
+ * under the lid's middle half (kept from the last snapshot). */
+static void cavity_volume(const lahar_check_particles *p, int64_t k, cavity *cv)
+{
+    const double m = cv->rho0 * cv->dx * cv->dx, x0 = cv->x0, L = cv->L;
+    double s = 0.0, sr = 0.0, rmax = 0.0, sl = 0.0;
+    int nl = 0;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        s += m / p->density[i];
+        sr += p->density[i];
+        rmax = fmax(rmax, p->density[i]);
+        if (p->y[i] > cv->y1 - cv->dx && fabs(p->x[i] - x0 - 0.5 * L) < 0.25 * L)
+            sl += p->vx[i], nl++;
+    }
+    cv->V = s;
+    if (k == 0)
+        cv->V0 = cv->V;
+    cv->dev = fmax(cv->dev, fabs(cv->V / cv->V0 - 1.0));
+    cv->rho_mean = sr / (double)(p->cur_n ? p->cur_n : 1) / cv->rho0;
+    cv->rho_max = rmax / cv->rho0;
+    cv->ulid = nl ? sl / nl / cv->U : NAN;
+}
+
+/* The snapshot in the buffers into the Shepard sums of every sample point (weight exp(-(r/dx)^2),
+ * r < 2 dx): u at Ghia's u points and on the plotted u profile, v at the others. */
+static void cavity_sample(const lahar_check_particles *p, cavity *cv)
+{
+    const double dx = cv->dx, R2 = 4.0 * dx * dx;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        for (int q = 0; q < CAVITY_NPT; q++) {
+            const double ddx = p->x[i] - cv->px[q], ddy = p->y[i] - cv->py[q], r2 = ddx * ddx + ddy * ddy;
+            if (r2 >= R2)
+                continue;
+            const double w = exp(-r2 / (dx * dx));
+            cv->su[q] += w * (q < GHIA_NU || (q >= CAVITY_PROF_U && q < CAVITY_PROF_V) ? p->vx[i] : p->vy[i]);
+            cv->sw[q] += w;
+        }
+}
+
+/* Every snapshot: the volume (plotted) and the state at the end; the late window's snapshots
+ * also into the sample points' sums, the steady state with the particle noise averaged out.
+ * 0, or -1 with r->err. */
+static int cavity_snapshots(const lahar_check_data *d, cavity *cv, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    const double twin = fluid_late_from(p->t, p->nsnap);
+    cv->V0 = NAN, cv->V = NAN, cv->dev = 0.0, cv->Vwin = 0.0, cv->rho_mean = NAN, cv->rho_max = NAN, cv->ulid = NAN;
+    cv->nwin = 0;
     int pv = lahar_check_panel(r, "total volume sum m/rho over the box area L^2", "t [s]", "V / L^2");
     lahar_check_curve(r, pv, 1, "lahar");
     for (int64_t k = 0; k < p->nsnap; k++) {
         if (fluid_read(d, k, r))
             return -1;
-        double s = 0.0, sr = 0.0, rmax = 0.0, sl = 0.0;
-        int nl = 0;
-        for (int64_t i = 0; i < p->cur_n; i++) {
-            s += m / p->density[i];
-            sr += p->density[i];
-            rmax = fmax(rmax, p->density[i]);
-            if (p->y[i] > y1 - dx && fabs(p->x[i] - x0 - 0.5 * L) < 0.25 * L)
-                sl += p->vx[i], nl++;
-        }
-        V = s;
-        if (k == 0)
-            V0 = V;
-        dev = fmax(dev, fabs(V / V0 - 1.0));
-        rho_mean = sr / (double)(p->cur_n ? p->cur_n : 1) / rho0;
-        rho_max = rmax / rho0;
-        ulid = nl ? sl / nl / U : NAN;
-        lahar_check_point(r, p->t[k], V / (L * L));
+        cavity_volume(p, k, cv);
+        lahar_check_point(r, p->t[k], cv->V / (cv->L * cv->L));
         if (p->t[k] < twin)
             continue;
-        nwin++;
-        Vwin += V;
-        for (int64_t i = 0; i < p->cur_n; i++)
-            for (int q = 0; q < NPT; q++) {
-                const double ddx = p->x[i] - px[q], ddy = p->y[i] - py[q], r2 = ddx * ddx + ddy * ddy;
-                if (r2 >= R2)
-                    continue;
-                const double w = exp(-r2 / (dx * dx));
-                su[q] += w * (q < GHIA_NU || (q >= GHIA_NU + GHIA_NV && q < GHIA_NU + GHIA_NV + CAVITY_NPROF)
-                                  ? p->vx[i]
-                                  : p->vy[i]);
-                sw[q] += w;
-            }
+        cv->nwin++;
+        cv->Vwin += cv->V;
+        cavity_sample(p, cv);
     }
-    double val[NPT];
-    for (int q = 0; q < NPT; q++)
-        val[q] = sw[q] > 0.0 ? su[q] / sw[q] / U : NAN;
+    return 0;
+}
+
+/* The sampled velocities / U against Ghia et al.'s Tables I and II: max and sums of squares of
+ * the errors. 0, or -1 with r->err when a centreline point had no particle near. */
+static int cavity_centrelines(cavity *cv, lahar_check_result *r)
+{
+    for (int q = 0; q < CAVITY_NPT; q++)
+        cv->val[q] = cv->sw[q] > 0.0 ? cv->su[q] / cv->sw[q] / cv->U : NAN;
     double umax = 0.0, u2 = 0.0, vmax = 0.0, v2 = 0.0;
     for (int k = 0; k < GHIA_NU; k++) {
-        double e = fabs(val[k] - ghia_u[k]);
+        double e = fabs(cv->val[k] - ghia_u[k]);
         umax = fmax(umax, e), u2 += e * e;
     }
     for (int k = 0; k < GHIA_NV; k++) {
-        double e = fabs(val[GHIA_NU + k] - ghia_v[k]);
+        double e = fabs(cv->val[GHIA_NU + k] - ghia_v[k]);
         vmax = fmax(vmax, e), v2 += e * e;
     }
+    cv->umax = umax, cv->u2 = u2, cv->vmax = vmax, cv->v2 = v2;
     if (!isfinite(umax + vmax)) {
         snprintf(r->err, sizeof r->err, "lid_driven_cavity: a centreline point has no particle within 2 dx");
         return -1;
     }
+    return 0;
+}
+
+/* The two centreline profiles next to Ghia's points. */
+static void cavity_plot_profiles(const cavity *cv, lahar_check_result *r)
+{
+    const double x0 = cv->x0, y0 = cv->y0, L = cv->L;
     int pu = lahar_check_panel(r, "u / U along the vertical centreline x = L/2", "u / U", "y / L");
     lahar_check_curve(r, pu, 0, "Ghia, Ghia & Shin 1982, Table I (Re = 100)");
     for (int k = 0; k < GHIA_NU; k++)
         lahar_check_point(r, ghia_u[k], ghia_y[k]);
     lahar_check_curve(r, pu, 1, "lahar (late-window mean)");
     for (int k = 0; k < CAVITY_NPROF; k++)
-        lahar_check_point(r, val[GHIA_NU + GHIA_NV + k], (py[GHIA_NU + GHIA_NV + k] - y0) / L);
+        lahar_check_point(r, cv->val[CAVITY_PROF_U + k], (cv->py[CAVITY_PROF_U + k] - y0) / L);
     int pw = lahar_check_panel(r, "v / U along the horizontal centreline y = L/2", "x / L", "v / U");
     lahar_check_curve(r, pw, 0, "Ghia, Ghia & Shin 1982, Table II (Re = 100)");
     for (int k = 0; k < GHIA_NV; k++)
         lahar_check_point(r, ghia_x[k], ghia_v[k]);
     lahar_check_curve(r, pw, 1, "lahar (late-window mean)");
     for (int k = 0; k < CAVITY_NPROF; k++)
-        lahar_check_point(r, (px[GHIA_NU + GHIA_NV + CAVITY_NPROF + k] - x0) / L,
-                          val[GHIA_NU + GHIA_NV + CAVITY_NPROF + k]);
-    lahar_check_value(r, "u_max_error", umax);
-    lahar_check_value(r, "v_max_error", vmax);
-    lahar_check_value(r, "u_l2_error", sqrt(u2 / GHIA_NU));
-    lahar_check_value(r, "v_l2_error", sqrt(v2 / GHIA_NV));
-    lahar_check_value(r, "volume_drift", fabs(Vwin / nwin / V0 - 1.0));
-    lahar_check_value(r, "volume_deviation_max", dev);
-    lahar_check_value(r, "volume_end_over_box", V / (L * L));
-    lahar_check_value(r, "density_mean_end", rho_mean);
-    lahar_check_value(r, "density_max_end", rho_max);
-    lahar_check_value(r, "u_under_lid_end", ulid);
+        lahar_check_point(r, (cv->px[CAVITY_PROF_V + k] - x0) / L, cv->val[CAVITY_PROF_V + k]);
+}
+
+/* The metrics and the information values (check.json), the convention, the note and the title. */
+static void cavity_report(const lahar_case *c, const cavity *cv, lahar_check_result *r)
+{
+    const double L = cv->L, Re = cv->Re;
+    lahar_check_value(r, "u_max_error", cv->umax);
+    lahar_check_value(r, "v_max_error", cv->vmax);
+    lahar_check_value(r, "u_l2_error", sqrt(cv->u2 / GHIA_NU));
+    lahar_check_value(r, "v_l2_error", sqrt(cv->v2 / GHIA_NV));
+    lahar_check_value(r, "volume_drift", fabs(cv->Vwin / cv->nwin / cv->V0 - 1.0));
+    lahar_check_value(r, "volume_deviation_max", cv->dev);
+    lahar_check_value(r, "volume_end_over_box", cv->V / (L * L));
+    lahar_check_value(r, "density_mean_end", cv->rho_mean);
+    lahar_check_value(r, "density_max_end", cv->rho_max);
+    lahar_check_value(r, "u_under_lid_end", cv->ulid);
     lahar_check_value(r, "reynolds", Re);
-    lahar_check_value(r, "window_snapshots", nwin);
+    lahar_check_value(r, "window_snapshots", cv->nwin);
     snprintf(r->convention, sizeof r->convention,
              "errors in units of the lid speed U at Ghia et al.'s interior points (docs/reference/"
              "ghia_1982_re100.txt); volume V = sum rho0 dx^2 / rho_i");
     snprintf(r->note, sizeof r->note,
              "lid %s at U = %g m/s, L = %g m, Re = %.4g; profiles: Shepard mean (weight exp(-(r/dx)^2), r < 2 dx) "
              "over %d late-window snapshots",
-             c->bodies[lid].name, U, L, Re, nwin);
+             c->bodies[cv->lid].name, cv->U, L, Re, cv->nwin);
     snprintf(r->title, sizeof r->title, "lid_driven_cavity: Re = %.4g, max |u - u_Ghia| = %.3g U, max |v - v_Ghia| = %.3g U",
-             Re, umax, vmax);
+             Re, cv->umax, cv->vmax);
+}
+
+int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    cavity cv = {0};
+    if (cavity_lid(c, d, &cv, r) || cavity_box(c, d, &cv, r))
+        return -1;
+    cavity_sample_points(&cv);
+    if (cavity_snapshots(d, &cv, r) || cavity_centrelines(&cv, r))
+        return -1;
+    cavity_plot_profiles(&cv, r);
+    cavity_report(c, &cv, r);
     return 0;
 }
 
