@@ -72,108 +72,167 @@ static int64_t soil_extent(const lahar_check_particles *p, int dim, double dx, d
     return n;
 }
 
-int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+/* Start of the soil references' window, the last quarter of the run: long enough for the
+ * start-up oscillation to average out. */
+static double soil_late_from(const lahar_check_particles *p)
 {
-    lahar_check_particles *p = d->particles;
-    const lahar_material *mat = soil_material(c);
-    if (!p || !p->phase || !p->stress || !mat) {
+    const int64_t kl = p->nsnap - 1;
+    return p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+}
+
+/* What soil_geostatic measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    const lahar_material *mat; /* the soil's */
+    int dim, up;               /* up: the last axis (gravity along -up) */
+    double g, dx, rho, nu;
+    double k0, M;              /* nu / (1 - nu); the constrained modulus E (1 - nu) / ((1 + nu)(1 - 2 nu)) */
+    double mean0, H;           /* the soil's mean height and thickness at t = 0 */
+    /* the rows of dx below the surface, summed over the window */
+    int nrow;
+    double *sv, *sh;           /* [nrow] sums of sigma_v, sigma_h */
+    int64_t *cnt;              /* [nrow] samples */
+    int64_t kfirst;            /* the window's first snapshot */
+    double mean_first, mean_last; /* the mean height at the window's first and last snapshot */
+    /* the errors */
+    double ev, ek, erow, efloor;
+    int nused;                 /* the 2-row bins in ev, ek */
+} geostatic;
+
+static void geostatic_free(geostatic *gs)
+{
+    free(gs->sv), free(gs->sh), free(gs->cnt);
+    gs->sv = gs->sh = NULL, gs->cnt = NULL;
+}
+
+/* The fields, the soil and gravity along the last axis: 0, or -1 with r->err. */
+static int geostatic_setup(const lahar_case *c, const lahar_check_data *d, geostatic *gs, lahar_check_result *r)
+{
+    const lahar_check_particles *p = d->particles;
+    gs->mat = soil_material(c);
+    if (!p || !p->phase || !p->stress || !gs->mat) {
         snprintf(r->err, sizeof r->err, "soil_geostatic: needs a soil block and the particle fields phase and stress "
                  "(output: fields)");
         return -1;
     }
-    const int dim = c->dim, up = dim - 1; /* gravity along the last axis */
-    double g = -c->gravity[up];
-    const double dx = c->sph_dx, rho = mat->density, nu = mat->poisson;
-    for (int a = 0; a < dim; a++)
-        if (a != up && c->gravity[a] != 0.0)
+    gs->dim = c->dim, gs->up = gs->dim - 1; /* gravity along the last axis */
+    double g = -c->gravity[gs->up];
+    gs->dx = c->sph_dx, gs->rho = gs->mat->density, gs->nu = gs->mat->poisson;
+    for (int a = 0; a < gs->dim; a++)
+        if (a != gs->up && c->gravity[a] != 0.0)
             g = NAN;
-    if (!(g > 0.0) || !(dx > 0.0) || p->nsnap < 2) {
+    gs->g = g;
+    if (!(g > 0.0) || !(gs->dx > 0.0) || p->nsnap < 2) {
         snprintf(r->err, sizeof r->err, "soil_geostatic: needs gravity along -%c only, sph.dx > 0 and >= 2 snapshots",
-                 "xyz"[up]);
+                 "xyz"[gs->up]);
         return -1;
     }
-    const double k0 = nu / (1.0 - nu);
-    const double M = mat->young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    double top0, bot0, mean0;
+    const double nu = gs->nu;
+    gs->k0 = nu / (1.0 - nu);
+    gs->M = gs->mat->young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    return 0;
+}
+
+/* The layer at t = 0 (its thickness H and mean height) and the rows' buffers, H / dx + 2 rows:
+ * the surface may rise by a row. 0, or -1 with r->err. */
+static int geostatic_layer(lahar_check_particles *p, geostatic *gs, lahar_check_result *r)
+{
+    double top0, bot0;
     if (lahar_check_particles_read(p, 0, r->err, sizeof r->err) ||
-        soil_extent(p, dim, dx, &top0, &bot0, &mean0) == 0) {
+        soil_extent(p, gs->dim, gs->dx, &top0, &bot0, &gs->mean0) == 0) {
         if (!r->err[0])
             snprintf(r->err, sizeof r->err, "soil_geostatic: no soil particles at t = 0");
         return -1;
     }
-    const double H = top0 - bot0;
-    const int nrow = (int)ceil(H / dx) + 2;
-    double *sv = calloc((size_t)nrow, sizeof *sv), *sh = calloc((size_t)nrow, sizeof *sh);
-    int64_t *cnt = calloc((size_t)nrow, sizeof *cnt);
-    if (!sv || !sh || !cnt) {
-        free(sv), free(sh), free(cnt);
+    gs->H = top0 - bot0;
+    gs->nrow = (int)ceil(gs->H / gs->dx) + 2;
+    gs->sv = calloc((size_t)gs->nrow, sizeof *gs->sv), gs->sh = calloc((size_t)gs->nrow, sizeof *gs->sh);
+    gs->cnt = calloc((size_t)gs->nrow, sizeof *gs->cnt);
+    if (!gs->sv || !gs->sh || !gs->cnt) {
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
+    return 0;
+}
+
+/* The snapshots of the last quarter of the run (latest first): each soil particle's vertical and
+ * horizontal stress into its row by depth below the current surface, so that the start-up
+ * oscillation averages out; the mean height at both ends of the window (the creep). 0, or -1 with
+ * r->err. */
+static int geostatic_window(lahar_check_particles *p, geostatic *gs, lahar_check_result *r)
+{
+    const int dim = gs->dim;
     const int64_t kl = p->nsnap - 1;
-    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
-    int64_t kfirst = kl;
-    double mean_first = 0.0, mean_last = 0.0;
-    int rc = 0;
+    const double t_from = soil_late_from(p), dx = gs->dx;
     /* the stress of component a along axis e: xx, yy or zz */
-    const int comp_v = up == 1 ? 3 : 5, comp_h = 0;
+    const int comp_v = gs->up == 1 ? 3 : 5, comp_h = 0;
+    gs->kfirst = kl, gs->mean_first = 0.0, gs->mean_last = 0.0;
     for (int64_t k = kl; k >= 0 && (k == kl || p->t[k] >= t_from); k--) {
         double top, bot, mean;
-        if (lahar_check_particles_read(p, k, r->err, sizeof r->err)) {
-            rc = -1;
-            break;
-        }
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
+            return -1;
         soil_extent(p, dim, dx, &top, &bot, &mean);
         if (k == kl)
-            mean_last = mean;
-        kfirst = k;
-        mean_first = mean;
+            gs->mean_last = mean;
+        gs->kfirst = k;
+        gs->mean_first = mean;
         for (int64_t i = 0; i < p->cur_n; i++) {
             if (p->phase[i] != 1)
                 continue;
             int row = (int)floor((top - soil_up(p, dim, i)) / dx);
-            if (row < 0 || row >= nrow)
+            if (row < 0 || row >= gs->nrow)
                 continue;
-            sv[row] += p->stress[i * 6 + comp_v];
-            sh[row] += p->stress[i * 6 + comp_h];
-            cnt[row]++;
+            gs->sv[row] += p->stress[i * 6 + comp_v];
+            gs->sh[row] += p->stress[i * 6 + comp_h];
+            gs->cnt[row]++;
         }
     }
-    if (rc) {
-        free(sv), free(sh), free(cnt);
-        return -1;
-    }
-    double ev = 0.0, ek = 0.0;
-    int nused = 0;
+    return 0;
+}
+
+/* The rows' mean stresses against rho g z and K0 rho g z (kPa, compression positive). */
+static void geostatic_plot(const geostatic *gs, lahar_check_result *r)
+{
+    const double dx = gs->dx, H = gs->H, rho = gs->rho, g = gs->g;
     int pv = lahar_check_panel(r, "soil column at rest: stress vs depth (late-window mean per row)", "depth z (m)",
                                "stress (kPa, compression positive)");
     lahar_check_curve(r, pv, 1, "sigma_v (lahar)");
-    for (int row = 0; row < nrow; row++)
-        if (cnt[row] > 0)
-            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sv[row] / (double)cnt[row]);
+    for (int row = 0; row < gs->nrow; row++)
+        if (gs->cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * gs->sv[row] / (double)gs->cnt[row]);
     lahar_check_curve(r, pv, 1, "sigma_h (lahar)");
-    for (int row = 0; row < nrow; row++)
-        if (cnt[row] > 0)
-            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * sh[row] / (double)cnt[row]);
+    for (int row = 0; row < gs->nrow; row++)
+        if (gs->cnt[row] > 0)
+            lahar_check_point(r, (row + 0.5) * dx, -1e-3 * gs->sh[row] / (double)gs->cnt[row]);
     lahar_check_curve(r, pv, 0, "rho g z");
     lahar_check_point(r, 0.0, 0.0);
     lahar_check_point(r, H, 1e-3 * rho * g * H);
     lahar_check_curve(r, pv, 0, "K0 rho g z");
     lahar_check_point(r, 0.0, 0.0);
-    lahar_check_point(r, H, 1e-3 * k0 * rho * g * H);
-    double erow = 0.0, efloor = NAN;
-    for (int row = nrow - 1; row >= 0; row--)
+    lahar_check_point(r, H, 1e-3 * gs->k0 * rho * g * H);
+}
+
+/* The errors against sigma_v = -rho g z, sigma_h = K0 sigma_v (see the top of the file): the
+ * deepest row's alone (on the floor), every row's deeper than H/4, and those of the bins of two
+ * rows that enter the metrics. */
+static void geostatic_errors(geostatic *gs)
+{
+    const double dx = gs->dx, H = gs->H, rho = gs->rho, g = gs->g, k0 = gs->k0;
+    const double *sv = gs->sv, *sh = gs->sh;
+    const int64_t *cnt = gs->cnt;
+    double ev = 0.0, ek = 0.0, erow = 0.0, efloor = NAN;
+    int nused = 0;
+    for (int row = gs->nrow - 1; row >= 0; row--)
         if (cnt[row] > 0) { /* the deepest row: the one on the floor */
             double z = (row + 0.5) * dx;
             efloor = fabs(sv[row] / (double)cnt[row] + rho * g * z) / (rho * g * z);
             break;
         }
-    for (int row = 0; row < nrow; row++) {
+    for (int row = 0; row < gs->nrow; row++) {
         double z = (row + 0.5) * dx;
         if (cnt[row] > 0 && z >= 0.25 * H && z <= H) /* every row, the one on the floor too */
             erow = fmax(erow, fabs(sv[row] / (double)cnt[row] + rho * g * z) / (rho * g * z));
     }
-    for (int row = 0; row + 1 < nrow; row += 2) { /* bins of two rows, centred at depth (row + 1) dx */
+    for (int row = 0; row + 1 < gs->nrow; row += 2) { /* bins of two rows, centred at depth (row + 1) dx */
         double z = (row + 1) * dx;
         int64_t nb = cnt[row] + cnt[row + 1];
         if (cnt[row] == 0 || cnt[row + 1] == 0 || z < 0.25 * H || z + dx > H - dx * (1.0 - 1e-6))
@@ -184,26 +243,45 @@ int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, l
         ek = fmax(ek, fabs(h / v - k0) / k0);
         nused++;
     }
-    free(sv), free(sh), free(cnt);
-    if (nused == 0) {
-        snprintf(r->err, sizeof r->err, "soil_geostatic: no soil rows below H/4 (H = %g m, dx = %g m)", H, dx);
-        return -1;
-    }
-    const double settle_ref = rho * g * H * H / (3.0 * M);
-    lahar_check_value(r, "sigma_v_rel_error", ev);
-    lahar_check_value(r, "K0_rel_error", ek);
-    lahar_check_value(r, "creep_rel", fabs(mean_last - mean_first) / settle_ref);
-    lahar_check_value(r, "sigma_v_row_max_rel_error", erow);
-    lahar_check_value(r, "sigma_v_floor_rel_error", efloor);
-    lahar_check_value(r, "K0_reference", k0);
-    lahar_check_value(r, "settlement_m", mean0 - mean_last);
+    gs->ev = ev, gs->ek = ek, gs->erow = erow, gs->efloor = efloor, gs->nused = nused;
+}
+
+/* The metrics and the information values (check.json), the convention and the note. */
+static void geostatic_report(const lahar_check_particles *p, const geostatic *gs, lahar_check_result *r)
+{
+    const double H = gs->H, settle_ref = gs->rho * gs->g * H * H / (3.0 * gs->M);
+    lahar_check_value(r, "sigma_v_rel_error", gs->ev);
+    lahar_check_value(r, "K0_rel_error", gs->ek);
+    lahar_check_value(r, "creep_rel", fabs(gs->mean_last - gs->mean_first) / settle_ref);
+    lahar_check_value(r, "sigma_v_row_max_rel_error", gs->erow);
+    lahar_check_value(r, "sigma_v_floor_rel_error", gs->efloor);
+    lahar_check_value(r, "K0_reference", gs->k0);
+    lahar_check_value(r, "settlement_m", gs->mean0 - gs->mean_last);
     lahar_check_value(r, "settlement_elastic_m", settle_ref);
     lahar_check_value(r, "height_m", H);
-    lahar_check_value(r, "window_start_s", p->t[kfirst]);
+    lahar_check_value(r, "window_start_s", p->t[gs->kfirst]);
     snprintf(r->convention, sizeof r->convention,
              "stress tension positive; rows of dx by depth below the surface, mean over t >= %.3g s; bins of "
-             "two rows deeper than H/4 enter the metrics", p->t[kfirst]);
-    snprintf(r->note, sizeof r->note, "K0 = nu/(1-nu) = %.4f, H = %.4g m, 2-row bins used %d", k0, H, nused);
+             "two rows deeper than H/4 enter the metrics", p->t[gs->kfirst]);
+    snprintf(r->note, sizeof r->note, "K0 = nu/(1-nu) = %.4f, H = %.4g m, 2-row bins used %d", gs->k0, H, gs->nused);
+}
+
+int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    lahar_check_particles *p = d->particles;
+    geostatic gs = {0};
+    if (geostatic_setup(c, d, &gs, r) || geostatic_layer(p, &gs, r) || geostatic_window(p, &gs, r)) {
+        geostatic_free(&gs);
+        return -1;
+    }
+    geostatic_plot(&gs, r);
+    geostatic_errors(&gs);
+    geostatic_free(&gs);
+    if (gs.nused == 0) {
+        snprintf(r->err, sizeof r->err, "soil_geostatic: no soil rows below H/4 (H = %g m, dx = %g m)", gs.H, gs.dx);
+        return -1;
+    }
+    geostatic_report(p, &gs, r);
     return 0;
 }
 
@@ -486,7 +564,7 @@ int lahar_check_darcy(const lahar_case *c, const lahar_check_data *d, lahar_chec
     }
     const double g = gg > 0.0 ? gg : 9.81, i_h = bm / g, u_ref = mat->permeability * i_h;
     const int64_t kl = p->nsnap - 1;
-    const double t_from = p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
+    const double t_from = soil_late_from(p);
     double usum = 0.0;
     int nwin = 0;
     for (int64_t k = 0; k <= kl; k++) {
