@@ -424,7 +424,43 @@ static double check_gap(const lahar_case *c, int j, vec3 x, double R, vec3 *norm
  * height (where the overlap is zero: contact start and end) when the nearest fixed body is a
  * horizontal surface, otherwise at the instant where the two parabolas meet (contact time
  * neglected, an error of order g t_c (1 - e) / 2v). Independent of the snapshot interval. */
-static int check_restitution(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+
+/* What restitution measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    const lahar_check_data *d;
+    int b;                     /* the free body */
+    vec3 gh;                   /* unit vector along gravity */
+    double g, e_ref;           /* |gravity|; the least restitution of the body and what it touched */
+    /* the bounces found */
+    int nb;
+    int64_t last_q;            /* the last bounce's first snapshot after it */
+    double err_max;
+    /* the first bounce */
+    double e_first, u_imp_first, u_reb_first, t_first, h_contact, t_sep_first;
+    int64_t p_first;
+} bounces;
+
+/* One bounce between the free-flight snapshots p (before) and q (after). */
+typedef struct {
+    double u_imp, u_reb;       /* the speeds of the falling and of the rising parabola */
+    double hi, t_touch, t_sep; /* where and when they are taken: contact start and end */
+} bounce;
+
+/* Height of the body along -g at snapshot k, and its velocity along -g. */
+static double bounce_h(const bounces *bs, int64_t k) { return -v3_dot(check_vec(bs->d, bs->d->x, k, bs->b), bs->gh); }
+static double bounce_u(const bounces *bs, int64_t k) { return -v3_dot(check_vec(bs->d, bs->d->v, k, bs->b), bs->gh); }
+
+/* 1 when the body flies freely from snapshot k0 to k1: u_k follows u_{k-1} - g dt (exact for
+ * leap-frog under constant gravity). */
+static int bounce_free(const bounces *bs, int64_t k0, int64_t k1)
+{
+    const double g = bs->g, *t = bs->d->t;
+    return fabs(bounce_u(bs, k1) - (bounce_u(bs, k0) - g * (t[k1] - t[k0]))) <=
+           1e-6 * (fabs(bounce_u(bs, k0)) + g * (t[k1] - t[k0])) + 1e-12;
+}
+
+/* The free body, gravity and the reference e: 0, or -1 with r->err. */
+static int bounce_setup(const lahar_case *c, const lahar_check_data *d, bounces *bs, lahar_check_result *r)
 {
     int b = check_first_free_body(c);
     vec3 gv = v3_load(c->gravity);
@@ -434,106 +470,144 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
                  d->nsnap);
         return -1;
     }
-    vec3 gh = v3_scale(gv, 1.0 / g);
+    bs->d = d, bs->b = b, bs->g = g;
+    bs->gh = v3_scale(gv, 1.0 / g);
     double e_ref = check_material(c, b, offsetof(lahar_material, restitution));
     for (int j = 0; j < c->nbody; j++)
         if (check_fixed_touched(c, d, j))
             e_ref = fmin(e_ref, check_material(c, j, offsetof(lahar_material, restitution)));
-#define H(k) (-v3_dot(check_vec(d, d->x, (k), b), gh))
-#define U(k) (-v3_dot(check_vec(d, d->v, (k), b), gh))
-    /* u_k follows u_{k-1} - g dt in free flight (exact for leap-frog under constant gravity) */
-#define FREE(k0, k1) (fabs(U(k1) - (U(k0) - g * (d->t[k1] - d->t[k0]))) <= 1e-6 * (fabs(U(k0)) + g * (d->t[k1] - d->t[k0])) + 1e-12)
-    int nb = 0;
-    double e_first = NAN, err_max = 0.0, u_imp_first = 0.0, u_reb_first = 0.0, t_first = 0.0, h_contact = 0.0,
-           t_sep_first = 0.0;
-    int64_t p_first = 0, last_q = 0;
-    for (int64_t k = 0; k + 1 < d->nsnap; k++) {
-        if (!(U(k) < 0.0 && U(k + 1) > 0.0))
+    bs->e_ref = e_ref;
+    bs->e_first = NAN;
+    return 0;
+}
+
+/* The free-flight snapshots around the turn between k (moving down) and k + 1 (moving up): a
+ * snapshot taken during the contact is skipped, at most 3 each way. 1 with *p, *q; 0 when the
+ * bounce does not resolve that way (a ball settling, jitter at rest) or overlaps the last one. */
+static int bounce_flight(bounces *bs, int64_t k, int64_t *p_out, int64_t *q_out)
+{
+    const int64_t nsnap = bs->d->nsnap;
+    int64_t p = k, q = k + 1;
+    for (int tries = 0; tries < 3 && p >= 1 && !bounce_free(bs, p - 1, p); tries++)
+        p--;
+    for (int tries = 0; tries < 3 && q + 1 < nsnap && !bounce_free(bs, q, q + 1) && bounce_u(bs, q + 1) > 0.0; tries++)
+        q++;
+    if (p < 1 || p < bs->last_q || !bounce_free(bs, p - 1, p) || q + 1 >= nsnap || !bounce_free(bs, q, q + 1))
+        return 0;
+    bs->last_q = q;
+    *p_out = p, *q_out = q;
+    return 1;
+}
+
+/* The instant where the falling parabola of p meets the rising one of q, and their speeds there
+ * (the contact time neglected, an error of order g t_c (1 - e) / 2v). 1, or 0 when they do not
+ * meet between the two snapshots. */
+static int bounce_meet(const bounces *bs, int64_t p, int64_t q, bounce *bn)
+{
+    const double g = bs->g;
+    double tp = bs->d->t[p], tq = bs->d->t[q], up = bounce_u(bs, p), uq = bounce_u(bs, q), hp = bounce_h(bs, p),
+           hq = bounce_h(bs, q);
+    double beta = up - uq - g * (tq - tp);
+    double alpha = hp - hq - up * tp + uq * tq + 0.5 * g * (tq - tp) * (tp + tq);
+    if (beta == 0.0)
+        return 0;
+    double ti = -alpha / beta;
+    if (!(ti >= tp && ti <= tq))
+        return 0;
+    bn->u_imp = -(up - g * (ti - tp)), bn->u_reb = uq - g * (ti - tq);
+    bn->hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp), bn->t_touch = ti, bn->t_sep = ti;
+    return 1;
+}
+
+/* With a flat floor under the ball the contact starts and ends at the touching height h_c (zero
+ * overlap), and energy along each parabola gives the speeds there exactly: u^2 = u_k^2 + 2 g (h_k
+ * - h_c). This removes the g t_c/2 bias of the meeting point. 1 (bn changed only over a flat
+ * floor), or 0 when p or q lies inside the contact (not free flight). */
+static int bounce_flat_floor(const lahar_case *c, const bounces *bs, int64_t p, int64_t q, bounce *bn)
+{
+    const int b = bs->b;
+    const double g = bs->g;
+    int floor_j = -1;
+    double gap_p = INFINITY;
+    vec3 xp = check_vec(bs->d, bs->d->x, p, b), nrm;
+    for (int j = 0; j < c->nbody; j++) {
+        if (c->bodies[j].motion != LAHAR_MOTION_FIXED || c->bodies[j].shape.nv == 0)
             continue;
-        /* the snapshots around the bounce must be in free flight (a snapshot taken during the
-         * contact is skipped, at most 3 each way); bounces that do not resolve that way (a ball
-         * settling, jitter at rest) are not measured */
-        int64_t p = k, q = k + 1;
-        for (int tries = 0; tries < 3 && p >= 1 && !FREE(p - 1, p); tries++)
-            p--;
-        for (int tries = 0; tries < 3 && q + 1 < d->nsnap && !FREE(q, q + 1) && U(q + 1) > 0.0; tries++)
-            q++;
-        if (p < 1 || p < last_q || !FREE(p - 1, p) || q + 1 >= d->nsnap || !FREE(q, q + 1))
-            continue;
-        last_q = q;
-        double tp = d->t[p], tq = d->t[q], up = U(p), uq = U(q), hp = H(p), hq = H(q);
-        double beta = up - uq - g * (tq - tp);
-        double alpha = hp - hq - up * tp + uq * tq + 0.5 * g * (tq - tp) * (tp + tq);
-        if (beta == 0.0)
-            continue;
-        double ti = -alpha / beta;
-        if (!(ti >= tp && ti <= tq))
-            continue;
-        double u_imp = -(up - g * (ti - tp)), u_reb = uq - g * (ti - tq);
-        double hi = hp + up * (ti - tp) - 0.5 * g * (ti - tp) * (ti - tp), t_touch = ti, t_sep = ti;
-        /* With a flat floor under the ball the contact starts and ends at the touching height
-         * h_c (zero overlap), and energy along each parabola gives the speeds there exactly:
-         * u^2 = u_k^2 + 2 g (h_k - h_c). This removes the g t_c/2 bias of the meeting point. */
-        int floor_j = -1;
-        double gap_p = INFINITY;
-        vec3 xp = check_vec(d, d->x, p, b), nrm;
-        for (int j = 0; j < c->nbody; j++) {
-            if (c->bodies[j].motion != LAHAR_MOTION_FIXED || c->bodies[j].shape.nv == 0)
-                continue;
-            double gap = check_gap(c, j, xp, c->bodies[b].shape.radius, NULL);
-            if (gap < gap_p)
-                gap_p = gap, floor_j = j;
-        }
-        if (floor_j >= 0 && c->bodies[b].shape.nv == 1) {
-            check_gap(c, floor_j, xp, c->bodies[b].shape.radius, &nrm);
-            double hc = hp - gap_p;
-            if (-v3_dot(nrm, gh) > 0.999) {
-                if (!(hp > hc && hq > hc))
-                    continue; /* a snapshot inside the contact: not free flight */
-                u_imp = sqrt(up * up + 2.0 * g * (hp - hc));
-                u_reb = sqrt(uq * uq + 2.0 * g * (hq - hc));
-                hi = hc;
-                t_touch = tp + (up + u_imp) / g; /* u(t) = up - g (t - tp) reaches -u_imp */
-                t_sep = tq - (u_reb - uq) / g;   /* and the rising parabola left h_c at +u_reb */
-            }
-        }
-        if (u_imp <= 0.0 || u_reb <= 0.0)
-            continue;
-        double e = u_reb / u_imp;
-        if (nb == 0) {
-            e_first = e, u_imp_first = u_imp, u_reb_first = u_reb, t_first = t_touch, h_contact = hi, p_first = p;
-            t_sep_first = t_sep;
-        }
-        /* later bounces count only while the flight after them spans >= 3 snapshots, so that no
-         * second bounce hides between two snapshots */
-        double dt_out = d->t[q] - d->t[q - 1];
-        if (nb == 0 || 2.0 * u_reb / g >= 3.0 * dt_out)
-            err_max = fmax(err_max, fabs(e - e_ref) / e_ref);
-        nb++;
+        double gap = check_gap(c, j, xp, c->bodies[b].shape.radius, NULL);
+        if (gap < gap_p)
+            gap_p = gap, floor_j = j;
     }
-    if (nb == 0) {
-        snprintf(r->err, sizeof r->err,
-                 "restitution: no bounce of body %s found in %" PRId64 " snapshots (does it reach the floor before "
-                 "t_end?)",
-                 c->bodies[b].name, d->nsnap);
-        return -1;
+    if (floor_j < 0 || c->bodies[b].shape.nv != 1)
+        return 1;
+    check_gap(c, floor_j, xp, c->bodies[b].shape.radius, &nrm);
+    double tp = bs->d->t[p], tq = bs->d->t[q], up = bounce_u(bs, p), uq = bounce_u(bs, q), hp = bounce_h(bs, p),
+           hq = bounce_h(bs, q);
+    double hc = hp - gap_p;
+    if (!(-v3_dot(nrm, bs->gh) > 0.999))
+        return 1;
+    if (!(hp > hc && hq > hc))
+        return 0; /* a snapshot inside the contact: not free flight */
+    bn->u_imp = sqrt(up * up + 2.0 * g * (hp - hc));
+    bn->u_reb = sqrt(uq * uq + 2.0 * g * (hq - hc));
+    bn->hi = hc;
+    bn->t_touch = tp + (up + bn->u_imp) / g; /* u(t) = up - g (t - tp) reaches -u_imp */
+    bn->t_sep = tq - (bn->u_reb - uq) / g;   /* and the rising parabola left h_c at +u_reb */
+    return 1;
+}
+
+/* The turn between snapshots k and k + 1, if it is a bounce that can be measured: its e against
+ * e_ref; the first bounce is kept for the report and the plot. */
+static void bounce_measure(const lahar_case *c, bounces *bs, int64_t k)
+{
+    int64_t p, q;
+    bounce bn;
+    if (!(bounce_u(bs, k) < 0.0 && bounce_u(bs, k + 1) > 0.0) || !bounce_flight(bs, k, &p, &q) ||
+        !bounce_meet(bs, p, q, &bn) || !bounce_flat_floor(c, bs, p, q, &bn))
+        return;
+    if (bn.u_imp <= 0.0 || bn.u_reb <= 0.0)
+        return;
+    double e = bn.u_reb / bn.u_imp;
+    if (bs->nb == 0) {
+        bs->e_first = e, bs->u_imp_first = bn.u_imp, bs->u_reb_first = bn.u_reb, bs->t_first = bn.t_touch;
+        bs->h_contact = bn.hi, bs->p_first = p, bs->t_sep_first = bn.t_sep;
     }
-    check_value(r, "restitution_rel_error", fabs(e_first - e_ref) / e_ref);
-    check_value(r, "restitution_rel_error_max", err_max);
-    check_value(r, "e_measured", e_first);
+    /* later bounces count only while the flight after them spans >= 3 snapshots, so that no
+     * second bounce hides between two snapshots */
+    double dt_out = bs->d->t[q] - bs->d->t[q - 1];
+    if (bs->nb == 0 || 2.0 * bn.u_reb / bs->g >= 3.0 * dt_out)
+        bs->err_max = fmax(bs->err_max, fabs(e - bs->e_ref) / bs->e_ref);
+    bs->nb++;
+}
+
+/* The metrics and the information values (check.json), the note, the title and the axes. */
+static void bounce_report(const lahar_case *c, const bounces *bs, lahar_check_result *r)
+{
+    const double e_ref = bs->e_ref;
+    const char *name = c->bodies[bs->b].name;
+    check_value(r, "restitution_rel_error", fabs(bs->e_first - e_ref) / e_ref);
+    check_value(r, "restitution_rel_error_max", bs->err_max);
+    check_value(r, "e_measured", bs->e_first);
     check_value(r, "e_reference", e_ref);
-    check_value(r, "impact_speed", u_imp_first);
-    check_value(r, "rebound_speed", u_reb_first);
-    check_value(r, "impact_time", t_first);
-    check_value(r, "bounces", nb);
+    check_value(r, "impact_speed", bs->u_imp_first);
+    check_value(r, "rebound_speed", bs->u_reb_first);
+    check_value(r, "impact_time", bs->t_first);
+    check_value(r, "bounces", bs->nb);
     snprintf(r->note, sizeof r->note, "body %s; e_ref = min restitution of the body and the fixed bodies it touched",
-             c->bodies[b].name);
-    snprintf(r->title, sizeof r->title, "restitution: %s, e = %.4f (reference %.4f)", c->bodies[b].name, e_first, e_ref);
+             name);
+    snprintf(r->title, sizeof r->title, "restitution: %s, e = %.4f (reference %.4f)", name, bs->e_first, e_ref);
     snprintf(r->xlabel, sizeof r->xlabel, "t [s]");
     snprintf(r->ylabel, sizeof r->ylabel, "height along -g [m]");
-    /* reference: the measured pre-impact flight, then bounces at the impact height with e_ref */
-    double t0 = t_sep_first, u0 = e_ref * u_imp_first;
-    double hp = H(p_first), up = U(p_first), tp = d->t[p_first];
+}
+
+/* The measured height next to the reference: the measured flight before the first impact, then
+ * bounces at the impact height with e_ref. */
+static void bounce_plot(const bounces *bs, lahar_check_result *r)
+{
+    const lahar_check_data *d = bs->d;
+    const double g = bs->g, e_ref = bs->e_ref, t_first = bs->t_first, t_sep_first = bs->t_sep_first;
+    const double h_contact = bs->h_contact;
+    double t0 = t_sep_first, u0 = e_ref * bs->u_imp_first;
+    double hp = bounce_h(bs, bs->p_first), up = bounce_u(bs, bs->p_first), tp = d->t[bs->p_first];
     for (int64_t k = 0; k < d->nsnap && r->nseries < LAHAR_CHECK_MAX_SERIES; k++) {
         double t = d->t[k], href;
         if (t <= t_first) {
@@ -548,13 +622,28 @@ static int check_restitution(const lahar_case *c, const lahar_check_data *d, lah
             href = u0 > 1e-9 ? h_contact + u0 * (t - t0) - 0.5 * g * (t - t0) * (t - t0) : h_contact;
         }
         r->series_t[r->nseries] = t;
-        r->series_measured[r->nseries] = H(k);
+        r->series_measured[r->nseries] = bounce_h(bs, k);
         r->series_reference[r->nseries] = href;
         r->nseries++;
     }
-#undef H
-#undef U
-#undef FREE
+}
+
+static int check_restitution(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    bounces bs = {0};
+    if (bounce_setup(c, d, &bs, r))
+        return -1;
+    for (int64_t k = 0; k + 1 < d->nsnap; k++)
+        bounce_measure(c, &bs, k);
+    if (bs.nb == 0) {
+        snprintf(r->err, sizeof r->err,
+                 "restitution: no bounce of body %s found in %" PRId64 " snapshots (does it reach the floor before "
+                 "t_end?)",
+                 c->bodies[bs.b].name, d->nsnap);
+        return -1;
+    }
+    bounce_report(c, &bs, r);
+    bounce_plot(&bs, r);
     return 0;
 }
 
