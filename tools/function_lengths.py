@@ -40,7 +40,7 @@ def functions(text):
             j = i - 1  # the signature: the nearest line above with an opening parenthesis
             while j > 0 and "(" not in lines[j]:
                 j -= 1
-            m = re.search(r"(\w+)\s*\(", lines[j])
+            m = re.search(r"(\w+)\s*\(", re.sub(r"__attribute__\s*\(\(.*?\)\)", "", lines[j]))
             k = i + 1
             while k < len(lines) and not lines[k].startswith("}"):
                 k += 1
