@@ -1672,8 +1672,10 @@ static int coord_init(coord *co, const lahar_case *c, const lahar_coord_options 
     co->status = "error";
     co->summary_fd = -1;
     co->wall0 = lahar_now();
-    co->node[LAHAR_ROLE_DEM] = (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
-    co->node[LAHAR_ROLE_SPH] = (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
+    co->node[LAHAR_ROLE_DEM] =
+        (coord_node){.role = LAHAR_ROLE_DEM, .exe_name = "lahar-dem", .needed = coord_dem_needed(c), .last_step = -1};
+    co->node[LAHAR_ROLE_SPH] =
+        (coord_node){.role = LAHAR_ROLE_SPH, .exe_name = "lahar-sph", .needed = c->nblock > 0, .last_step = -1};
     if (!co->node[LAHAR_ROLE_DEM].needed && !co->node[LAHAR_ROLE_SPH].needed) {
         fprintf(stderr, "lahar: %s: nothing to simulate (no bodies and no particle blocks)\n", c->path);
         return -1;
@@ -1886,8 +1888,12 @@ static int coord_step_to_end(coord *co)
 static int coord_stop_nodes(coord *co, int status)
 {
     coord_progress(co, 1);
-    coord_send_stop(co, status == LAHAR_EXIT_OK || co->clean_stop ? 0 : (status == LAHAR_EXIT_NODE_LOST ? 3 : (coord_interrupted ? 2 : 1)),
-                    co->message);
+    /* STOP's reason (stop_t.lcm): 0 finished, 1 error, 2 interrupted, 3 node lost */
+    const int stop_code = status == LAHAR_EXIT_OK || co->clean_stop ? 0
+                          : status == LAHAR_EXIT_NODE_LOST            ? 3
+                          : coord_interrupted                         ? 2
+                                                                      : 1;
+    coord_send_stop(co, stop_code, co->message);
     coord_finish_nodes(co);
     for (int r = 1; r < LAHAR_NROLES && status == LAHAR_EXIT_OK; r++)
         if (co->node[r].needed && co->node[r].exited && co->node[r].exit_status != 0) {
@@ -1915,7 +1921,8 @@ static void coord_print_hints(const coord *co)
     if (co->c->nbody > 0 && co->c->output_forces)
         printf("              python3 %s/plot_forces.py %s   (force history, see tools/README.md)\n",
                LAHAR_TOOLS_DIR, co->outdir);
-    printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR, co->outdir);
+    printf("              python3 %s/plot_snapshot.py %s   (last snapshot to PNG; --all for frames)\n", LAHAR_TOOLS_DIR,
+           co->outdir);
     printf("  run summary: %s/summary.json\n", co->outdir);
 }
 
