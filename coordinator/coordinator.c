@@ -640,112 +640,132 @@ static int coord_setup_wait(coord *co, const coord_node *n)
     return 0;
 }
 
-/* Wait for STATUS(k) of every node; fills the node records. */
+/* Wait for STATUS(k) from node r. Requests are idempotent: besides the NACKs of both sides,
+ * STEP(k) goes out again every 250 ms until STATUS(k) is in (a node that has it already drops the
+ * duplicate, and its kept STATUS(k) answers the coordinator's NACK). Every COORD_DEATH_POLL_MS
+ * without it, the nodes this coordinator started are reaped: a node that died is lost at once, not
+ * after its silence (*lost: its role). Returns the link's code (LAHAR_LINK_*), or
+ * COORD_WAIT_INTERRUPTED when Ctrl-C came while a node set up. */
+enum { COORD_WAIT_INTERRUPTED = 100 };
+static int coord_wait_status(coord *co, int r, int64_t k, lahar_link_msg *m, int *lost)
+{
+    *lost = -1;
+    double resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
+    for (;;) {
+        int rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k,
+                                 k < 0 ? COORD_SETUP_POLL_MS : COORD_DEATH_POLL_MS, m);
+        if (rc == LAHAR_LINK_TIMEOUT) {
+            for (int d = 1; d < LAHAR_NROLES && k >= 0; d++)
+                if (co->node[d].needed && co->node[d].pid > 0 && coord_node_ended(&co->node[d]))
+                    *lost = d;
+            if (*lost >= 0)
+                return LAHAR_LINK_LOST;
+            if (k >= 0 && lahar_now() >= resend) {
+                lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
+                resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
+            }
+            if (k < 0 && coord_setup_wait(co, &co->node[r])) /* Ctrl-C while a node sets up: stop now */
+                return COORD_WAIT_INTERRUPTED;
+        } else if (rc == LAHAR_LINK_LOST && coord_node_starved(co, &co->node[lahar_link_lost_role(co->link)])) {
+            lahar_link_heard_now(co->link, lahar_link_lost_role(co->link));
+        } else {
+            return rc;
+        }
+    }
+}
+
+/* The message for a lost node: who, how long silent, why if known (ended, hung, starved), and
+ * the last step it completed. */
+static void coord_report_lost(coord *co, int lost)
+{
+    coord_node *ln = &co->node[lost];
+    int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
+                                                                         : lahar_link_peer_step(co->link, lost);
+    char how[96] = "died or hangs";
+    double silent = coord_silence(co) + ln->starved_s;
+    if (ln->pid > 0 && coord_node_ended(ln))
+        silent = lahar_now() - lahar_link_last_heard(co->link, lost);
+    if (ln->pid > 0 && !coord_node_ended(ln))
+        snprintf(how, sizeof how, ln->starved_s >= COORD_NODE_STARVED_MAX
+                                      ? "still running, but it has not answered for %.0f s"
+                                      : "hangs: no thread of it ran or waited for a CPU in %.0f ms",
+                 ln->starved_s >= COORD_NODE_STARVED_MAX ? COORD_NODE_STARVED_MAX : (double)COORD_STARVED_PROBE_MS);
+    if (ln->pid > 0 && coord_node_ended(ln))
+        snprintf(how, sizeof how, "%s %d", ln->exit_status > 128 ? "killed by signal" : "exited with status",
+                 ln->exit_status > 128 ? ln->exit_status - 128 : ln->exit_status);
+    snprintf(co->message, sizeof co->message,
+             "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
+             "(t = %.9g s); stopping the run",
+             lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, silent, how, (long long)last,
+             co->sim_time);
+    co->status = "node lost";
+}
+
+/* Node r's STATUS(k): its figures into the node's record, and its error (an instability decoded)
+ * into the run's message. Returns LAHAR_EXIT_OK or LAHAR_EXIT_RUN_ERROR. */
+static int coord_take_status(coord *co, int r, int64_t k, const lahar_link_msg *m)
+{
+    coord_node *n = &co->node[r];
+    lahar_status_t s;
+    if (LAHAR_MSG_DECODE(lahar_status_t, m->data, m->size, &s) < 0) {
+        snprintf(co->message, sizeof co->message, "undecodable STATUS(%lld) from the %s", (long long)k,
+                 lahar_link_role_name(r));
+        return LAHAR_EXIT_RUN_ERROR;
+    }
+    int err = s.error;
+    s.message[sizeof s.message - 1] = 0;
+    const char *text = (const char *)s.message;
+    if (err && lahar_instability_decode(text, &co->inst)) {
+        co->has_inst = 1;
+        co->inst_node = r == LAHAR_ROLE_DEM ? "dem" : "sph";
+        text = co->inst.text;
+    }
+    if (err)
+        snprintf(co->message, sizeof co->message, "the %s reports at step %lld: %s", lahar_link_role_name(r),
+                 (long long)k, text[0] ? text : "(no message)");
+    else if (k < 0)
+        snprintf(n->engine_desc, sizeof n->engine_desc, "%s", text);
+    n->compute_s += s.compute_s;
+    n->wait_s += s.wait_s;
+    n->substeps += s.nsubsteps;
+    n->dt_proposed = s.dt_proposed;
+    n->dt_stable = s.dt_stable;
+    n->kinetic_energy = s.kinetic_energy;
+    n->ncontacts = s.ncontacts;
+    n->checkpointed = s.checkpointed;
+    coord_take_work(n, &s);
+    if (!err)
+        n->last_step = k;
+    n->starved_s = 0.0; /* an answer ends a silence */
+    lahar_status_t_decode_cleanup(&s);
+    if (err) {
+        co->status = co->has_inst ? "unstable" : "error";
+        return LAHAR_EXIT_RUN_ERROR;
+    }
+    return LAHAR_EXIT_OK;
+}
+
+/* STATUS(k) of every node the run needs, in role order. */
 static int coord_collect_status(coord *co, int64_t k)
 {
     for (int r = 1; r < LAHAR_NROLES; r++) {
-        coord_node *n = &co->node[r];
-        if (!n->needed)
+        if (!co->node[r].needed)
             continue;
         lahar_link_msg m;
-        int rc;
-        /* Requests are idempotent: besides the NACKs of both sides, STEP(k) goes out again every
-         * 250 ms until STATUS(k) is in (a node that has it already drops the duplicate, and its
-         * kept STATUS(k) answers the coordinator's NACK). Every COORD_DEATH_POLL_MS without it,
-         * the nodes this coordinator started are reaped: a node that died is lost at once, not
-         * after its silence. */
-        int lost = -1;
-        double resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
-        for (;;) {
-            rc = lahar_link_wait(co->link, r, LAHAR_FRAME_T_MSG_STATUS, k,
-                                 k < 0 ? COORD_SETUP_POLL_MS : COORD_DEATH_POLL_MS, &m);
-            if (rc == LAHAR_LINK_TIMEOUT) {
-                for (int d = 1; d < LAHAR_NROLES && k >= 0; d++)
-                    if (co->node[d].needed && co->node[d].pid > 0 && coord_node_ended(&co->node[d]))
-                        lost = d;
-                if (lost >= 0) {
-                    rc = LAHAR_LINK_LOST;
-                    break;
-                }
-                if (k >= 0 && lahar_now() >= resend) {
-                    lahar_link_republish(co->link, LAHAR_FRAME_T_MSG_STEP, k);
-                    resend = lahar_now() + 1e-3 * COORD_STEP_RESEND_MS;
-                }
-                if (k < 0 && coord_setup_wait(co, n)) /* Ctrl-C while a node sets up: stop now */
-                    return LAHAR_EXIT_RUN_ERROR;
-            } else if (rc == LAHAR_LINK_LOST && coord_node_starved(co, &co->node[lahar_link_lost_role(co->link)])) {
-                lahar_link_heard_now(co->link, lahar_link_lost_role(co->link));
-            } else {
-                break;
-            }
-        }
+        int lost;
+        int rc = coord_wait_status(co, r, k, &m, &lost);
+        if (rc == COORD_WAIT_INTERRUPTED)
+            return LAHAR_EXIT_RUN_ERROR;
         if (rc == LAHAR_LINK_LOST) {
-            if (lost < 0)
-                lost = lahar_link_lost_role(co->link);
-            coord_node *ln = &co->node[lost];
-            int64_t last = ln->last_step > lahar_link_peer_step(co->link, lost) ? ln->last_step
-                                                                                 : lahar_link_peer_step(co->link, lost);
-            char how[96] = "died or hangs";
-            double silent = coord_silence(co) + ln->starved_s;
-            if (ln->pid > 0 && coord_node_ended(ln))
-                silent = lahar_now() - lahar_link_last_heard(co->link, lost);
-            if (ln->pid > 0 && !coord_node_ended(ln))
-                snprintf(how, sizeof how, ln->starved_s >= COORD_NODE_STARVED_MAX
-                                              ? "still running, but it has not answered for %.0f s"
-                                              : "hangs: no thread of it ran or waited for a CPU in %.0f ms",
-                         ln->starved_s >= COORD_NODE_STARVED_MAX ? COORD_NODE_STARVED_MAX
-                                                                 : (double)COORD_STARVED_PROBE_MS);
-            if (ln->pid > 0 && coord_node_ended(ln))
-                snprintf(how, sizeof how, "%s %d", ln->exit_status > 128 ? "killed by signal" : "exited with status",
-                         ln->exit_status > 128 ? ln->exit_status - 128 : ln->exit_status);
-            snprintf(co->message, sizeof co->message,
-                     "lost the %s (%s, pid %d on %s): silent for %.1f s (%s); last completed step %lld "
-                     "(t = %.9g s); stopping the run",
-                     lahar_link_role_name(lost), ln->exe_name, ln->remote_pid, ln->host, silent, how,
-                     (long long)last, co->sim_time);
-            co->status = "node lost";
+            coord_report_lost(co, lost >= 0 ? lost : lahar_link_lost_role(co->link));
             return LAHAR_EXIT_NODE_LOST;
         }
         if (rc != LAHAR_LINK_OK) {
             snprintf(co->message, sizeof co->message, "link error waiting for the %s", lahar_link_role_name(r));
             return LAHAR_EXIT_RUN_ERROR;
         }
-        lahar_status_t s;
-        if (LAHAR_MSG_DECODE(lahar_status_t, m.data, m.size, &s) < 0) {
-            snprintf(co->message, sizeof co->message, "undecodable STATUS(%lld) from the %s", (long long)k,
-                     lahar_link_role_name(r));
+        if (coord_take_status(co, r, k, &m) != LAHAR_EXIT_OK)
             return LAHAR_EXIT_RUN_ERROR;
-        }
-        int err = s.error;
-        s.message[sizeof s.message - 1] = 0;
-        const char *text = (const char *)s.message;
-        if (err && lahar_instability_decode(text, &co->inst)) {
-            co->has_inst = 1;
-            co->inst_node = r == LAHAR_ROLE_DEM ? "dem" : "sph";
-            text = co->inst.text;
-        }
-        if (err)
-            snprintf(co->message, sizeof co->message, "the %s reports at step %lld: %s", lahar_link_role_name(r),
-                     (long long)k, text[0] ? text : "(no message)");
-        else if (k < 0)
-            snprintf(n->engine_desc, sizeof n->engine_desc, "%s", text);
-        n->compute_s += s.compute_s;
-        n->wait_s += s.wait_s;
-        n->substeps += s.nsubsteps;
-        n->dt_proposed = s.dt_proposed;
-        n->dt_stable = s.dt_stable;
-        n->kinetic_energy = s.kinetic_energy;
-        n->ncontacts = s.ncontacts;
-        n->checkpointed = s.checkpointed;
-        coord_take_work(n, &s);
-        if (!err)
-            n->last_step = k;
-        n->starved_s = 0.0; /* an answer ends a silence */
-        lahar_status_t_decode_cleanup(&s);
-        if (err) {
-            co->status = co->has_inst ? "unstable" : "error";
-            return LAHAR_EXIT_RUN_ERROR;
-        }
     }
     return LAHAR_EXIT_OK;
 }
