@@ -70,6 +70,110 @@ int lahar_heightmap_valid(const lahar_heightmap *h, int i, int j)
     return h->z[(size_t)i * h->ncols + j] != h->nodata;
 }
 
+/* The header keys of an ESRI ASCII grid, in the order of asc_header.val. */
+enum { ASC_NCOLS, ASC_NROWS, ASC_XLL, ASC_YLL, ASC_CELL, ASC_NODATA, ASC_NKEY };
+
+typedef struct {
+    double val[ASC_NKEY];
+    int have[ASC_NKEY];
+    int xcenter, ycenter; /* xllcenter / yllcenter instead of the corner */
+} asc_header;
+
+/* The header: KEY VALUE pairs until the first token that is a number (left in t). */
+static int asc_read_header(tokens *t, const char *path, asc_header *hd, char *err, size_t errlen)
+{
+    memset(hd, 0, sizeof *hd);
+    for (;;) {
+        int rc = tok_next(t);
+        if (rc != 0) {
+            lahar_errf(err, errlen, "%s:%d: %s; an ESRI ASCII grid starts with ncols, nrows, xllcorner, yllcorner, "
+                     "cellsize (and NODATA_value) followed by the values", path, t->line,
+                     rc > 0 ? "the file ends in the header" : "a word longer than 127 characters");
+            return -1;
+        }
+        double num;
+        if (parse_double(t->tok, &num) == 0)
+            break;
+        static const char *const names[] = {"ncols", "nrows", "xllcorner", "yllcorner", "cellsize", "nodata_value"};
+        int k = -1;
+        for (int i = 0; i < ASC_NKEY; i++)
+            if (strcasecmp(t->tok, names[i]) == 0)
+                k = i;
+        if (strcasecmp(t->tok, "xllcenter") == 0)
+            k = ASC_XLL, hd->xcenter = 1;
+        if (strcasecmp(t->tok, "yllcenter") == 0)
+            k = ASC_YLL, hd->ycenter = 1;
+        if (k < 0) {
+            lahar_errf(err, errlen, "%s:%d: unknown header key '%s'; the header keys are ncols, nrows, xllcorner (or "
+                     "xllcenter), yllcorner (or yllcenter), cellsize, NODATA_value", path, t->tok_line, t->tok);
+            return -1;
+        }
+        if (hd->have[k]) {
+            lahar_errf(err, errlen, "%s:%d: header key '%s' given twice; keep one", path, t->tok_line, t->tok);
+            return -1;
+        }
+        int kl = t->tok_line;
+        char key[128];
+        snprintf(key, sizeof key, "%s", t->tok);
+        if (tok_next(t) != 0 || parse_double(t->tok, &hd->val[k]) != 0 || t->tok_line != kl) {
+            lahar_errf(err, errlen, "%s:%d: header key '%s' needs a number after it on the same line", path, kl, key);
+            return -1;
+        }
+        hd->have[k] = 1;
+    }
+    static const char *const need[] = {"ncols", "nrows", "xllcorner", "yllcorner", "cellsize"};
+    for (int k = 0; k < ASC_CELL + 1; k++)
+        if (!hd->have[k]) {
+            lahar_errf(err, errlen, "%s:%d: the header has no '%s'; add a line `%s VALUE` before the values", path,
+                     t->tok_line, need[k], need[k]);
+            return -1;
+        }
+    const double *val = hd->val;
+    if (!(val[ASC_NCOLS] >= 2 && val[ASC_NCOLS] == floor(val[ASC_NCOLS]) && val[ASC_NROWS] >= 2 &&
+          val[ASC_NROWS] == floor(val[ASC_NROWS]) && val[ASC_NCOLS] * val[ASC_NROWS] <= 1e8)) {
+        lahar_errf(err, errlen, "%s: ncols and nrows must be whole numbers >= 2 (got %g and %g, at most 1e8 values)",
+                 path, val[ASC_NCOLS], val[ASC_NROWS]);
+        return -1;
+    }
+    if (!(val[ASC_CELL] > 0)) {
+        lahar_errf(err, errlen, "%s: cellsize must be > 0 m (got %g)", path, val[ASC_CELL]);
+        return -1;
+    }
+    return 0;
+}
+
+/* The nrows x ncols values, the first already in t, rows from the north; h->z stores them from the
+ * south (row 0 at y0). Nothing may follow them. */
+static int asc_read_values(tokens *t, const char *path, lahar_heightmap *h, char *err, size_t errlen)
+{
+    const size_t total = (size_t)h->ncols * h->nrows;
+    int rc;
+    for (size_t k = 0; k < total; k++) {
+        if (k > 0 && (rc = tok_next(t)) != 0) {
+            lahar_errf(err, errlen, "%s:%d: %s after %zu of the %d x %d = %zu values (row %zu from the north); "
+                     "each of the nrows rows needs ncols values", path, rc > 0 ? t->tok_line : t->line,
+                     rc > 0 ? "the file ends" : "a word longer than 127 characters", k, h->nrows, h->ncols, total,
+                     k / (size_t)h->ncols + 1);
+            return -1;
+        }
+        double z;
+        if (parse_double(t->tok, &z) != 0) {
+            lahar_errf(err, errlen, "%s:%d: '%s' is not a number (value %zu: row %zu from the north, column %zu); "
+                     "the values are elevations in m, NODATA_value where there is none", path, t->tok_line, t->tok,
+                     k + 1, k / (size_t)h->ncols + 1, k % (size_t)h->ncols + 1);
+            return -1;
+        }
+        int row = (int)(k / (size_t)h->ncols), col = (int)(k % (size_t)h->ncols);
+        h->z[(size_t)(h->nrows - 1 - row) * h->ncols + col] = z;
+    }
+    if (tok_next(t) == 0) {
+        lahar_errf(err, errlen, "%s:%d: more values than nrows x ncols = %zu ('%s'); check ncols and nrows", path,
+                 t->tok_line, total, t->tok);
+        return -1;
+    }
+    return 0;
+}
+
 int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, size_t errlen)
 {
     memset(h, 0, sizeof *h);
@@ -79,106 +183,28 @@ int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, si
         return -1;
     }
     tokens t = {fp, 1, "", 1};
-    enum { NCOLS, NROWS, XLL, YLL, CELL, NODATA, NKEY };
-    double val[NKEY] = {0};
-    int have[NKEY] = {0}, xcenter = 0, ycenter = 0, rc = 0;
-    /* the header: KEY VALUE pairs until the first token that is a number */
-    for (;;) {
-        rc = tok_next(&t);
-        if (rc != 0) {
-            lahar_errf(err, errlen, "%s:%d: %s; an ESRI ASCII grid starts with ncols, nrows, xllcorner, yllcorner, "
-                     "cellsize (and NODATA_value) followed by the values", path, t.line,
-                     rc > 0 ? "the file ends in the header" : "a word longer than 127 characters");
-            goto fail;
+    asc_header hd;
+    int rc = asc_read_header(&t, path, &hd, err, errlen);
+    if (rc == 0) {
+        const double *val = hd.val;
+        h->ncols = (int)val[ASC_NCOLS];
+        h->nrows = (int)val[ASC_NROWS];
+        h->cellsize = val[ASC_CELL];
+        h->x0 = val[ASC_XLL] + (hd.xcenter ? 0.0 : 0.5 * val[ASC_CELL]);
+        h->y0 = val[ASC_YLL] + (hd.ycenter ? 0.0 : 0.5 * val[ASC_CELL]);
+        h->nodata = hd.have[ASC_NODATA] ? val[ASC_NODATA] : -9999.0;
+        h->z = malloc((size_t)h->ncols * h->nrows * sizeof *h->z);
+        if (!h->z) {
+            lahar_errf(err, errlen, "%s: out of memory for a %d x %d grid", path, h->ncols, h->nrows);
+            rc = -1;
         }
-        double num;
-        if (parse_double(t.tok, &num) == 0)
-            break;
-        static const char *const names[] = {"ncols", "nrows", "xllcorner", "yllcorner", "cellsize", "nodata_value"};
-        int k = -1;
-        for (int i = 0; i < NKEY; i++)
-            if (strcasecmp(t.tok, names[i]) == 0)
-                k = i;
-        if (strcasecmp(t.tok, "xllcenter") == 0)
-            k = XLL, xcenter = 1;
-        if (strcasecmp(t.tok, "yllcenter") == 0)
-            k = YLL, ycenter = 1;
-        if (k < 0) {
-            lahar_errf(err, errlen, "%s:%d: unknown header key '%s'; the header keys are ncols, nrows, xllcorner (or "
-                     "xllcenter), yllcorner (or yllcenter), cellsize, NODATA_value", path, t.tok_line, t.tok);
-            goto fail;
-        }
-        if (have[k]) {
-            lahar_errf(err, errlen, "%s:%d: header key '%s' given twice; keep one", path, t.tok_line, t.tok);
-            goto fail;
-        }
-        int kl = t.tok_line;
-        char key[128];
-        snprintf(key, sizeof key, "%s", t.tok);
-        if (tok_next(&t) != 0 || parse_double(t.tok, &val[k]) != 0 || t.tok_line != kl) {
-            lahar_errf(err, errlen, "%s:%d: header key '%s' needs a number after it on the same line", path, kl, key);
-            goto fail;
-        }
-        have[k] = 1;
     }
-    static const char *const need[] = {"ncols", "nrows", "xllcorner", "yllcorner", "cellsize"};
-    for (int k = 0; k < CELL + 1; k++)
-        if (!have[k]) {
-            lahar_errf(err, errlen, "%s:%d: the header has no '%s'; add a line `%s VALUE` before the values", path,
-                     t.tok_line, need[k], need[k]);
-            goto fail;
-        }
-    if (!(val[NCOLS] >= 2 && val[NCOLS] == floor(val[NCOLS]) && val[NROWS] >= 2 && val[NROWS] == floor(val[NROWS]) &&
-          val[NCOLS] * val[NROWS] <= 1e8)) {
-        lahar_errf(err, errlen, "%s: ncols and nrows must be whole numbers >= 2 (got %g and %g, at most 1e8 values)",
-                 path, val[NCOLS], val[NROWS]);
-        goto fail;
-    }
-    if (!(val[CELL] > 0)) {
-        lahar_errf(err, errlen, "%s: cellsize must be > 0 m (got %g)", path, val[CELL]);
-        goto fail;
-    }
-    h->ncols = (int)val[NCOLS];
-    h->nrows = (int)val[NROWS];
-    h->cellsize = val[CELL];
-    h->x0 = val[XLL] + (xcenter ? 0.0 : 0.5 * val[CELL]);
-    h->y0 = val[YLL] + (ycenter ? 0.0 : 0.5 * val[CELL]);
-    h->nodata = have[NODATA] ? val[NODATA] : -9999.0;
-    h->z = malloc((size_t)h->ncols * h->nrows * sizeof *h->z);
-    if (!h->z) {
-        lahar_errf(err, errlen, "%s: out of memory for a %d x %d grid", path, h->ncols, h->nrows);
-        goto fail;
-    }
-    const size_t total = (size_t)h->ncols * h->nrows;
-    for (size_t k = 0; k < total; k++) {
-        if (k > 0 && (rc = tok_next(&t)) != 0) {
-            lahar_errf(err, errlen, "%s:%d: %s after %zu of the %d x %d = %zu values (row %zu from the north); "
-                     "each of the nrows rows needs ncols values", path, rc > 0 ? t.tok_line : t.line,
-                     rc > 0 ? "the file ends" : "a word longer than 127 characters", k, h->nrows, h->ncols, total,
-                     k / (size_t)h->ncols + 1);
-            goto fail;
-        }
-        double z;
-        if (parse_double(t.tok, &z) != 0) {
-            lahar_errf(err, errlen, "%s:%d: '%s' is not a number (value %zu: row %zu from the north, column %zu); "
-                     "the values are elevations in m, NODATA_value where there is none", path, t.tok_line, t.tok,
-                     k + 1, k / (size_t)h->ncols + 1, k % (size_t)h->ncols + 1);
-            goto fail;
-        }
-        int row = (int)(k / (size_t)h->ncols), col = (int)(k % (size_t)h->ncols);
-        h->z[(size_t)(h->nrows - 1 - row) * h->ncols + col] = z;
-    }
-    if ((rc = tok_next(&t)) == 0) {
-        lahar_errf(err, errlen, "%s:%d: more values than nrows x ncols = %zu ('%s'); check ncols and nrows", path,
-                 t.tok_line, total, t.tok);
-        goto fail;
-    }
+    if (rc == 0)
+        rc = asc_read_values(&t, path, h, err, errlen);
     fclose(fp);
-    return 0;
-fail:
-    fclose(fp);
-    lahar_heightmap_free(h);
-    return -1;
+    if (rc != 0)
+        lahar_heightmap_free(h);
+    return rc;
 }
 
 int lahar_heightmap_shape(const lahar_heightmap *h, double radius, lahar_shape *s, char *err, size_t errlen)
