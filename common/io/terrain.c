@@ -286,8 +286,10 @@ static double grid_slope_factor(const lahar_heightmap *h, int i, int j)
     return sqrt(1.0 + gx * gx + gy * gy);
 }
 
-int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
-                          lahar_particle_block *pb, char *err, size_t errlen)
+/* The two grids of a region between terrain and an upper surface: the same nodes, and the terrain
+ * defined at every one. */
+static int region_grids_match(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path,
+                              char *err, size_t errlen)
 {
     const double tol = 1e-9 * (bot->cellsize + fabs(bot->x0) + fabs(bot->y0));
     if (top->ncols != bot->ncols || top->nrows != bot->nrows || fabs(top->cellsize - bot->cellsize) > tol ||
@@ -306,11 +308,17 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
                          "on the grid", top_path, bot->nrows - i, j + 1);
                 return -1;
             }
-    /* The region is empty where the top is on (or below) the raised terrain: the mesh covers only
-     * the nodes' window [r0, r1] x [c0, c1] around the nodes with the top above it (one node more on
-     * each side, for the cells that taper to zero), so the lattice that fills it spans the region,
-     * not the whole grid (a small mass on a large terrain: the block's bounding box, and with it the
-     * lattice points tested against the mesh, scale with the mass). */
+    return 0;
+}
+
+/* The region is empty where the top is on (or below) the raised terrain: the mesh covers only the
+ * nodes' window [w[0], w[1]] (rows) x [w[2], w[3]] (columns) around the nodes with the top above
+ * it (one node more on each side, for the cells that taper to zero), so the lattice that fills it
+ * spans the region, not the whole grid (a small mass on a large terrain: the block's bounding box,
+ * and with it the lattice points tested against the mesh, scale with the mass). */
+static int region_window(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
+                         int w[4], char *err, size_t errlen)
+{
     int r0 = bot->nrows, r1 = -1, c0 = bot->ncols, c1 = -1;
     for (int i = 0; i < bot->nrows; i++)
         for (int j = 0; j < bot->ncols; j++) {
@@ -339,18 +347,18 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
         lahar_errf(err, errlen, "%s: the grid needs at least 2 x 2 nodes for a region", top_path);
         return -1;
     }
-    /* vertices of the window (local node k = (i - r0) * nc + (j - c0)): bottom 0 .. N-1, top N .. 2N-1 */
-    const int nc = c1 - c0 + 1, nr = r1 - r0 + 1;
-    const int N = nc * nr, nbound = 2 * (nc - 1) + 2 * (nr - 1);
-    const int ntri = 4 * (nc - 1) * (nr - 1) + 2 * nbound;
-    pb->vert = malloc((size_t)2 * N * sizeof *pb->vert);
-    pb->tri = malloc((size_t)ntri * sizeof *pb->tri);
-    if (!pb->vert || !pb->tri) {
-        free(pb->vert), free(pb->tri);
-        pb->vert = NULL, pb->tri = NULL;
-        lahar_errf(err, errlen, "out of memory for the region");
-        return -1;
-    }
+    w[0] = r0, w[1] = r1, w[2] = c0, w[3] = c1;
+    return 0;
+}
+
+/* The closed mesh of the window: nc x nr nodes (local node k = (i - r0) * nc + (j - c0)) on the
+ * raised terrain (vertices 0 .. N-1) and on the top (N .. 2N-1, at least the terrain), two
+ * triangles per cell on each surface and two per boundary edge on the side walls. */
+static void region_mesh(const lahar_heightmap *bot, const lahar_heightmap *top, double lift, const int w[4],
+                        lahar_particle_block *pb)
+{
+    const int r0 = w[0], r1 = w[1], c0 = w[2], c1 = w[3];
+    const int nc = c1 - c0 + 1, nr = r1 - r0 + 1, N = nc * nr, nbound = 2 * (nc - 1) + 2 * (nr - 1);
     for (int i = r0; i <= r1; i++)
         for (int j = c0; j <= c1; j++) {
             int g = i * bot->ncols + j, k = (i - r0) * nc + (j - c0);
@@ -394,6 +402,26 @@ int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top
     pb->kind = LAHAR_BLOCK_MESH;
     pb->nvert = 2 * N;
     pb->ntri = t;
+}
+
+int lahar_heightmap_block(const lahar_heightmap *bot, const lahar_heightmap *top, const char *top_path, double lift,
+                          lahar_particle_block *pb, char *err, size_t errlen)
+{
+    int w[4];
+    if (region_grids_match(bot, top, top_path, err, errlen) != 0 ||
+        region_window(bot, top, top_path, lift, w, err, errlen) != 0)
+        return -1;
+    const int nc = w[3] - w[2] + 1, nr = w[1] - w[0] + 1, N = nc * nr, nbound = 2 * (nc - 1) + 2 * (nr - 1);
+    const int ntri = 4 * (nc - 1) * (nr - 1) + 2 * nbound;
+    pb->vert = malloc((size_t)2 * N * sizeof *pb->vert);
+    pb->tri = malloc((size_t)ntri * sizeof *pb->tri);
+    if (!pb->vert || !pb->tri) {
+        free(pb->vert), free(pb->tri);
+        pb->vert = NULL, pb->tri = NULL;
+        lahar_errf(err, errlen, "out of memory for the region");
+        return -1;
+    }
+    region_mesh(bot, top, lift, w, pb);
     lahar_particle_block_bounds(pb, 3);
     return 0;
 }
