@@ -849,16 +849,16 @@ static void sph_node_io_f64(lahar_ckpt_file *f, const char *name, double *a, int
         lahar_ckpt_f64(f, name, a, n);
 }
 
-static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double *t_now)
+/* The step, time and particle count; reading, the count must fit this case (open boundaries: up to
+ * its capacity; else exactly its count). */
+static int64_t sph_state_io_count(sph_node *s, lahar_ckpt_file *f, int64_t *k, double *t_now)
 {
-    sph_fluid *fl = &s->f;
-    sph_particles *p = &fl->p;
+    sph_particles *p = &s->f.p;
     lahar_ckpt_i64(f, "step", k, 1);
     lahar_ckpt_f64(f, "t", t_now, 1);
     int64_t n = p->n;
     lahar_ckpt_i64(f, "n", &n, 1);
     if (s->has_flow && !f->writing && !f->failed) {
-        /* open boundaries: the count varies, up to the capacity of this case */
         if (n < 0 || n > p->cap) {
             snprintf(f->err, sizeof f->err, "the checkpoint holds %lld particles, this case has room for %lld "
                      "(another case?)", (long long)n, (long long)p->cap);
@@ -871,6 +871,15 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
                  (long long)n, (long long)p->n);
         f->failed = 1;
     }
+    return n;
+}
+
+/* Every per-particle array the next step reads: state, half-step values, soil stresses and their
+ * rates, the transport velocity's terms. */
+static void sph_state_io_particles(sph_node *s, lahar_ckpt_file *f, int64_t n)
+{
+    sph_fluid *fl = &s->f;
+    sph_particles *p = &fl->p;
     static const char *const names[] = {"x", "y", "z", "vx", "vy", "vz", "rho", "p", "m", "ax", "ay", "az", "drho",
                                         "vhx", "vhy", "vhz", "rhoh", "tvx", "tvy", "tvz"};
     double *arrays[] = {p->x, p->y, p->z, p->vx, p->vy, p->vz, p->rho, p->p, p->m, p->ax, p->ay, p->az, p->drho,
@@ -893,6 +902,13 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
     sph_node_io_f64(f, "tv_bx", fl->tv_bx, n);
     sph_node_io_f64(f, "tv_by", fl->tv_by, n);
     sph_node_io_f64(f, "tv_bz", fl->tv_bz, n);
+}
+
+/* The solver's clock and step-size inputs, the work counters, the summary figures and the bodies'
+ * states. */
+static void sph_state_io_solver(sph_node *s, lahar_ckpt_file *f)
+{
+    sph_fluid *fl = &s->f;
     lahar_ckpt_f64(f, "fluid_t", &fl->t, 1);
     lahar_ckpt_i64(f, "fluid_step", &fl->step, 1);
     lahar_ckpt_f64(f, "vmax", &fl->vmax, 1);
@@ -911,48 +927,59 @@ static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double
     lahar_ckpt_f64(f, "kinetic_energy", &s->kinetic_energy, 1);
     if (s->nbody > 0)
         lahar_ckpt_f64(f, "body_states", (double *)s->states, (int64_t)s->nbody * 13);
-    if (fl->has_bodies) {
-        sph_coupling *c = &fl->cpl;
-        lahar_ckpt_f64(f, "cpl_force", (double *)c->force, (int64_t)c->nbody * 3);
-        lahar_ckpt_f64(f, "cpl_torque", (double *)c->torque, (int64_t)c->nbody * 3);
-        lahar_ckpt_i64(f, "cpl_body_start", c->body_start, c->nbody + 1);
-        lahar_ckpt_f64(f, "cpl_kn", &c->kn, 1);
-        int64_t nc = c->ncontacts;
-        lahar_ckpt_i64(f, "cpl_ncontacts", &nc, 1);
-        if (!f->writing && !f->failed && nc > c->contacts_cap) {
-            sph_contact *m = realloc(c->contacts, (size_t)nc * sizeof *m);
-            if (!m) {
-                snprintf(f->err, sizeof f->err, "out of memory for %lld contacts", (long long)nc);
-                f->failed = 1;
-            } else {
-                c->contacts = m;
-                c->contacts_cap = nc;
-            }
+}
+
+/* The coupling's last evaluation (the loads the DEM node gets next) and the soil springs. */
+static void sph_state_io_coupling(sph_coupling *c, lahar_ckpt_file *f)
+{
+    lahar_ckpt_f64(f, "cpl_force", (double *)c->force, (int64_t)c->nbody * 3);
+    lahar_ckpt_f64(f, "cpl_torque", (double *)c->torque, (int64_t)c->nbody * 3);
+    lahar_ckpt_i64(f, "cpl_body_start", c->body_start, c->nbody + 1);
+    lahar_ckpt_f64(f, "cpl_kn", &c->kn, 1);
+    int64_t nc = c->ncontacts;
+    lahar_ckpt_i64(f, "cpl_ncontacts", &nc, 1);
+    if (!f->writing && !f->failed && nc > c->contacts_cap) {
+        sph_contact *m = realloc(c->contacts, (size_t)nc * sizeof *m);
+        if (!m) {
+            snprintf(f->err, sizeof f->err, "out of memory for %lld contacts", (long long)nc);
+            f->failed = 1;
+        } else {
+            c->contacts = m;
+            c->contacts_cap = nc;
         }
-        if (!f->failed) {
-            c->ncontacts = nc;
-            /* sph_contact is doubles and an int64: stored as the bytes of the array */
-            void *blob = c->contacts;
-            size_t len = (size_t)nc * sizeof *c->contacts;
-            if (f->writing) {
-                lahar_ckpt_blob(f, "cpl_contacts", &blob, &len);
-            } else {
-                lahar_ckpt_u8(f, "cpl_contacts", blob, (int64_t)len);
-            }
-        }
-        if (c->soil_hist_body) {
-            const int64_t nh = c->pcap * SPH_COUPLING_MAX_PER_PARTICLE;
-            lahar_ckpt_i32(f, "cpl_soil_hist_body", (int32_t *)c->soil_hist_body, nh);
-            lahar_ckpt_f64(f, "cpl_soil_hist_d", (double *)c->soil_hist_d, nh * 3);
-        }
-        c->near_valid = 0;
     }
+    if (!f->failed) {
+        c->ncontacts = nc;
+        /* sph_contact is doubles and an int64: stored as the bytes of the array */
+        void *blob = c->contacts;
+        size_t len = (size_t)nc * sizeof *c->contacts;
+        if (f->writing) {
+            lahar_ckpt_blob(f, "cpl_contacts", &blob, &len);
+        } else {
+            lahar_ckpt_u8(f, "cpl_contacts", blob, (int64_t)len);
+        }
+    }
+    if (c->soil_hist_body) {
+        const int64_t nh = c->pcap * SPH_COUPLING_MAX_PER_PARTICLE;
+        lahar_ckpt_i32(f, "cpl_soil_hist_body", (int32_t *)c->soil_hist_body, nh);
+        lahar_ckpt_f64(f, "cpl_soil_hist_d", (double *)c->soil_hist_d, nh * 3);
+    }
+    c->near_valid = 0;
+}
+
+static int sph_node_state_io(sph_node *s, lahar_ckpt_file *f, int64_t *k, double *t_now)
+{
+    const int64_t n = sph_state_io_count(s, f, k, t_now);
+    sph_state_io_particles(s, f, n);
+    sph_state_io_solver(s, f);
+    if (s->f.has_bodies)
+        sph_state_io_coupling(&s->f.cpl, f);
     if (s->probes.n > 0) {
         lahar_ckpt_i64(f, "probe_next_slot", s->probes.next_slot, s->probes.n);
         lahar_ckpt_i64(f, "probe_target", s->probes.target, s->probes.n); /* trackers' particles */
     }
     if (s->has_flow)
-        sph_inflow_state_io(&s->flow, p, f);
+        sph_inflow_state_io(&s->flow, &s->f.p, f);
     return f->failed ? -1 : 0;
 }
 
