@@ -79,9 +79,30 @@ static int64_t soil_xs(const lahar_check_particles *p, double *xs)
     return m;
 }
 
-int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+/* What landslide measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    /* the set-up */
+    const lahar_shape *ts;     /* the terrain's polyline (x increasing) */
+    double dx;                 /* spacing: the width of a column of the surfaces */
+    double *xs;                /* [nmax] the soil's x of the snapshot read, sorted (soil_xs) */
+    int pl;                    /* the deposit panel */
+    /* the initial mass */
+    int64_t n0;                /* soil particles at t = 0 */
+    double front0;             /* its front: the 99 % quantile of x */
+    /* over the snapshots */
+    int64_t escaped;           /* the most soil particles below the terrain's core line at once */
+    double ke_max, ke_last, vmax;
+    /* the deposit at the end */
+    int64_t n1;
+    double x01, x99;           /* the 1 % and 99 % quantiles of the soil's x */
+    double tmax, tsum;         /* thickness per column: largest, sum over the tn columns */
+    int tn;
+} landslide;
+
+/* The case and output landslide can judge, the terrain, and the buffer of x: 0, or -1 with r->err. */
+static int landslide_setup(const lahar_case *c, const lahar_check_data *d, landslide *ls, lahar_check_result *r)
 {
-    lahar_check_particles *p = d->particles;
+    const lahar_check_particles *p = d->particles;
     const int tb = lahar_case_find_body(c, "terrain");
     if (!p || !p->phase || !p->vx || p->nsnap < 2 || c->dim != 2 || tb < 0 ||
         c->bodies[tb].motion != LAHAR_MOTION_FIXED || c->bodies[tb].shape.nf != 0 || c->bodies[tb].shape.nv < 2) {
@@ -95,50 +116,70 @@ int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_
             snprintf(r->err, sizeof r->err, "landslide: the terrain's x must increase along its points");
             return -1;
         }
-    const double dx = c->sph_dx;
-    double *xs = malloc((size_t)(p->nmax > 0 ? p->nmax : 1) * sizeof *xs);
-    if (!xs) {
+    ls->ts = ts;
+    ls->dx = c->sph_dx;
+    ls->xs = malloc((size_t)(p->nmax > 0 ? p->nmax : 1) * sizeof *ls->xs);
+    if (!ls->xs) {
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
-    int rc = -1;
+    return 0;
+}
+
+/* The soil at t = 0 (left in the buffers): its count and front. 0, or -1 with r->err. */
+static int landslide_initial(lahar_check_particles *p, landslide *ls, lahar_check_result *r)
+{
     if (lahar_check_particles_read(p, 0, r->err, sizeof r->err))
-        goto done;
-    const int64_t n0 = soil_xs(p, xs);
-    if (n0 < 2) {
+        return -1;
+    ls->n0 = soil_xs(p, ls->xs);
+    if (ls->n0 < 2) {
         snprintf(r->err, sizeof r->err, "landslide: fewer than 2 soil particles at t = 0");
-        goto done;
+        return -1;
     }
-    const double front0 = quantile(xs, n0, 0.99);
-    int pl = lahar_check_panel(r, "deposit at the end, the initial mass and the terrain", "x (m)", "y (m)");
-    lahar_check_curve(r, pl, 0, "terrain (surface)");
+    ls->front0 = quantile(ls->xs, ls->n0, 0.99);
+    return 0;
+}
+
+/* The deposit panel with the terrain's surface and the initial mass's surface: the highest
+ * particle + dx/2 per column of dx (drawn only if its columns fit in memory). */
+static void landslide_plot_initial(const lahar_check_particles *p, landslide *ls, lahar_check_result *r)
+{
+    const lahar_shape *ts = ls->ts;
+    const double dx = ls->dx;
+    ls->pl = lahar_check_panel(r, "deposit at the end, the initial mass and the terrain", "x (m)", "y (m)");
+    lahar_check_curve(r, ls->pl, 0, "terrain (surface)");
     for (int i = 0; i < ts->nv; i++)
         lahar_check_point(r, ts->v[i][0], terrain_surface(ts, ts->v[i][0]));
-    {   /* the initial mass's surface: the highest particle + dx/2 per column of dx */
-        const double xa = xs[0], xb = xs[n0 - 1];
-        const int nc0 = (int)ceil((xb - xa) / dx) + 1;
-        double *top0 = malloc((size_t)nc0 * sizeof *top0);
-        if (top0) {
-            for (int k = 0; k < nc0; k++)
-                top0[k] = -INFINITY;
-            for (int64_t i = 0; i < p->cur_n; i++)
-                if (p->phase[i] == 1) {
-                    int col = (int)floor((p->x[i] - xa) / dx);
-                    if (col >= 0 && col < nc0)
-                        top0[col] = fmax(top0[col], p->y[i] + 0.5 * dx);
-                }
-            lahar_check_curve(r, pl, 0, "initial mass (surface)");
-            for (int k = 0; k < nc0; k++)
-                if (top0[k] > -INFINITY)
-                    lahar_check_point(r, xa + (k + 0.5) * dx, top0[k]);
-            free(top0);
+    const double xa = ls->xs[0], xb = ls->xs[ls->n0 - 1];
+    const int nc0 = (int)ceil((xb - xa) / dx) + 1;
+    double *top0 = malloc((size_t)nc0 * sizeof *top0);
+    if (!top0)
+        return;
+    for (int k = 0; k < nc0; k++)
+        top0[k] = -INFINITY;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        if (p->phase[i] == 1) {
+            int col = (int)floor((p->x[i] - xa) / dx);
+            if (col >= 0 && col < nc0)
+                top0[col] = fmax(top0[col], p->y[i] + 0.5 * dx);
         }
-    }
+    lahar_check_curve(r, ls->pl, 0, "initial mass (surface)");
+    for (int k = 0; k < nc0; k++)
+        if (top0[k] > -INFINITY)
+            lahar_check_point(r, xa + (k + 0.5) * dx, top0[k]);
+    free(top0);
+}
+
+/* Every snapshot in turn: the soil particles through the terrain's core line, the kinetic energy
+ * (per unit particle mass: only its ratio is reported) and the largest speed. The last snapshot
+ * stays in the buffers. 0, or -1 with r->err. */
+static int landslide_snapshots(lahar_check_particles *p, landslide *ls, lahar_check_result *r)
+{
     int64_t escaped = 0;
     double ke_max = 0.0, ke_last = 0.0, vmax = 0.0;
     for (int64_t k = 0; k < p->nsnap; k++) {
         if (lahar_check_particles_read(p, k, r->err, sizeof r->err))
-            goto done;
+            return -1;
         double ke = 0.0;
         int64_t esc = 0;
         for (int64_t i = 0; i < p->cur_n; i++)
@@ -146,24 +187,34 @@ int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_
                 double v2 = p->vx[i] * p->vx[i] + p->vy[i] * p->vy[i];
                 ke += 0.5 * v2;
                 vmax = fmax(vmax, sqrt(v2));
-                esc += p->y[i] < terrain_y(ts, p->x[i]);
+                esc += p->y[i] < terrain_y(ls->ts, p->x[i]);
             }
         escaped = esc > escaped ? esc : escaped;
         ke_max = fmax(ke_max, ke);
         ke_last = ke;
     }
-    /* the deposit: the last snapshot is in the buffers */
-    const int64_t n1 = soil_xs(p, xs);
-    if (n1 < 2) {
+    ls->escaped = escaped, ls->ke_max = ke_max, ls->ke_last = ke_last, ls->vmax = vmax;
+    return 0;
+}
+
+/* The deposit (the last snapshot, in the buffers) between the 1 % and 99 % quantiles of x: its
+ * surface per column of dx (the highest particle + dx/2), drawn, and its vertical thickness above
+ * the terrain's surface. 0, or -1 with r->err. */
+static int landslide_deposit(const lahar_check_particles *p, landslide *ls, lahar_check_result *r)
+{
+    const double dx = ls->dx;
+    ls->n1 = soil_xs(p, ls->xs);
+    if (ls->n1 < 2) {
         snprintf(r->err, sizeof r->err, "landslide: fewer than 2 soil particles at the end");
-        goto done;
+        return -1;
     }
-    const double x01 = quantile(xs, n1, 0.01), x99 = quantile(xs, n1, 0.99);
+    const double x01 = quantile(ls->xs, ls->n1, 0.01), x99 = quantile(ls->xs, ls->n1, 0.99);
+    ls->x01 = x01, ls->x99 = x99;
     const int ncol = (int)ceil((x99 - x01) / dx) + 1;
     double *top = malloc((size_t)ncol * sizeof *top);
     if (!top) {
         snprintf(r->err, sizeof r->err, "out of memory");
-        goto done;
+        return -1;
     }
     for (int k = 0; k < ncol; k++)
         top[k] = -INFINITY;
@@ -175,40 +226,66 @@ int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_
         }
     double tmax = 0.0, tsum = 0.0;
     int tn = 0;
-    lahar_check_curve(r, pl, 1, "lahar deposit (surface, 1-99 % of the mass)");
+    lahar_check_curve(r, ls->pl, 1, "lahar deposit (surface, 1-99 % of the mass)");
     for (int k = 0; k < ncol; k++) {
         if (!(top[k] > -INFINITY))
             continue;
-        double xc = x01 + (k + 0.5) * dx, th = fmax(0.0, top[k] - terrain_surface(ts, xc));
+        double xc = x01 + (k + 0.5) * dx, th = fmax(0.0, top[k] - terrain_surface(ls->ts, xc));
         tmax = fmax(tmax, th);
         tsum += th;
         tn++;
         lahar_check_point(r, xc, top[k]);
     }
     free(top);
-    const double L = x99 - x01;
-    lahar_check_value(r, "escaped_particles", (double)escaped);
-    lahar_check_value(r, "mass_change", fabs((double)(n1 - n0)) / (double)n0);
+    ls->tmax = tmax, ls->tsum = tsum, ls->tn = tn;
+    return 0;
+}
+
+/* The metrics against the field deposit (Trujillo-Vela et al. 2020 section 5.4), the information
+ * values (check.json), the note and the convention. */
+static void landslide_report(const landslide *ls, lahar_check_result *r)
+{
+    const double L = ls->x99 - ls->x01, tmax = ls->tmax;
+    lahar_check_value(r, "escaped_particles", (double)ls->escaped);
+    lahar_check_value(r, "mass_change", fabs((double)(ls->n1 - ls->n0)) / (double)ls->n0);
     lahar_check_value(r, "deposit_length_m", L);
     lahar_check_value(r, "deposit_length_field_m", LANDSLIDE_FIELD_LENGTH);
     lahar_check_value(r, "deposit_length_rel_diff", (L - LANDSLIDE_FIELD_LENGTH) / LANDSLIDE_FIELD_LENGTH);
     lahar_check_value(r, "deposit_length_rel_error", fabs(L - LANDSLIDE_FIELD_LENGTH) / LANDSLIDE_FIELD_LENGTH);
-    lahar_check_value(r, "deposit_rear_x_m", x01);
-    lahar_check_value(r, "front_x_m", x99);
-    lahar_check_value(r, "runout_m", x99 - front0);
+    lahar_check_value(r, "deposit_rear_x_m", ls->x01);
+    lahar_check_value(r, "front_x_m", ls->x99);
+    lahar_check_value(r, "runout_m", ls->x99 - ls->front0);
     lahar_check_value(r, "deposit_thickness_max_m", tmax);
-    const double tmean = tn > 0 ? tsum / tn : 0.0;
+    const double tmean = ls->tn > 0 ? ls->tsum / ls->tn : 0.0;
     lahar_check_value(r, "deposit_thickness_mean_m", tmean);
     lahar_check_value(r, "deposit_thickness_outside_field_m",
                       fmax(0.0, fmax(LANDSLIDE_FIELD_THICK_LO - tmean, tmax - LANDSLIDE_FIELD_THICK_HI)));
-    lahar_check_value(r, "kinetic_energy_rel", ke_max > 0.0 ? ke_last / ke_max : 0.0);
-    lahar_check_value(r, "speed_max_m_s", vmax);
+    lahar_check_value(r, "kinetic_energy_rel", ls->ke_max > 0.0 ? ls->ke_last / ls->ke_max : 0.0);
+    lahar_check_value(r, "speed_max_m_s", ls->vmax);
     snprintf(r->note, sizeof r->note, "field deposit (Yangbaodi, Trujillo-Vela et al. 2020 section 5.4): about 140 m "
              "long, 1-5 m thick; the paper's SPH overestimates the run-out");
     snprintf(r->convention, sizeof r->convention, "deposit between the 1 %% and 99 %% quantiles of the soil's x at "
              "the end; thickness vertical, column tops (dx wide) above the terrain's surface");
-    rc = 0;
-done:
-    free(xs);
+}
+
+/* The steps from the initial mass to the report; xs is the caller's to free. */
+static int landslide_measure(lahar_check_particles *p, landslide *ls, lahar_check_result *r)
+{
+    if (landslide_initial(p, ls, r))
+        return -1;
+    landslide_plot_initial(p, ls, r);
+    if (landslide_snapshots(p, ls, r) || landslide_deposit(p, ls, r))
+        return -1;
+    landslide_report(ls, r);
+    return 0;
+}
+
+int lahar_check_landslide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    landslide ls = {0};
+    if (landslide_setup(c, d, &ls, r))
+        return -1;
+    const int rc = landslide_measure(d->particles, &ls, r);
+    free(ls.xs);
     return rc;
 }
