@@ -932,57 +932,102 @@ static void check_plot(const char *outdir)
         fprintf(stderr, "lahar check: no plot (%s %s failed, see above); check.json is written\n", py, script);
 }
 
-int lahar_check_evaluate(const lahar_case *c, const char *outdir)
-{
+/* What lahar_check_evaluate holds, step by step (the helpers below fill it in order). Every step
+ * that fails returns check_fail's exit status (2, with check.json saying why) having freed what
+ * it was given; 0 to go on. */
+typedef struct {
+    const lahar_check_reference *ref;
+    lahar_check_data d;         /* the output, loaded; freed once the reference has evaluated it */
+    lahar_check_result *r;      /* what the reference computed */
+    double *series;             /* the storage behind r's series and curve points */
+    cJSON *root, *metrics, *info;
+    int all_pass;
+    int used[LAHAR_CHECK_MAX_VALUES]; /* the value is a metric (the others go to info) */
     char msg[2048];
+} evaluation;
+
+/* The case's reference by name. */
+static int evaluation_reference(const lahar_case *c, const char *outdir, evaluation *ev)
+{
     if (!c->check.enabled)
         return check_fail(outdir, "", "the case has no check: section (add check: {reference: ..., metrics: ...})");
-    const lahar_check_reference *ref = lahar_check_find(c->check.reference);
-    if (!ref) {
-        snprintf(msg, sizeof msg, "%s: check.reference '%s' is unknown; known references: %s", c->path,
+    ev->ref = lahar_check_find(c->check.reference);
+    if (!ev->ref) {
+        snprintf(ev->msg, sizeof ev->msg, "%s: check.reference '%s' is unknown; known references: %s", c->path,
                  c->check.reference, lahar_check_names());
-        return check_fail(outdir, c->check.reference, msg);
+        return check_fail(outdir, c->check.reference, ev->msg);
     }
-    lahar_check_data d;
-    if (lahar_check_data_load(outdir, &d, msg, sizeof msg))
-        return check_fail(outdir, ref->name, msg);
-    if (d.nbody != c->nbody) {
-        snprintf(msg, sizeof msg, "%s/bodies.h5 has %d bodies, the case %s has %d: output of another case?", outdir,
-                 d.nbody, c->path, c->nbody);
-        lahar_check_data_free(&d);
-        return check_fail(outdir, ref->name, msg);
+    return 0;
+}
+
+/* The output in OUT, refused when it is not the case's (another body count or dimension), and
+ * the bodies' grids the references measure distances with. */
+static int evaluation_load(const lahar_case *c, const char *outdir, evaluation *ev)
+{
+    lahar_check_data *d = &ev->d;
+    const char *name = ev->ref->name;
+    if (lahar_check_data_load(outdir, d, ev->msg, sizeof ev->msg))
+        return check_fail(outdir, name, ev->msg);
+    if (d->nbody != c->nbody) {
+        snprintf(ev->msg, sizeof ev->msg, "%s/bodies.h5 has %d bodies, the case %s has %d: output of another case?",
+                 outdir, d->nbody, c->path, c->nbody);
+        lahar_check_data_free(d);
+        return check_fail(outdir, name, ev->msg);
     }
-    if (d.particles && d.particles->dim != c->dim) {
-        snprintf(msg, sizeof msg, "%s/particles.h5 is %dD, the case %s is %dD: output of another case?", outdir,
-                 d.particles->dim, c->path, c->dim);
-        lahar_check_data_free(&d);
-        return check_fail(outdir, ref->name, msg);
+    if (d->particles && d->particles->dim != c->dim) {
+        snprintf(ev->msg, sizeof ev->msg, "%s/particles.h5 is %dD, the case %s is %dD: output of another case?",
+                 outdir, d->particles->dim, c->path, c->dim);
+        lahar_check_data_free(d);
+        return check_fail(outdir, name, ev->msg);
     }
-    if (geom_body_grids_build(&d.grids, c->bodies, c->nbody)) {
-        lahar_check_data_free(&d);
-        return check_fail(outdir, ref->name, "out of memory");
+    if (geom_body_grids_build(&d->grids, c->bodies, c->nbody)) {
+        lahar_check_data_free(d);
+        return check_fail(outdir, name, "out of memory");
     }
-    lahar_check_result *r = calloc(1, sizeof *r);
-    double *series = malloc((3 * LAHAR_CHECK_MAX_SERIES + 2 * LAHAR_CHECK_MAX_POINTS) * sizeof *series);
-    if (!r || !series) {
-        free(r), free(series);
-        lahar_check_data_free(&d);
-        return check_fail(outdir, ref->name, "out of memory");
+    return 0;
+}
+
+/* The result and one block behind its series and curve points (too large for the stack). */
+static int evaluation_alloc(const char *outdir, evaluation *ev)
+{
+    ev->r = calloc(1, sizeof *ev->r);
+    ev->series = malloc((3 * LAHAR_CHECK_MAX_SERIES + 2 * LAHAR_CHECK_MAX_POINTS) * sizeof *ev->series);
+    if (!ev->r || !ev->series) {
+        free(ev->r), free(ev->series);
+        lahar_check_data_free(&ev->d);
+        return check_fail(outdir, ev->ref->name, "out of memory");
     }
+    lahar_check_result *r = ev->r;
+    double *series = ev->series;
     r->series_t = series, r->series_measured = series + LAHAR_CHECK_MAX_SERIES;
     r->series_reference = series + 2 * LAHAR_CHECK_MAX_SERIES;
     r->px = series + 3 * LAHAR_CHECK_MAX_SERIES, r->py = r->px + LAHAR_CHECK_MAX_POINTS;
-    int rc = ref->evaluate(c, &d, r);
-    lahar_check_data_free(&d);
+    return 0;
+}
+
+/* The reference's evaluation of the output; the output is freed after. */
+static int evaluation_run(const lahar_case *c, const char *outdir, evaluation *ev)
+{
+    int rc = ev->ref->evaluate(c, &ev->d, ev->r);
+    lahar_check_data_free(&ev->d);
     if (rc) {
-        snprintf(msg, sizeof msg, "%s", r->err);
-        free(r), free(series);
-        return check_fail(outdir, ref->name, msg);
+        snprintf(ev->msg, sizeof ev->msg, "%s", ev->r->err);
+        free(ev->r), free(ev->series);
+        return check_fail(outdir, ev->ref->name, ev->msg);
     }
-    /* the case's metrics (or the reference's default) against the computed values */
+    return 0;
+}
+
+/* The case's metrics (or the reference's default) against the computed values, each printed as
+ * it is judged; a metric the reference does not compute lists those it does. */
+static int evaluation_metrics(const lahar_case *c, const char *outdir, evaluation *ev)
+{
+    const lahar_check_reference *ref = ev->ref;
+    const lahar_check_result *r = ev->r;
+    char *msg = ev->msg;
     int nmetric = c->check.nmetric > 0 ? c->check.nmetric : 1;
-    cJSON *root = cJSON_CreateObject(), *metrics = cJSON_CreateObject(), *info = cJSON_CreateObject();
-    int all_pass = 1, used[LAHAR_CHECK_MAX_VALUES] = {0};
+    ev->root = cJSON_CreateObject(), ev->metrics = cJSON_CreateObject(), ev->info = cJSON_CreateObject();
+    ev->all_pass = 1;
     for (int k = 0; k < nmetric; k++) {
         const char *name = c->check.nmetric > 0 ? c->check.metric[k].name : ref->default_metric;
         double bound = c->check.nmetric > 0 ? c->check.metric[k].bound : ref->default_bound;
@@ -991,35 +1036,72 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
             if (strcmp(r->value[i].name, name) == 0)
                 found = i;
         if (found < 0) {
-            size_t pos = (size_t)snprintf(msg, sizeof msg, "%s: check.metrics.%s is not a metric of reference %s; it has:",
-                                          c->path, name, ref->name);
-            for (int i = 0; i < r->nvalue && pos < sizeof msg; i++)
-                pos += (size_t)snprintf(msg + pos, sizeof msg - pos, " %s", r->value[i].name);
-            cJSON_Delete(root), cJSON_Delete(metrics), cJSON_Delete(info);
-            free(r), free(series);
+            size_t pos = (size_t)snprintf(msg, sizeof ev->msg,
+                                          "%s: check.metrics.%s is not a metric of reference %s; it has:", c->path,
+                                          name, ref->name);
+            for (int i = 0; i < r->nvalue && pos < sizeof ev->msg; i++)
+                pos += (size_t)snprintf(msg + pos, sizeof ev->msg - pos, " %s", r->value[i].name);
+            cJSON_Delete(ev->root), cJSON_Delete(ev->metrics), cJSON_Delete(ev->info);
+            free(ev->r), free(ev->series);
             return check_fail(outdir, ref->name, msg);
         }
-        used[found] = 1;
+        ev->used[found] = 1;
         double v = r->value[found].value;
         int pass = v <= bound; /* NaN fails */
-        all_pass &= pass;
-        cJSON *m = cJSON_AddObjectToObject(metrics, name);
+        ev->all_pass &= pass;
+        cJSON *m = cJSON_AddObjectToObject(ev->metrics, name);
         cJSON_AddNumberToObject(m, "value", v);
         cJSON_AddNumberToObject(m, "bound", bound);
         cJSON_AddBoolToObject(m, "pass", pass);
         printf("lahar check %s: %s = %.6g (bound %.6g) %s\n", ref->name, name, v, bound, pass ? "pass" : "FAIL");
     }
+    return 0;
+}
+
+/* The reference's panels of labelled curves under plot (none: no "panels" key). */
+static void evaluation_json_panels(const lahar_check_result *r, cJSON *plot)
+{
+    if (r->npanel <= 0)
+        return;
+    cJSON *panels = cJSON_AddArrayToObject(plot, "panels");
+    for (int p = 0; p < r->npanel; p++) {
+        cJSON *pj = cJSON_CreateObject();
+        cJSON_AddStringToObject(pj, "title", r->panel[p].title);
+        cJSON_AddStringToObject(pj, "xlabel", r->panel[p].xlabel);
+        cJSON_AddStringToObject(pj, "ylabel", r->panel[p].ylabel);
+        cJSON_AddBoolToObject(pj, "ylog", r->panel[p].ylog);
+        cJSON *curves = cJSON_AddArrayToObject(pj, "curves");
+        for (int k = 0; k < r->ncurve; k++) {
+            if (r->curve[k].panel != p)
+                continue;
+            cJSON *cj = cJSON_CreateObject();
+            cJSON_AddStringToObject(cj, "label", r->curve[k].label);
+            cJSON_AddStringToObject(cj, "kind", r->curve[k].measured ? "measured" : "reference");
+            cJSON_AddItemToObject(cj, "x", cJSON_CreateDoubleArray(r->px + r->curve[k].start, r->curve[k].n));
+            cJSON_AddItemToObject(cj, "y", cJSON_CreateDoubleArray(r->py + r->curve[k].start, r->curve[k].n));
+            cJSON_AddItemToArray(curves, cj);
+        }
+        cJSON_AddItemToArray(panels, pj);
+    }
+}
+
+/* check.json's document: the verdict, the metrics, the other values as information, and the plot
+ * (the single series and the panels) that tools/plot_check.py draws. */
+static void evaluation_json(const lahar_case *c, evaluation *ev)
+{
+    const lahar_check_result *r = ev->r;
+    cJSON *root = ev->root;
     for (int i = 0; i < r->nvalue; i++)
-        if (!used[i])
-            cJSON_AddNumberToObject(info, r->value[i].name, r->value[i].value);
-    cJSON_AddStringToObject(info, "note", r->note);
-    cJSON_AddBoolToObject(root, "pass", all_pass);
-    cJSON_AddStringToObject(root, "reference", ref->name);
+        if (!ev->used[i])
+            cJSON_AddNumberToObject(ev->info, r->value[i].name, r->value[i].value);
+    cJSON_AddStringToObject(ev->info, "note", r->note);
+    cJSON_AddBoolToObject(root, "pass", ev->all_pass);
+    cJSON_AddStringToObject(root, "reference", ev->ref->name);
     cJSON_AddStringToObject(root, "case", c->path);
     if (r->convention[0])
         cJSON_AddStringToObject(root, "convention", r->convention);
-    cJSON_AddItemToObject(root, "metrics", metrics);
-    cJSON_AddItemToObject(root, "info", info);
+    cJSON_AddItemToObject(root, "metrics", ev->metrics);
+    cJSON_AddItemToObject(root, "info", ev->info);
     cJSON *plot = cJSON_AddObjectToObject(root, "plot");
     cJSON_AddStringToObject(plot, "title", r->title);
     cJSON_AddStringToObject(plot, "xlabel", r->xlabel);
@@ -1027,39 +1109,36 @@ int lahar_check_evaluate(const lahar_case *c, const char *outdir)
     cJSON_AddItemToObject(plot, "t", cJSON_CreateDoubleArray(r->series_t, r->nseries));
     cJSON_AddItemToObject(plot, "measured", cJSON_CreateDoubleArray(r->series_measured, r->nseries));
     cJSON_AddItemToObject(plot, "reference", cJSON_CreateDoubleArray(r->series_reference, r->nseries));
-    if (r->npanel > 0) {
-        cJSON *panels = cJSON_AddArrayToObject(plot, "panels");
-        for (int p = 0; p < r->npanel; p++) {
-            cJSON *pj = cJSON_CreateObject();
-            cJSON_AddStringToObject(pj, "title", r->panel[p].title);
-            cJSON_AddStringToObject(pj, "xlabel", r->panel[p].xlabel);
-            cJSON_AddStringToObject(pj, "ylabel", r->panel[p].ylabel);
-            cJSON_AddBoolToObject(pj, "ylog", r->panel[p].ylog);
-            cJSON *curves = cJSON_AddArrayToObject(pj, "curves");
-            for (int k = 0; k < r->ncurve; k++) {
-                if (r->curve[k].panel != p)
-                    continue;
-                cJSON *cj = cJSON_CreateObject();
-                cJSON_AddStringToObject(cj, "label", r->curve[k].label);
-                cJSON_AddStringToObject(cj, "kind", r->curve[k].measured ? "measured" : "reference");
-                cJSON_AddItemToObject(cj, "x", cJSON_CreateDoubleArray(r->px + r->curve[k].start, r->curve[k].n));
-                cJSON_AddItemToObject(cj, "y", cJSON_CreateDoubleArray(r->py + r->curve[k].start, r->curve[k].n));
-                cJSON_AddItemToArray(curves, cj);
-            }
-            cJSON_AddItemToArray(panels, pj);
-        }
-    }
+    evaluation_json_panels(r, plot);
+}
+
+/* OUT/check.json written, everything freed, the verdict printed and the plot drawn: 0 pass,
+ * 1 fail, 2 when check.json cannot be written. */
+static int evaluation_write(const char *outdir, evaluation *ev)
+{
     char path[1200];
     snprintf(path, sizeof path, "%s/check.json", outdir);
-    int wrc = check_write_json(path, root);
-    cJSON_Delete(root);
-    free(r), free(series);
+    int wrc = check_write_json(path, ev->root);
+    cJSON_Delete(ev->root);
+    free(ev->r), free(ev->series);
     if (wrc) {
         fprintf(stderr, "lahar check: %s: cannot write\n", path);
         return 2;
     }
-    printf("lahar check %s: %s; details in %s\n", ref->name, all_pass ? "PASS" : "FAIL", path);
+    printf("lahar check %s: %s; details in %s\n", ev->ref->name, ev->all_pass ? "PASS" : "FAIL", path);
     fflush(stdout);
     check_plot(outdir);
-    return all_pass ? 0 : 1;
+    return ev->all_pass ? 0 : 1;
+}
+
+int lahar_check_evaluate(const lahar_case *c, const char *outdir)
+{
+    evaluation ev = {0};
+    int rc;
+    if ((rc = evaluation_reference(c, outdir, &ev)) || (rc = evaluation_load(c, outdir, &ev)) ||
+        (rc = evaluation_alloc(outdir, &ev)) || (rc = evaluation_run(c, outdir, &ev)) ||
+        (rc = evaluation_metrics(c, outdir, &ev)))
+        return rc;
+    evaluation_json(c, &ev);
+    return evaluation_write(outdir, &ev);
 }
