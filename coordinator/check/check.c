@@ -699,19 +699,37 @@ static double check_gap(const lahar_case *c, int j, vec3 x, double R, vec3 *norm
     return dist - f->shape.radius - R;
 }
 
-/* A sphere or disc on a fixed incline (reference 06 §6.4): acceleration along the slope is
- * g sin(theta) / (1 + k), k = I/(m R^2) (sphere 5/7, disc 2/3), when it rolls, i.e. when
- * mu >= k/(1+k) tan(theta); otherwise g (sin(theta) - mu cos(theta)). theta comes from the
- * incline's geometry (normal at the closest point, geometry.h), the measured acceleration from a
- * quadratic fit of the distance travelled along the slope while in contact. */
-static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+/* What incline_roll measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    /* the ball and gravity */
+    int b;                     /* the ball: the first free body */
+    const lahar_body *ball;
+    double g, R, m, I;         /* |gravity|; the ball's radius, mass, moment of inertia */
+    vec3 gh;                   /* gravity's direction */
+    /* the incline and the contact */
+    int inc;                   /* the incline: the fixed body closest to the ball at the first snapshot */
+    int64_t i0, i1;            /* the longest run of snapshots in contact */
+    /* the theory */
+    double cos_t, sin_t;       /* the slope's angle theta */
+    vec3 down;                 /* down the slope */
+    double k_i, mu, a_ref;     /* I/(m R^2), the friction, the reference acceleration */
+    int rolling;
+    /* the fit */
+    int64_t start;             /* the first snapshot fitted */
+    int np;                    /* snapshots fitted */
+    double *tau, *s;           /* [np] time since start, distance down the slope */
+    double cf[3], a;           /* s = cf[0] + cf[1] tau + cf[2] tau^2; the acceleration 2 cf[2] */
+} incline;
+
+/* The ball (a sphere or disc) and gravity: 0, or -1 with r->err. */
+static int incline_ball(const lahar_case *c, const lahar_check_data *d, incline *in, lahar_check_result *r)
 {
     int b = check_first_free_body(c);
     vec3 gv = v3_load(c->gravity);
     double g = v3_norm(gv);
     if (b < 0 || g <= 0.0 || d->nsnap < 5) {
-        snprintf(r->err, sizeof r->err, "incline_roll: needs a free body, gravity and >= 5 snapshots (have %" PRId64 ")",
-                 d->nsnap);
+        snprintf(r->err, sizeof r->err,
+                 "incline_roll: needs a free body, gravity and >= 5 snapshots (have %" PRId64 ")", d->nsnap);
         return -1;
     }
     const lahar_body *ball = &c->bodies[b];
@@ -721,15 +739,21 @@ static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, la
                  ball->name);
         return -1;
     }
-    vec3 gh = v3_scale(gv, 1.0 / g);
-    /* the incline: the fixed body closest to the ball at the first snapshot */
+    in->b = b, in->ball = ball, in->g = g, in->R = R, in->m = m, in->I = I;
+    in->gh = v3_scale(gv, 1.0 / g);
+    return 0;
+}
+
+/* The incline: the fixed body closest to the ball at the first snapshot. 0, or -1 with r->err. */
+static int incline_body(const lahar_case *c, const lahar_check_data *d, incline *in, lahar_check_result *r)
+{
     int inc = -1;
     double best = INFINITY;
-    vec3 x0 = check_vec(d, d->x, 0, b), n;
+    vec3 x0 = check_vec(d, d->x, 0, in->b);
     for (int j = 0; j < c->nbody; j++) {
         if (c->bodies[j].motion != LAHAR_MOTION_FIXED)
             continue;
-        double gap = check_gap(c, j, x0, R, NULL);
+        double gap = check_gap(c, j, x0, in->R, NULL);
         if (gap < best)
             best = gap, inc = j;
     }
@@ -737,12 +761,18 @@ static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, la
         snprintf(r->err, sizeof r->err, "incline_roll: no fixed body (the incline) in the case");
         return -1;
     }
-    /* contact snapshots: the longest run of consecutive snapshots touching the incline (a ball
-     * placed above it may bounce first; one rolling off the end leaves it) */
-    double tol = 0.02 * R;
+    in->inc = inc;
+    return 0;
+}
+
+/* Contact snapshots: the longest run of consecutive snapshots touching the incline (a ball placed
+ * above it may bounce first; one rolling off the end leaves it). 0, or -1 with r->err. */
+static int incline_contact(const lahar_case *c, const lahar_check_data *d, incline *in, lahar_check_result *r)
+{
+    double tol = 0.02 * in->R;
     int64_t i0 = -1, i1 = -1, run0 = -1;
     for (int64_t k = 0; k <= d->nsnap; k++) {
-        int touching = k < d->nsnap && check_gap(c, inc, check_vec(d, d->x, k, b), R, NULL) <= tol;
+        int touching = k < d->nsnap && check_gap(c, in->inc, check_vec(d, d->x, k, in->b), in->R, NULL) <= tol;
         if (touching && run0 < 0)
             run0 = k;
         if (!touching && run0 >= 0) {
@@ -752,64 +782,114 @@ static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, la
         }
     }
     if (i0 < 0) {
-        snprintf(r->err, sizeof r->err, "incline_roll: body %s never touches %s", ball->name, c->bodies[inc].name);
+        snprintf(r->err, sizeof r->err, "incline_roll: body %s never touches %s", in->ball->name,
+                 c->bodies[in->inc].name);
         return -1;
     }
-    check_gap(c, inc, check_vec(d, d->x, i0, b), R, &n);
+    in->i0 = i0, in->i1 = i1;
+    return 0;
+}
+
+/* theta from the incline's normal at the closest point where the contact starts (geometry.h) and
+ * the reference acceleration (reference 06 §6.4): g sin(theta) / (1 + k), k = I/(m R^2), when the
+ * ball rolls, i.e. when mu >= k/(1+k) tan(theta); otherwise g (sin(theta) - mu cos(theta)). */
+static void incline_theory(const lahar_case *c, const lahar_check_data *d, incline *in)
+{
+    const double g = in->g, R = in->R;
+    const vec3 gh = in->gh;
+    vec3 n;
+    check_gap(c, in->inc, check_vec(d, d->x, in->i0, in->b), R, &n);
     double cos_t = fmin(1.0, fmax(-1.0, -v3_dot(n, gh))), sin_t = sqrt(fmax(0.0, 1.0 - cos_t * cos_t));
-    vec3 down = v3_normalize(v3_sub(gh, v3_scale(n, v3_dot(gh, n))));
-    double k_i = I / (m * R * R);
-    double mu = fmin(check_material(c, b, offsetof(lahar_material, friction)),
-                     check_material(c, inc, offsetof(lahar_material, friction)));
+    in->down = v3_normalize(v3_sub(gh, v3_scale(n, v3_dot(gh, n))));
+    double k_i = in->I / (in->m * R * R);
+    double mu = fmin(check_material(c, in->b, offsetof(lahar_material, friction)),
+                     check_material(c, in->inc, offsetof(lahar_material, friction)));
     int rolling = mu * cos_t >= k_i / (1.0 + k_i) * sin_t;
-    double a_ref = rolling ? g * sin_t / (1.0 + k_i) : g * (sin_t - mu * cos_t);
-    /* skip the start transient: the first tenth of the contact window, at least one snapshot */
-    int64_t start = i0 + ((i1 - i0 + 1) / 10 > 1 ? (i1 - i0 + 1) / 10 : 1);
-    int np = (int)(i1 - start + 1);
+    in->a_ref = rolling ? g * sin_t / (1.0 + k_i) : g * (sin_t - mu * cos_t);
+    in->cos_t = cos_t, in->sin_t = sin_t, in->k_i = k_i, in->mu = mu, in->rolling = rolling;
+}
+
+/* The distance travelled down the slope while in contact, after the start transient (the first
+ * tenth of the contact window, at least one snapshot), and its quadratic fit. 0, or -1 with r->err
+ * (tau and s are freed). */
+static int incline_fit(const lahar_check_data *d, incline *in, lahar_check_result *r)
+{
+    const int64_t i0 = in->i0, i1 = in->i1;
+    const int64_t start = i0 + ((i1 - i0 + 1) / 10 > 1 ? (i1 - i0 + 1) / 10 : 1);
+    const int np = (int)(i1 - start + 1);
+    in->start = start, in->np = np;
     if (np < 4) {
         snprintf(r->err, sizeof r->err,
                  "incline_roll: only %d snapshots in contact after the start; lower time.output_interval", np);
         return -1;
     }
-    double *tau = malloc((size_t)np * sizeof *tau), *s = malloc((size_t)np * sizeof *s), cf[3];
+    double *tau = malloc((size_t)np * sizeof *tau), *s = malloc((size_t)np * sizeof *s);
     if (!tau || !s) {
         free(tau), free(s);
         snprintf(r->err, sizeof r->err, "out of memory");
         return -1;
     }
-    vec3 xs = check_vec(d, d->x, start, b);
+    vec3 xs = check_vec(d, d->x, start, in->b);
     for (int i = 0; i < np; i++) {
         tau[i] = d->t[start + i] - d->t[start];
-        s[i] = v3_dot(v3_sub(check_vec(d, d->x, start + i, b), xs), down);
+        s[i] = v3_dot(v3_sub(check_vec(d, d->x, start + i, in->b), xs), in->down);
     }
-    int fit = check_fit_quadratic(tau, s, np, cf);
+    int fit = check_fit_quadratic(tau, s, np, in->cf);
     if (fit) {
         free(tau), free(s);
         snprintf(r->err, sizeof r->err, "incline_roll: degenerate fit");
         return -1;
     }
-    double a = 2.0 * cf[2];
+    in->tau = tau, in->s = s;
+    in->a = 2.0 * in->cf[2];
+    return 0;
+}
+
+/* The metric and the information values (check.json), the note, the title, and the fitted
+ * distance next to the reference parabola through the fit's start. */
+static void incline_report(const lahar_case *c, const lahar_check_data *d, const incline *in, lahar_check_result *r)
+{
+    const double a = in->a, a_ref = in->a_ref;
+    const int rolling = in->rolling, np = in->np;
+    const lahar_body *ball = in->ball;
     check_value(r, "accel_rel_error", fabs(a - a_ref) / a_ref);
     check_value(r, "accel_measured", a);
     check_value(r, "accel_reference", a_ref);
-    check_value(r, "theta_deg", atan2(sin_t, cos_t) * 180.0 / M_PI);
-    check_value(r, "mu", mu);
-    check_value(r, "inertia_ratio", k_i);
+    check_value(r, "theta_deg", atan2(in->sin_t, in->cos_t) * 180.0 / M_PI);
+    check_value(r, "mu", in->mu);
+    check_value(r, "inertia_ratio", in->k_i);
     check_value(r, "rolling", rolling);
     check_value(r, "fit_points", np);
-    snprintf(r->note, sizeof r->note, "body %s on %s: %s (mu %s k/(1+k) tan(theta))", ball->name, c->bodies[inc].name,
-             rolling ? "rolling without slip" : "sliding", rolling ? ">=" : "<");
+    snprintf(r->note, sizeof r->note, "body %s on %s: %s (mu %s k/(1+k) tan(theta))", ball->name,
+             c->bodies[in->inc].name, rolling ? "rolling without slip" : "sliding", rolling ? ">=" : "<");
     snprintf(r->title, sizeof r->title, "incline: %s %s, a = %.5g (reference %.5g) m/s^2", ball->name,
              rolling ? "rolling" : "sliding", a, a_ref);
     snprintf(r->xlabel, sizeof r->xlabel, "t [s]");
     snprintf(r->ylabel, sizeof r->ylabel, "distance down the slope [m]");
+    const double *tau = in->tau, *cf = in->cf;
     for (int i = 0; i < np && r->nseries < LAHAR_CHECK_MAX_SERIES; i++) {
-        r->series_t[r->nseries] = d->t[start + i];
-        r->series_measured[r->nseries] = s[i];
+        r->series_t[r->nseries] = d->t[in->start + i];
+        r->series_measured[r->nseries] = in->s[i];
         r->series_reference[r->nseries] = cf[0] + cf[1] * tau[i] + 0.5 * a_ref * tau[i] * tau[i];
         r->nseries++;
     }
-    free(tau), free(s);
+}
+
+/* A sphere or disc on a fixed incline (reference 06 §6.4): acceleration along the slope is
+ * g sin(theta) / (1 + k), k = I/(m R^2) (sphere 5/7, disc 2/3), when it rolls, i.e. when
+ * mu >= k/(1+k) tan(theta); otherwise g (sin(theta) - mu cos(theta)). theta comes from the
+ * incline's geometry (normal at the closest point, geometry.h), the measured acceleration from a
+ * quadratic fit of the distance travelled along the slope while in contact. */
+static int check_incline_roll(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    incline in = {0};
+    if (incline_ball(c, d, &in, r) || incline_body(c, d, &in, r) || incline_contact(c, d, &in, r))
+        return -1;
+    incline_theory(c, d, &in);
+    if (incline_fit(d, &in, r))
+        return -1;
+    incline_report(c, d, &in, r);
+    free(in.tau), free(in.s);
     return 0;
 }
 
