@@ -88,9 +88,25 @@ static double inlet_volume(const lahar_inlet *in, int dim, const double up[3], d
     return s;
 }
 
-int lahar_check_inflow(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+/* What inflow measures, step by step (the helpers below fill it in order). */
+typedef struct {
+    /* the set-up */
+    int dim;
+    double dx, cell;               /* spacing; a particle's lattice cell dx^D */
+    double up[3];                  /* against gravity */
+    double *area;                  /* [ninlet] wetted area of each inlet's section below its level */
+    double (*fv)[LAHAR_FLOW_NVAL]; /* [nsnap] the flow_* counters of each snapshot */
+    /* the discharge and the mass balance over the snapshots */
+    double vref_end;               /* the hydrographs' volume by the last snapshot */
+    double dis, bal;               /* the largest volume difference, the largest relative mass imbalance */
+    /* the late window: the last third of the snapshots */
+    int64_t k0, k1;
+} inflow;
+
+/* The case and output inflow can judge, the vertical, and the buffers: 0, or -1 with r->err. */
+static int inflow_setup(const lahar_case *c, const lahar_check_data *d, inflow *fl, lahar_check_result *r)
 {
-    lahar_check_particles *p = d->particles;
+    const lahar_check_particles *p = d->particles;
     if (!p || p->nsnap < 2) {
         snprintf(r->err, sizeof r->err, "inflow: needs at least two particle snapshots (OUT/particles.h5)");
         return -1;
@@ -99,35 +115,55 @@ int lahar_check_inflow(const lahar_case *c, const lahar_check_data *d, lahar_che
         snprintf(r->err, sizeof r->err, "inflow: the case has no inlets: section");
         return -1;
     }
-    const int dim = c->dim;
-    const double gmag = sqrt(dot3(c->gravity, c->gravity)), dx = c->sph_dx;
-    const double up[3] = {-c->gravity[0] / gmag, -c->gravity[1] / gmag, -c->gravity[2] / gmag};
-    double *area = calloc((size_t)c->ninlet, sizeof *area);
-    double(*fv)[LAHAR_FLOW_NVAL] = calloc((size_t)p->nsnap, sizeof *fv);
-    if (!area || !fv) {
-        free(area), free(fv);
+    fl->dim = c->dim;
+    const double gmag = sqrt(dot3(c->gravity, c->gravity));
+    fl->dx = c->sph_dx;
+    for (int a = 0; a < 3; a++)
+        fl->up[a] = -c->gravity[a] / gmag;
+    fl->area = calloc((size_t)c->ninlet, sizeof *fl->area);
+    fl->fv = calloc((size_t)p->nsnap, sizeof *fl->fv);
+    if (!fl->area || !fl->fv) {
+        free(fl->area), free(fl->fv);
+        fl->area = NULL, fl->fv = NULL;
         snprintf(r->err, sizeof r->err, "inflow: out of memory");
         return -1;
     }
+    return 0;
+}
+
+/* Each inlet's wetted area at its level (fine sampling) and every snapshot's flow_* counters.
+ * 0, or -1 with r->err. */
+static int inflow_counters(const lahar_case *c, const lahar_check_particles *p, inflow *fl, lahar_check_result *r)
+{
     for (int k = 0; k < c->ninlet; k++)
-        area[k] = inlet_area(&c->inlets[k], dim, up, c->inlets[k].level, 1);
+        fl->area[k] = inlet_area(&c->inlets[k], fl->dim, fl->up, c->inlets[k].level, 1);
     for (int64_t k = 0; k < p->nsnap; k++)
-        if (flow_attrs(p, k, fv[k]) != 0) {
+        if (flow_attrs(p, k, fl->fv[k]) != 0) {
             snprintf(r->err, sizeof r->err, "inflow: snapshot %lld of particles.h5 has no flow_* attributes (written "
                      "by a run with open boundaries)", (long long)k);
-            free(area), free(fv);
             return -1;
         }
-    const double cell = dim == 3 ? dx * dx * dx : dx * dx;
+    return 0;
+}
+
+/* Per snapshot the volume entered (particles x dx^D) against the hydrographs' (the plotted
+ * series) and the domain's mass against M(0) + entered - removed. */
+static void inflow_discharge(const lahar_case *c, const lahar_check_particles *p, inflow *fl,
+                             lahar_check_result *r)
+{
+    const int dim = fl->dim;
+    const double dx = fl->dx;
+    double(*fv)[LAHAR_FLOW_NVAL] = fl->fv;
+    fl->cell = dim == 3 ? dx * dx * dx : dx * dx;
     double vref_end = 0.0;
     for (int k = 0; k < c->ninlet; k++)
-        vref_end += inlet_volume(&c->inlets[k], dim, up, area[k], p->t[p->nsnap - 1]);
+        vref_end += inlet_volume(&c->inlets[k], dim, fl->up, fl->area[k], p->t[p->nsnap - 1]);
     double dis = 0.0, bal = 0.0;
     for (int64_t k = 0; k < p->nsnap; k++) {
         double vref = 0.0;
         for (int i = 0; i < c->ninlet; i++)
-            vref += inlet_volume(&c->inlets[i], dim, up, area[i], p->t[k]);
-        const double vin = fv[k][0] * cell;
+            vref += inlet_volume(&c->inlets[i], dim, fl->up, fl->area[i], p->t[k]);
+        const double vin = fv[k][0] * fl->cell;
         dis = fmax(dis, fabs(vin - vref));
         const double m = fv[k][7];
         const double b = m - fv[0][7] - (fv[k][1] - fv[k][3] - fv[k][5]);
@@ -139,62 +175,111 @@ int lahar_check_inflow(const lahar_case *c, const lahar_check_data *d, lahar_che
             r->nseries++;
         }
     }
-    lahar_check_value(r, "discharge_rel_error", vref_end > 0.0 ? dis / vref_end : dis);
-    lahar_check_value(r, "mass_balance_rel_error", bal);
-    lahar_check_value(r, "volume_in_m", fv[p->nsnap - 1][0] * cell);
-    lahar_check_value(r, "volume_hydrograph_m", vref_end);
+    fl->vref_end = vref_end, fl->dis = dis, fl->bal = bal;
+}
+
+/* The discharge and mass-balance values, and over the last third of the snapshots the mass
+ * removed against the mass entered (a steady state passes its inflow on). */
+static void inflow_report_flow(const lahar_check_particles *p, inflow *fl, lahar_check_result *r)
+{
+    double(*fv)[LAHAR_FLOW_NVAL] = fl->fv;
+    lahar_check_value(r, "discharge_rel_error", fl->vref_end > 0.0 ? fl->dis / fl->vref_end : fl->dis);
+    lahar_check_value(r, "mass_balance_rel_error", fl->bal);
+    lahar_check_value(r, "volume_in_m", fv[p->nsnap - 1][0] * fl->cell);
+    lahar_check_value(r, "volume_hydrograph_m", fl->vref_end);
     const int64_t k0 = p->nsnap - 1 - (p->nsnap - 1) / 3, k1 = p->nsnap - 1;
     const double min_ = fv[k1][1] - fv[k0][1], mout = fv[k1][3] + fv[k1][5] - fv[k0][3] - fv[k0][5];
     lahar_check_value(r, "outflow_rel_error", min_ > 0.0 ? fabs(mout / min_ - 1.0) : 1.0);
     lahar_check_value(r, "mass_in_late", min_);
     lahar_check_value(r, "mass_out_late", mout);
-    if (c->ninlet == 1 && c->noutlet >= 1) {
-        const lahar_inlet *in = &c->inlets[0];
-        const lahar_outlet *o = &c->outlets[0];
-        double st[3], low = HUGE_VAL;
+    fl->k0 = k0, fl->k1 = k1;
+}
+
+/* The depth station halfway between the inlet's centre and the outlet's centre, and the inlet
+ * section's lowest point (*low, along up) the depth is measured from. */
+static void inflow_station(const lahar_inlet *in, const lahar_outlet *o, const inflow *fl, double st[3],
+                           double *low)
+{
+    for (int a = 0; a < 3; a++)
+        st[a] = 0.5 * ((in->x0[a] + 0.5 * in->e1[a] + 0.5 * in->e2[a]) + (o->x0[a] + 0.5 * o->e1[a] + 0.5 * o->e2[a]));
+    *low = HUGE_VAL;
+    for (int cc = 0; cc < (fl->dim == 3 ? 4 : 2); cc++) {
+        double q[3];
         for (int a = 0; a < 3; a++)
-            st[a] = 0.5 * ((in->x0[a] + 0.5 * in->e1[a] + 0.5 * in->e2[a]) + (o->x0[a] + 0.5 * o->e1[a] + 0.5 * o->e2[a]));
-        for (int cc = 0; cc < (dim == 3 ? 4 : 2); cc++) {
-            double q[3];
-            for (int a = 0; a < 3; a++)
-                q[a] = in->x0[a] + (cc & 1 ? in->e1[a] : 0.0) + (cc & 2 ? in->e2[a] : 0.0);
-            low = fmin(low, dot3(q, up));
-        }
-        double sum = 0.0;
-        int cnt = 0;
-        for (int64_t k = k0; k <= k1; k++) {
-            if (lahar_check_particles_read(p, k, r->err, sizeof r->err) != 0) {
-                free(area), free(fv);
-                return -1;
-            }
-            double top = -HUGE_VAL;
-            for (int64_t i = 0; i < p->cur_n; i++) {
-                const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
-                const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
-                const double s = dot3(rr, up);
-                const double hz2 = dot3(rr, rr) - s * s; /* squared horizontal distance */
-                if (hz2 < dx * dx)
-                    top = fmax(top, dot3(x, up));
-            }
-            if (top > -HUGE_VAL) {
-                sum += top + 0.5 * dx - low;
-                cnt++;
-            }
-        }
-        const double depth = cnt ? sum / cnt : 0.0;
-        /* against the level over the same window (a level table: its mean there) */
-        double hl = 0.0;
-        for (int64_t k = k0; k <= k1; k++)
-            hl += lahar_inlet_level(in, p->t[k]);
-        hl /= (double)(k1 - k0 + 1);
-        lahar_check_value(r, "depth_rel_error", fabs(depth / hl - 1.0));
-        lahar_check_value(r, "depth_m", depth);
+            q[a] = in->x0[a] + (cc & 1 ? in->e1[a] : 0.0) + (cc & 2 ? in->e2[a] : 0.0);
+        *low = fmin(*low, dot3(q, fl->up));
     }
+}
+
+/* One inlet and an outlet: the mean depth at the station over the late window (the highest
+ * domain particle within dx of the vertical line there, + dx/2, above the inlet section's lowest
+ * point) against the inlet's level over the same window (a level table: its mean there).
+ * 0, or -1 with r->err. */
+static int inflow_depth(const lahar_case *c, lahar_check_particles *p, const inflow *fl, lahar_check_result *r)
+{
+    const lahar_inlet *in = &c->inlets[0];
+    const int dim = fl->dim;
+    const double dx = fl->dx, *up = fl->up;
+    double st[3], low;
+    inflow_station(in, &c->outlets[0], fl, st, &low);
+    double sum = 0.0;
+    int cnt = 0;
+    for (int64_t k = fl->k0; k <= fl->k1; k++) {
+        if (lahar_check_particles_read(p, k, r->err, sizeof r->err) != 0)
+            return -1;
+        double top = -HUGE_VAL;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
+            const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
+            const double s = dot3(rr, up);
+            const double hz2 = dot3(rr, rr) - s * s; /* squared horizontal distance */
+            if (hz2 < dx * dx)
+                top = fmax(top, dot3(x, up));
+        }
+        if (top > -HUGE_VAL) {
+            sum += top + 0.5 * dx - low;
+            cnt++;
+        }
+    }
+    const double depth = cnt ? sum / cnt : 0.0;
+    double hl = 0.0;
+    for (int64_t k = fl->k0; k <= fl->k1; k++)
+        hl += lahar_inlet_level(in, p->t[k]);
+    hl /= (double)(fl->k1 - fl->k0 + 1);
+    lahar_check_value(r, "depth_rel_error", fabs(depth / hl - 1.0));
+    lahar_check_value(r, "depth_m", depth);
+    return 0;
+}
+
+/* The plot's title and labels and the convention (check.json). */
+static void inflow_labels(const lahar_case *c, const inflow *fl, lahar_check_result *r)
+{
     snprintf(r->title, sizeof r->title, "inflow: volume through %d inlet(s) against the hydrograph", c->ninlet);
     snprintf(r->xlabel, sizeof r->xlabel, "t (s)");
-    snprintf(r->ylabel, sizeof r->ylabel, dim == 3 ? "volume in (m^3)" : "volume in (m^2)");
+    snprintf(r->ylabel, sizeof r->ylabel, fl->dim == 3 ? "volume in (m^3)" : "volume in (m^2)");
     snprintf(r->convention, sizeof r->convention, "volume = particles entered x dx^%d; hydrograph: wetted area x "
-             "integral of u, or integral of Q", dim);
-    free(area), free(fv);
+             "integral of u, or integral of Q", fl->dim);
+}
+
+/* The steps from the counters to the labels; the buffers are the caller's to free. */
+static int inflow_measure(const lahar_case *c, lahar_check_particles *p, inflow *fl, lahar_check_result *r)
+{
+    if (inflow_counters(c, p, fl, r))
+        return -1;
+    inflow_discharge(c, p, fl, r);
+    inflow_report_flow(p, fl, r);
+    if (c->ninlet == 1 && c->noutlet >= 1 && inflow_depth(c, p, fl, r))
+        return -1;
+    inflow_labels(c, fl, r);
     return 0;
+}
+
+int lahar_check_inflow(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r)
+{
+    inflow fl = {0};
+    if (inflow_setup(c, d, &fl, r))
+        return -1;
+    const int rc = inflow_measure(c, d->particles, &fl, r);
+    free(fl.area), free(fl.fv);
+    return rc;
 }
