@@ -215,19 +215,25 @@ int sps_general_large(const lahar_dem_engine *e, const int **ids)
 
 static void sps_load(lahar_dem_engine *e);
 
-int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
+/* Whether body g has the fast path's shape: a single vertex at its centre, no edge, no face. */
+static int sphere_shaped(const lahar_dem_engine *e, const sp_geo *g)
+{
+    vec3 v = e->vb[g->v0];
+    return g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 && v.z == 0.0;
+}
+
+/* The free bodies that the fast path will take: none means no fast path at all. */
+static int count_spheres(const lahar_dem_engine *e)
 {
     int ns = 0;
-    for (int k = 0; k < e->nfree; k++) {
-        const sp_geo *g = &e->geo[e->free_ids[k]];
-        vec3 v = e->vb[g->v0];
-        ns += g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 && v.z == 0.0;
-    }
-    if (ns == 0) return 0;
-    sp_spheres *s = calloc(1, sizeof *s);
-    e->sph = s;
-    if (!s) goto oom;
-    int nb = e->nbody;
+    for (int k = 0; k < e->nfree; k++) ns += sphere_shaped(e, &e->geo[e->free_ids[k]]);
+    return ns;
+}
+
+/* The per-body maps and the per-sphere arrays (SoA) for ns spheres of nb bodies. Every array is
+ * tried, so that a failure leaves the same partial set as before; -1 if any is missing. */
+static int alloc_sphere_arrays(sp_spheres *s, int ns, int nb)
+{
     s->of_body = malloc(sizeof(int) * (size_t)nb);
     s->wall_of_body = malloc(sizeof(int) * (size_t)nb);
     s->body = lahar_soa_calloc((size_t)ns, sizeof(int));
@@ -254,6 +260,17 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->st = lahar_soa_calloc((size_t)ns, sizeof(vec3));
     s->scnt = lahar_soa_calloc((size_t)ns, sizeof(int));
     s->pstart = lahar_soa_calloc((size_t)ns + 1, sizeof(int));
+    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass ||
+        !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->qw ||
+        !s->qx || !s->qy || !s->qz || !s->bcount || !s->wstart || !s->sf || !s->st || !s->scnt || !s->pstart)
+        return -1;
+    return 0;
+}
+
+/* The wall cache, the thread partition (with its cross entries) and the cell binning of the list
+ * build; -1 if any array is missing (all are tried, as in alloc_sphere_arrays). */
+static int alloc_wall_part_arrays(const lahar_dem_engine *e, sp_spheres *s, int ns, int nb)
+{
     s->wunit = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
     s->wnrm = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
     s->wp0 = malloc(sizeof(vec3) * (size_t)(nb > 0 ? nb : 1));
@@ -269,18 +286,23 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     s->order = lahar_soa_calloc((size_t)ns, sizeof(int));
     s->ncell_cap = 8 * ns + 1024 + 1;
     s->cell_start = malloc(sizeof(int) * (size_t)(s->ncell_cap + 1));
-    if (!s->of_body || !s->wall_of_body || !s->body || !s->wall_body || !s->gen_large || !s->rad || !s->mass || !s->x0 || !s->mat || !s->iner || !s->inv_iner || !s->v0 || !s->x || !s->v || !s->w || !s->L || !s->qw || !s->qx || !s->qy || !s->qz ||
-        !s->bcount || !s->wstart || !s->sf || !s->st || !s->scnt ||
-        !s->pstart || !s->wunit || !s->wnrm || !s->wp0 || !s->wrad || !s->part || !s->xstart || !s->xpair || !s->xin || !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
-        goto oom;
+    if (!s->wunit || !s->wnrm || !s->wp0 || !s->wrad || !s->part || !s->xstart || !s->xpair || !s->xin ||
+        !s->xinstart || !s->cell_of || !s->order || !s->cell_start)
+        return -1;
+    return 0;
+}
+
+/* Sort the bodies: free spheres onto the fast path (their constants copied), single-face fixed
+ * walls in 3D to its wall list, other fixed or prescribed bodies to its general list. The skin is
+ * a fraction of the smallest sphere, so that a list stays valid over several steps. */
+static void classify_bodies(lahar_dem_engine *e, sp_spheres *s)
+{
     double rmin = DBL_MAX;
-    for (int i = 0; i < nb; i++) {
+    for (int i = 0; i < e->nbody; i++) {
         sp_geo *g = &e->geo[i];
         s->of_body[i] = -1;
         s->wall_of_body[i] = -1;
-        vec3 v = e->vb[g->v0];
-        if (g->motion == LAHAR_MOTION_FREE && g->nv == 1 && g->ne == 0 && g->nf == 0 && v.x == 0.0 && v.y == 0.0 &&
-            v.z == 0.0) {
+        if (g->motion == LAHAR_MOTION_FREE && sphere_shaped(e, g)) {
             s->of_body[i] = s->n;
             e->geo[i].fast_sphere = 1;
             s->body[s->n] = i;
@@ -302,9 +324,16 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
         }
     }
     s->skin = SPS_SKIN_FRACTION * rmin;
+}
+
+/* The bodies the general path still handles: other_ids (all but the fast spheres) and move_ids
+ * (the free ones first, nmove_free of them, then the prescribed). -1: no memory. */
+static int list_general_bodies(lahar_dem_engine *e)
+{
+    int nb = e->nbody;
     e->move_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
     e->other_ids = malloc(sizeof(int) * (size_t)(nb > 0 ? nb : 1));
-    if (!e->move_ids || !e->other_ids) goto oom;
+    if (!e->move_ids || !e->other_ids) return -1;
     for (int i = 0; i < nb; i++)
         if (!e->geo[i].fast_sphere) e->other_ids[e->nother++] = i;
     for (int i = 0; i < nb; i++)
@@ -312,13 +341,37 @@ int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
     e->nmove_free = e->nmove;
     for (int i = 0; i < nb; i++)
         if (e->geo[i].motion == LAHAR_MOTION_PRESCRIBED) e->move_ids[e->nmove++] = i;
-    /* pre-size for a dense pile: ~7 listed partners per sphere (half list), 2 walls */
-    if (list_reserve(&s->pl, 8 * s->n + 64) || list_reserve(&s->wl, 2 * s->n + 64) || hist_reserve(&s->ph, 8 * s->n + 64) ||
-        hist_reserve(&s->wh, 2 * s->n + 64))
-        goto oom;
+    return 0;
+}
+
+/* Pre-size the lists, their histories and the candidate scratch so that the step loop seldom
+ * grows them: a dense pile has ~7 listed partners per sphere (half list) and 2 walls. -1: no memory. */
+static int presize_lists(sp_spheres *s)
+{
+    if (list_reserve(&s->pl, 8 * s->n + 64) || list_reserve(&s->wl, 2 * s->n + 64) ||
+        hist_reserve(&s->ph, 8 * s->n + 64) || hist_reserve(&s->wh, 2 * s->n + 64))
+        return -1;
     s->cand_cap = 256;
     s->cand = malloc(sizeof(int) * (size_t)s->cand_cap);
-    if (!s->cand) goto oom;
+    if (!s->cand) return -1;
+    return 0;
+}
+
+/* The sphere fast path, when some free body is a plain sphere: its arrays, the bodies sorted
+ * between it and the general path, pre-sized lists, and the spheres' state loaded. */
+int sps_create(lahar_dem_engine *e, char *err, size_t errlen)
+{
+    int ns = count_spheres(e);
+    if (ns == 0) return 0;
+    sp_spheres *s = calloc(1, sizeof *s);
+    e->sph = s;
+    if (!s) goto oom;
+    /* both allocation steps run whatever the first returns (every array tried, as before) */
+    int bad = alloc_sphere_arrays(s, ns, e->nbody);
+    if (alloc_wall_part_arrays(e, s, ns, e->nbody)) bad = -1;
+    if (bad) goto oom;
+    classify_bodies(e, s);
+    if (list_general_bodies(e) || presize_lists(s)) goto oom;
     sps_load(e);
     return 0;
 oom:
