@@ -288,6 +288,7 @@ static int shape_from_points(reader *r, rmap *m, int kind, int motion, double ra
     }
     rd_key_join(m->prefix, "vertices", key);
     int np = 0, rc = -1;
+    yaml_node_t *fn = NULL; /* faces: of a polyhedron */
     double (*p)[3] = case_read_points(r, vn, key, dim, &np);
     if (!p)
         return -1;
@@ -311,8 +312,8 @@ static int shape_from_points(reader *r, rmap *m, int kind, int motion, double ra
         rc = lahar_shape_make_polygon_hull(s, cp, np, radius, err, sizeof err);
         if (rc != 0)
             rd_fail(r, vn, key, "%s; a polygon needs 3 or more points not on one line", err);
-    } else if (rmap_get(m, "faces")) {
-        rc = shape_from_faces(r, m, rmap_get(m, "faces"), cp, np, motion, radius, s);
+    } else if ((fn = rmap_get(m, "faces")) != NULL) {
+        rc = shape_from_faces(r, m, fn, cp, np, motion, radius, s);
     } else {
         rc = lahar_shape_make_hull(s, cp, np, radius, err, sizeof err);
         if (rc != 0)

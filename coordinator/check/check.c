@@ -343,6 +343,12 @@ void lahar_check_value(lahar_check_result *r, const char *name, double v)
 }
 #define check_value lahar_check_value
 
+double lahar_check_late_from(const double *t, int64_t n, double fraction)
+{
+    double t0 = t[0], t1 = t[n - 1];
+    return t1 - fraction * (t1 - t0);
+}
+
 int lahar_check_panel(lahar_check_result *r, const char *title, const char *xlabel, const char *ylabel)
 {
     if (r->npanel >= LAHAR_CHECK_MAX_PANELS)

@@ -105,6 +105,9 @@ typedef struct {
  * dropped; points beyond the pool are dropped (the plot is then shorter, the metrics are not
  * affected). */
 void lahar_check_value(lahar_check_result *r, const char *name, double v);
+/* Start of the late window of the times t[0, n) (n >= 1): the last `fraction` of the span
+ * t[n-1] - t[0], where an evaluator averages a steady state (water: 0.1, soil: 0.25). */
+double lahar_check_late_from(const double *t, int64_t n, double fraction);
 /* Start a panel; returns its index (or -1 when there are LAHAR_CHECK_MAX_PANELS already). */
 int lahar_check_panel(lahar_check_result *r, const char *title, const char *xlabel, const char *ylabel);
 /* Start a curve in panel `panel`; following lahar_check_point calls add to it. Returns 0 or -1. */

@@ -198,11 +198,7 @@ static int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 
 }
 
 /* Where the late window of the times t[0, n) starts (see the top of the file; n > 0). */
-static double fluid_late_from(const double *t, int64_t n)
-{
-    double t0 = t[0], t1 = t[n - 1];
-    return t1 - 0.1 * (t1 - t0);
-}
+static double fluid_late_from(const double *t, int64_t n) { return lahar_check_late_from(t, n, 0.1); }
 
 /* First index of the late window of the times t[0, n): the last one and the run of those before it
  * that are in the window (0 when n = 0). */

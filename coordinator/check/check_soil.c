@@ -74,11 +74,7 @@ static int64_t soil_extent(const lahar_check_particles *p, int dim, double dx, d
 
 /* Start of the soil references' window, the last quarter of the run: long enough for the
  * start-up oscillation to average out. */
-static double soil_late_from(const lahar_check_particles *p)
-{
-    const int64_t kl = p->nsnap - 1;
-    return p->t[kl] - 0.25 * (p->t[kl] - p->t[0]);
-}
+static double soil_late_from(const lahar_check_particles *p) { return lahar_check_late_from(p->t, p->nsnap, 0.25); }
 
 /* What soil_geostatic measures, step by step (the helpers below fill it in order). */
 typedef struct {
