@@ -21,6 +21,12 @@ set -u
 [ $# -ge 3 ] || { echo "usage: $0 LAHAR CASE OUT [dx=M] [end=S] [layers=N] [c=F] [threads=N] [paraview=1]" >&2; exit 2; }
 lahar=$1 case=$2 out=$3
 shift 3
+# an OUT such as "dx=0.004" is an option given in OUT's place: refuse it rather than create a
+# directory of that name wherever the script was started
+case $out in
+    *=*) echo "validation_check: OUT '$out' looks like an option; usage: $0 LAHAR CASE OUT [options]" >&2; exit 2 ;;
+esac
+[ -f "$case" ] || { echo "validation_check: case file '$case' not found" >&2; exit 2; }
 mkdir -p "$out" || exit 2
 py=${LAHAR_PYTHON:-python3}
 tools=$(cd "$(dirname "$0")/../tools" && pwd)
