@@ -1,5 +1,5 @@
 #!/bin/sh
-# Ctrl-C (SIGINT) and SIGTERM during a long set-up end the run at once (coordinator/coordinator.c,
+# Ctrl-C (SIGINT) and SIGTERM during a long set-up end the run at once (coordinator/run/nodes.c,
 # coord_setup_wait): lahar exits 1 within 2 s (it took 23 s, the whole set-up, before), summary.json
 # says "interrupted during set-up", and no node process is left. The case: the 3D dam break at
 # dx 3 mm (555,000 particles, ~7 s of set-up on one thread), interrupted 2.5 s in.

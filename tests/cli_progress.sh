@@ -1,5 +1,5 @@
 #!/bin/sh
-# Progress when stderr is not a terminal (a log file, a pipe, a batch job; coordinator/coordinator.c,
+# Progress when stderr is not a terminal (a log file, a pipe, a batch job; coordinator/run/lockstep.c,
 # coord_progress): whole lines "lahar: t = T / END s (P %) ... ETA ..." every --progress-every
 # seconds, with the simulated time rising and ending at or below END, a set-up line while the nodes
 # fill their particles, no carriage returns; none with -q, with --progress-every 0 or (default 60 s)

@@ -87,7 +87,7 @@ void fuzz_decode_message(int type, const uint8_t *data, int size)
         break;
     }
     case LAHAR_FRAME_T_MSG_STATUS: {
-        /* as the coordinator reads it (coordinator.c): the text cut to its 512 bytes */
+        /* as the coordinator reads it (coordinator/run/nodes.c, coord_take_status): the text cut to its 512 bytes */
         lahar_status_t s;
         if (LAHAR_MSG_DECODE(lahar_status_t, data, size, &s) < 0)
             break;
