@@ -1,4 +1,4 @@
-/* sph.initial_pressure: hydrostatic (sph_node/sph_node.c lahar_sph_node_fill): every particle of a
+/* sph.initial_pressure: hydrostatic (sph_node/node/node_fill.c, lahar_sph_node_fill): every particle of a
  * block starts at the density whose EOS pressure is rho0 |g| (h - height), h the block's top (half
  * a spacing above its highest particle centre, = the box's hi along gravity), volume dx^D (its lattice
  * cell), mass rho dx^D.
