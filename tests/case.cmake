@@ -45,3 +45,8 @@ lahar_test(case_keys PROGRAM test_case_keys SOURCES test_case_keys.c LABELS fast
 # cases/reference.yaml is what `lahar keys --yaml` prints (regenerate: build/bin/lahar keys --yaml > cases/reference.yaml)
 lahar_test(case_reference_yaml COMMAND sh -c "\"$1\" keys --yaml | diff -u \"$2\" - && ! \"$1\" keys nosuchsection 2>/dev/null" sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/reference.yaml
   LABELS fast)
+# What `lahar keys` tells a user: every key with a default and a whole description (parentheses
+# balanced: a description cut at a "; " inside one lost its half), `lahar keys SECTION` for every
+# section, and every key written in cases/*.yaml listed there for its section
+lahar_test(case_keys_doc COMMAND ${LAHAR_TEST_PYTHON} ${LAHAR_TEST_DIR}/case_keys_doc.py $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases
+  LABELS fast)

@@ -66,7 +66,7 @@ static const lahar_key material_keys[] = {
     END};
 
 static const lahar_key dem_keys[] = {
-    {"engine", LAHAR_KEY_TEXT, 0, "spheropoly", 0, 0, 0, NULL, "", "name of the DEM engine (`lahar-dem --list` shows them)", NULL},
+    {"engine", LAHAR_KEY_TEXT, 0, "spheropoly", 0, 0, 0, NULL, "", "name of the DEM engine (`lahar-dem --help` lists them)", NULL},
     {"dt_safety", LAHAR_KEY_NUMBER, 0, "0.02", LOX | HI, 0, 1, NULL, "", "fraction of the shortest contact period used as the DEM step; it is the fraction of the contact period used as the DEM step, 0.02 is safe", NULL},
     END};
 
@@ -229,7 +229,7 @@ static const lahar_key body_keys[] = {
 
 static const lahar_key terrain_keys[] = {
     {"name", LAHAR_KEY_TEXT, 0, "terrain", 0, 0, 0, NULL, "", "the body's name", NULL},
-    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "2D: a CSV of x,y; 3D: an ESRI ASCII grid (.asc); relative to the case file (or points)", NULL},
+    {"file", LAHAR_KEY_TEXT, 0, NULL, 0, 0, 0, NULL, "", "a CSV of x,y (2D) or an ESRI ASCII grid, .asc (3D), relative to the case file (or points)", NULL},
     {"points", LAHAR_KEY_LIST, 0, NULL, 0, 0, 0, NULL, "m", "2D: [[x, y], ...] the profile, instead of file", NULL},
     {"material", LAHAR_KEY_TEXT, 1, NULL, 0, 0, 0, NULL, "", "a DEM material (its friction is the bed's mu_phi against soil)", NULL},
     {"radius", LAHAR_KEY_NUMBER, 1, NULL, LOX, 0, 0, NULL, "m", "sweep radius of the surface (it lies radius above the points)", NULL},
@@ -239,14 +239,14 @@ static const char *const cv_axes[] = {"x", "y", "z", NULL};
 static const lahar_key tracker_keys[] = {
     {"name", LAHAR_KEY_TEXT, 0, "tracker<i>", 0, 0, 0, NULL, "", "unique name", NULL},
     {"position", LAHAR_KEY_VECTOR, 1, NULL, 0, 0, 0, NULL, "m", "the particle nearest this point at t = 0 is followed", NULL},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output", NULL},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step); samples per second, 0 or absent = every step", NULL},
     END};
 
 static const lahar_key control_volume_keys[] = {
     {"name", LAHAR_KEY_TEXT, 0, "cv<i>", 0, 0, 0, NULL, "", "unique name", NULL},
     {"box", LAHAR_KEY_MAPPING, 1, NULL, 0, 0, 0, NULL, "m", "{lo: [..], hi: [..]}: kinetic energy (Trujillo-Vela et al. 2020 eq. 39) and mass inside", NULL},
     {"axis", LAHAR_KEY_CHOICE, 0, "x", 0, 0, 0, cv_axes, "", "direction of the mass flux recorded through the box", NULL},
-    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every output); samples per second, 0 or absent = every output", NULL},
+    {"rate", LAHAR_KEY_NUMBER, 0, "0", LO, 0, 0, NULL, "Hz", "samples per second (0 = every step); samples per second, 0 or absent = every step", NULL},
     END};
 
 static const lahar_key_section sections[] = {
@@ -346,11 +346,30 @@ static void range_text(const lahar_key *k, char *out, size_t n)
         snprintf(out, n, "%s", k->type == LAHAR_KEY_WHOLE ? "a whole number" : "finite");
 }
 
+/* Where the doc's "; hint" tail starts: the hint completes the range error of a number
+ * (lahar_key_range_error), so only numbers have one, and it is the first "; " outside parentheses
+ * (a "; " inside "(...)" belongs to the description). NULL: the whole doc is the description. */
+static const char *doc_hint(const lahar_key *k)
+{
+    if (!k->doc || (k->type != LAHAR_KEY_NUMBER && k->type != LAHAR_KEY_WHOLE))
+        return NULL;
+    int depth = 0;
+    for (const char *p = k->doc; *p; p++) {
+        if (*p == '(')
+            depth++;
+        else if (*p == ')' && depth > 0)
+            depth--;
+        else if (*p == ';' && p[1] == ' ' && depth == 0)
+            return p;
+    }
+    return NULL;
+}
+
 void lahar_key_range_error(const lahar_key *k, double v, char *out, size_t n)
 {
     char rt[96];
     range_text(k, rt, sizeof rt);
-    const char *hint = k->doc ? strstr(k->doc, "; ") : NULL;
+    const char *hint = doc_hint(k);
     snprintf(out, n, "must be %s%s%s (got %g)%s%s", rt, k->unit && k->unit[0] ? " " : "", k->unit ? k->unit : "", v,
              hint ? "; " : "", hint ? hint + 2 : "");
 }
@@ -373,7 +392,7 @@ static const char *type_name(const lahar_key *k)
 /* The doc without its "; hint" tail. */
 static int doc_len(const lahar_key *k)
 {
-    const char *hint = strstr(k->doc, "; ");
+    const char *hint = doc_hint(k);
     return hint ? (int)(hint - k->doc) : (int)strlen(k->doc);
 }
 
