@@ -43,3 +43,13 @@ lahar_test(output_check_fluid COMMAND test_check_fluid ${LAHAR_OUTPUT_TEST_DIR}/
 # Measured: 0.28 % and 0.12 %, 4 s in Release.
 lahar_test(check_poiseuille_2d COMMAND lahar check ${CMAKE_SOURCE_DIR}/cases/poiseuille_2d.yaml -o ${LAHAR_OUTPUT_TEST_DIR}/check_poiseuille_2d --in-process -q --overwrite
   LABELS slow output TIMEOUT 300 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
+
+# tools/ as tools/README.md describes it: a row per script, executable, lahar_py.require() before
+# the third-party imports (so a python3 without h5py/matplotlib re-runs them under /usr/bin/python3),
+# `--help` exits 0
+lahar_test(tools_readme COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/tools_check.py ${CMAKE_SOURCE_DIR}/tools
+  LABELS fast output)
+# The impact tools on runs that end before the impact: plot_impact.py tabulates "none",
+# compare_spheric2.py exits 2 with a message (both crashed with a Python traceback)
+lahar_test(tools_no_impact COMMAND sh ${LAHAR_TEST_DIR}/tools_no_impact.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/tools_no_impact ${LAHAR_OUTPUT_PYTHON}
+  LABELS fast output TIMEOUT 120)

@@ -102,6 +102,11 @@ def main():
         run_p = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in ["P1", "P3", "P5", "P7"]}
     m = {"dx": dx, "window_ms": a.window}
     ti_run = first_at_or_above(*run_p["P1"], IMPACT_PA)
+    if np.isnan(ti_run):
+        t1 = run_p["P1"][0]
+        sys.stderr.write("compare_spheric2: %s: P1 never reaches %g Pa (samples to t = %.3g s): the water has not "
+                         "hit the box yet; run the case longer\n" % (a.out, IMPACT_PA, t1[-1] if len(t1) else 0.0))
+        return 2
     ti_exp = first_at_or_above(te, e[:, head.index("P1")], IMPACT_PA)
     m["impact"] = {"run": ti_run, "experiment": ti_exp, "rel": (ti_run - ti_exp) / ti_exp}
     m["peaks"] = {}

@@ -24,7 +24,12 @@ import os
 import subprocess
 import sys
 
-import numpy as np
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("numpy")
+
+import numpy as np  # noqa: E402
 
 L2D = "examples/resources/damBreak2D/damBreak2D_experimentalDataLobovsky2014/"
 K3D = "examples/resources/damBreak3D/test_case_2_exp_data-experimental_data.csv"

@@ -4,15 +4,19 @@
 
 usage: plot_column_collapse.py OUT.png OUT.csv RUN_DIR [RUN_DIR ...]
 Each RUN_DIR is a `lahar check` output of a granular_collapse case (its check.json carries
-aspect_ratio, runout_mass99_normalised, runout_normalised and the case's dx in the case file name
-is not needed: dx is read from the run's summary.json when present, else from the directory name's
-last '_' field). Scalings: docs/soil/column_collapse_scalings.md (Lube et al. 2005, Lajeunesse et
+aspect_ratio, runout_mass99_normalised, runout_normalised); dx is sph.dx of the case its check.json
+names, else the directory name's last '_' field (e.g. OUT/a1_0.005). Scalings: docs/soil/column_collapse_scalings.md (Lube et al. 2005, Lajeunesse et
 al. 2005, as quoted by Lagree, Staron & Popinet 2011, eq. 3.1)."""
 import json
 import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("matplotlib", "numpy")
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -33,14 +37,29 @@ def band(a):
     return min(br), max(br)
 
 
+def run_dx(d, check):
+    """sph.dx of the case the run's check.json names, else the directory name's last '_' field."""
+    try:
+        import yaml
+        with open(check["case"]) as f:
+            return float(yaml.safe_load(f)["sph"]["dx"])
+    except Exception:
+        return float(os.path.basename(os.path.normpath(d)).split("_")[-1])
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return
     if len(sys.argv) < 4:
-        sys.exit(__doc__)
+        sys.stderr.write(__doc__ + "\n")
+        sys.exit(2)
     png, csv, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
     rows = []
     for d in runs:
-        info = json.load(open(os.path.join(d, "check.json")))["info"]
-        dx = float(os.path.basename(os.path.normpath(d)).split("_")[-1])
+        check = json.load(open(os.path.join(d, "check.json")))
+        info = check["info"]
+        dx = run_dx(d, check)
         rows.append((info["aspect_ratio"], dx, info["runout_mass99_normalised"], info["runout_normalised"]))
     rows.sort()
     with open(csv, "w") as f:

@@ -78,8 +78,9 @@ def main(argv):
     for slope, run, chk, info, curve in runs:
         dx = info.get("dx_m", float("nan"))
         ax.plot(curve["x"], curve["y"], lw=1, label="%.0f deg" % slope)
-        print("| %.0f° | %s | %.3f | %.0f | %.3f | %.0f | %.0f | %.0f | %d | %.1e | %s |" % (
-            slope, "%.4g" % dx, info["first_impact_s"], info["peak_force_N"], info["peak_time_s"],
+        first = info["first_impact_s"]  # None: the soil never reached the wall in the run
+        print("| %.0f° | %s | %s | %.0f | %.3f | %.0f | %.0f | %.0f | %d | %.1e | %s |" % (
+            slope, "%.4g" % dx, "none" if first is None else "%.3f" % first, info["peak_force_N"], info["peak_time_s"],
             info["peak_force_raw_N"], info["momentum_flux_max_N"], info["weight_along_chute_N"],
             info["escaped_particles"], info["momentum_balance_rel_error"], "yes" if chk["pass"] else "no"))
     ax.set_xlabel("t (s)")

@@ -9,14 +9,23 @@ runs at each solid fraction (at the run's end, and at the peak of U_s, where K i
 Right: K against c, the reference curve and the runs' end values.
 """
 import json
+import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("matplotlib")
+
+import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
 def main(argv):
+    if len(argv) > 1 and argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0
     if len(argv) < 3:
         print(__doc__, file=sys.stderr)
         return 2

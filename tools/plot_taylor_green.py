@@ -6,15 +6,24 @@
 RUN_DIR is the output of `lahar check` on cases/taylor_green_2d.yaml (or a variant): its
 check.json holds the measured E/E0 and the exact curve (coordinator/check/check_fluid.c, taylor_green)."""
 import json
+import os
 import sys
 
-import matplotlib
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("matplotlib")
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
 def main(argv):
+    if len(argv) > 1 and argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 0
     if len(argv) < 3:
         print(__doc__, file=sys.stderr)
         return 2

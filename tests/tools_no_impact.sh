@@ -1,0 +1,27 @@
+#!/bin/sh
+# The impact tools on runs that end before the impact (a short first look at a case, the way a user
+# tries a tool): plot_impact.py writes its table with first impact "none" (it raised a TypeError on
+# first_impact_s = null), compare_spheric2.py exits 2 saying the water has not hit the box (it
+# raised a ValueError on an empty array).
+# usage: tools_no_impact.sh LAHAR SRC_DIR OUT_DIR PYTHON
+set -u
+lahar=$1 src=$2 out=$3 py=$4
+fail() { echo "tools_no_impact: $*" >&2; exit 1; }
+mkdir -p "$out"
+"$py" "$src/tools/case_override.py" "$src/cases/granular_impact_3d.yaml" "$out/gi.yaml" sph.dx=0.05 time.end=0.02 \
+  time.output_interval=0.01 || fail "case_override granular_impact_3d"
+"$lahar" check "$out/gi.yaml" -o "$out/gi" --in-process -q --overwrite --threads 1
+[ -f "$out/gi/check.json" ] || fail "lahar check wrote no check.json"
+"$py" "$src/tools/plot_impact.py" "$out/gi.png" "$out/gi" > "$out/gi.md" || fail "plot_impact.py failed on a run without impact"
+grep -q '^| 45° | 0.05 | none |' "$out/gi.md" || { cat "$out/gi.md"; fail "plot_impact.py: no row with first impact 'none'"; }
+[ -s "$out/gi.png" ] || fail "plot_impact.py wrote no PNG"
+
+"$py" "$src/tools/case_override.py" "$src/cases/dam_break_obstacle_plane_2d.yaml" "$out/sp.yaml" sph.dx=0.04 \
+  time.end=0.1 time.output_interval=0.05 || fail "case_override dam_break_obstacle_plane_2d"
+"$lahar" run "$out/sp.yaml" -o "$out/sp" --in-process -q --overwrite --threads 1 || fail "lahar run dam_break_obstacle_plane_2d"
+"$py" "$src/tools/compare_spheric2.py" "$out/sp" --no-plot 2> "$out/sp.err"
+rc=$?
+cat "$out/sp.err"
+[ $rc -eq 2 ] || fail "compare_spheric2.py: exit $rc on a run without impact, expected 2"
+grep -q "P1 never reaches" "$out/sp.err" || fail "compare_spheric2.py: no message saying why"
+echo "tools_no_impact: ok"
