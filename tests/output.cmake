@@ -53,3 +53,7 @@ lahar_test(tools_readme COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/tools_c
 # compare_spheric2.py exits 2 with a message (both crashed with a Python traceback)
 lahar_test(tools_no_impact COMMAND sh ${LAHAR_TEST_DIR}/tools_no_impact.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/tools_no_impact ${LAHAR_OUTPUT_PYTHON}
   LABELS fast output TIMEOUT 120)
+# The #include lines against the dependencies each folder's README states (tests/include_deps.py:
+# e.g. common/ never includes from the nodes or the coordinator)
+lahar_test(include_deps COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/include_deps.py ${CMAKE_SOURCE_DIR}
+  LABELS fast output)
