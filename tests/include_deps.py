@@ -14,9 +14,9 @@ import re
 import sys
 
 root = sys.argv[1]
-dirs=['common/scene','common/geometry','common/memory','common/kernels','common/io','common/protocol',
- 'sph_node','sph_node/particles','sph_node/fluid','sph_node/soil','sph_node/coupling','sph_node/probes','sph_node/inflow',
- 'dem_node','dem_node/engines','dem_node/engines/spheropoly','dem_node/engines/lammps','dem_node/contact','coordinator','coordinator/check']
+# every folder of the components that holds sources; one missing from ALLOW below fails the test
+dirs=sorted(os.path.relpath(dp,root) for top in ('common','sph_node','dem_node','coordinator')
+            for dp,_,fs in os.walk(os.path.join(root,top)) if any(f.endswith(('.c','.h')) for f in fs))
 hdr={}
 for d in dirs:
     for f in os.listdir(os.path.join(root,d)):
@@ -27,6 +27,7 @@ allow={
 'common/io':['common/scene','common/geometry','common/kernels'],
 'common/protocol':['common/scene','common/io','LCM'],
 'sph_node':['sph_node/*','common/*','LCM'],
+'sph_node/node':['sph_node','sph_node/*','common/*','LCM'],
 'sph_node/particles':['common/*'],
 'sph_node/fluid':['sph_node/particles','sph_node/soil','sph_node/coupling','common/*'],
 'sph_node/soil':['sph_node/particles','common/*'],
@@ -40,6 +41,7 @@ allow={
 'dem_node/contact':['common/*'],
 'coordinator':['common/*','LCM','coordinator/check','dem_node','dem_node/engines','sph_node','sph_node/inflow'],
 'coordinator/check':['common/*'],
+'coordinator/run':['coordinator','common/*','LCM','dem_node','sph_node'],
 }
 lcm=set('lahar_'+f[:-4]+'.h' for f in os.listdir(os.path.join(root,'lcm_types')) if f.endswith('.lcm'))
 def ok(d,t,h=None):
@@ -52,6 +54,9 @@ def ok(d,t,h=None):
     return False
 bad=collections.defaultdict(set)
 for d in dirs:
+    if d not in allow:
+        bad[d].add(f"{d}: a folder whose dependencies no README states (add it to ALLOW and to its README)")
+        continue
     for f in sorted(os.listdir(os.path.join(root,d))):
         if not f.endswith(('.c','.h')): continue
         for i,l in enumerate(open(os.path.join(root,d,f)),1):
