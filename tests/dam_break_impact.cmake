@@ -1,19 +1,23 @@
 # Wall impact pressure of a dam break against experiments. Lobovsky et al. 2014,
 # H = 300 mm (cases/dam_break_lobovsky_2d.yaml at dx = 10 mm, 1 s, one thread; 9 s of CPU, 20-45 s
 # on the loaded 2-core machine): impact time at sensor 1 within 5 %, the 10 ms mean peak pressure of
-# sensors 1-2 within [0.5, 2] x the experiment's, water levels H1-H4 (the case's level gauges)
-# within 0.05 H (mean over t* <= 5.5). Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
+# sensors 1-2 within [0.5, 2] x the experiment's (peak event 5), sensor 2's 10 ms mean within the
+# experiment's repeat spread (its 2.5-97.5 % percentile series: 1.73-1.98 rho g H) widened by 5 %
+# (--spread-tol 0.05; measured 1.70, 2.0 % under the spread, the Riemann scheme 1.75, inside), water
+# levels H1-H4 (the case's level gauges) within 0.05 H (mean over t* <= 5.5).
+# Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
 # measured values: cases/README.md "Lobovsky dam break".
 # tests/experiment_check.py runs a case with overrides on one thread and checks it with its tools/compare_*.py --check.
 set(LAHAR_LOBOVSKY_CASE ${CMAKE_SOURCE_DIR}/cases/dam_break_lobovsky_2d.yaml compare_lobovsky.py sph.dx=0.01)
 lahar_test(sph_dam_break_lobovsky_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
-  ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d ${LAHAR_LOBOVSKY_CASE}
+  ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d ${LAHAR_LOBOVSKY_CASE} -- --spread-tol 0.05
   LABELS sph validation slow TIMEOUT 300)
 # The same with the Riemann-solver scheme (sph.scheme: riemann, Zhang, Hu & Adams 2017; sph_node/fluid/sph_riemann.h):
 # the same bounds. Measured (dx 10 mm): impact t* within 0.2 %, sensor 1 peak 10.2 against delta-SPH's 12.9
 # rho g H (the experiment's 3.04): docs/bench/impact_pressure.md.
 lahar_test(sph_dam_break_lobovsky_2d_riemann COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d_riemann ${LAHAR_LOBOVSKY_CASE} sph.scheme=riemann sph.alpha=~ sph.delta=~
+  -- --spread-tol 0.05
   LABELS sph validation slow TIMEOUT 300)
 # SPHERIC Test 2 (Kleefsman et al. 2005; docs/references-data/kleefsman_2005_test2.csv), compared by
 # tools/compare_spheric2.py --check; measured values: cases/README.md "SPHERIC Test 2".

@@ -2,12 +2,13 @@
 """Compare a run of cases/dam_break_lobovsky_2d.yaml with Lobovsky et al. 2014 (H = 300 mm).
 
   tools/compare_lobovsky.py OUT [--window MS] [-o FILE.png] [--json FILE] [--check]
-                                [--rise-tol F] [--peak-band LO HI] [--level-tol F]
+                                [--rise-tol F] [--peak-band LO HI] [--level-tol F] [--spread-tol F]
 
 Reads OUT/gauges.h5 (pressure probes sensor1..sensor4, level gauges H1..H4) and
 the experiment in docs/references-data/ (lobovsky_2014_pressure.csv: Fig. 18, peak event 5;
-lobovsky_2014_levels.csv: Fig. 16, runs ETSIN 01 and 02). All in the paper's units: t* = t
-sqrt(g/H), p/(rho g H), h/H, H = 0.3 m.
+lobovsky_2014_levels.csv: Fig. 16, runs ETSIN 01 and 02; lobovsky_2014_sensor2_percentiles.csv:
+sensor 2's repeat spread, the 2.5 / 50 / 97.5 % percentiles over the test runs at each instant).
+All in the paper's units: t* = t sqrt(g/H), p/(rho g H), h/H, H = 0.3 m.
 
 Metrics (printed, and written to --json):
   rise        t* of the first sample of sensor 1 at or above 0.5 rho g H (the impact), run and
@@ -17,6 +18,10 @@ Metrics (printed, and written to --json):
               starting within that interval: (1/tau) * the pressure impulse over tau (Cooker &
               Peregrine 1995, J. Fluid Mech. 297:193: the impulse of an impact is set by the
               incompressible flow; the peak of a pulse shorter than tau is not)
+  spread      sensor 2: the same peak and peak_mean of the experiment's 2.5 %, 50 % and 97.5 %
+              percentile series (the repeat spread; the mean of a percentile series stands in
+              for the percentile of the runs' means), and whether the run's lie between the
+              2.5 % and 97.5 % values
   levels      per gauge H1-H4 (x = 0.300, 0.865, 1.114, 1.3625 m), the mean |h_run - h_exp| / H
               over the run's level-gauge samples with t* <= min(run end, --level-tmax, default 5.5:
               before the bore reflected from the wall reaches H4), against the experiment's mean
@@ -27,7 +32,9 @@ Metrics (printed, and written to --json):
               h >= 0.05 H, reported only.
 With --check: exit 1 unless |rise - 2.446| / 2.446 <= --rise-tol (default 0.05), every sensor 1-3
 sensor in --sensors (default sensor1 sensor2) peak_mean / experiment within --peak-band (default
-0.5 2) and every gauge's level difference <= --level-tol (default 0.05 H). The PNG shows pressure and levels against the experiment."""
+0.5 2), every gauge's level difference <= --level-tol (default 0.05 H) and, with --spread-tol F,
+sensor 2's peak_mean within the experiment's spread widened by the fraction F:
+[p2.5 (1 - F), p97.5 (1 + F)]. The PNG shows pressure and levels against the experiment."""
 import argparse
 import json
 import os
@@ -87,6 +94,7 @@ def main():
     ap.add_argument("--rise-tol", type=float, default=0.05)
     ap.add_argument("--peak-band", type=float, nargs=2, default=[0.5, 2.0])
     ap.add_argument("--level-tol", type=float, default=0.05)
+    ap.add_argument("--spread-tol", type=float, help="check sensor 2's peak_mean against the spread, widened by F")
     ap.add_argument("--sensors", nargs="+", default=["sensor1", "sensor2"], help="sensors whose peak_mean is checked")
     ap.add_argument("--no-plot", action="store_true")
     a = ap.parse_args()
@@ -123,6 +131,19 @@ def main():
         s = m["sensors"][n]
         s["ratio"] = s["peak"] / s["peak_exp"]
         s["ratio_mean"] = s["peak_mean"] / s["peak_mean_exp"]
+
+    # sensor 2's repeat spread: the percentile series, read as the run's sensor 2 is
+    sh, se = read_csv("lobovsky_2014_sensor2_percentiles.csv")
+    s2 = m["sensors"]["sensor2"]
+    spread = {}
+    for c, key in (("p2_5", "p2.5"), ("median", "median"), ("p97_5", "p97.5")):
+        y = se[:, sh.index(c)]
+        spread[key] = {"peak": peak(se[:, 0], y, r_exp), "peak_mean": peak_mean(se[:, 0], y, r_exp, tau)}
+    for q in ("peak", "peak_mean"):
+        lo, hi = spread["p2.5"][q], spread["p97.5"][q]
+        spread[q + "_inside"] = bool(lo <= s2[q] <= hi)
+        spread[q + "_rel_outside"] = (s2[q] - hi) / hi if s2[q] > hi else (s2[q] - lo) / lo if s2[q] < lo else 0.0
+    s2["spread"] = spread
 
     # levels: the level gauges H1-H4 of the case (kind: level, gauges.h5)
     hs, tls = {}, {}
@@ -165,12 +186,18 @@ def main():
         if n in a.sensors and not (a.peak_band[0] <= s["ratio_mean"] <= a.peak_band[1]):
             ok = False
             msgs.append(n + ".peak_mean")
+    if a.spread_tol is not None:
+        sp = m["sensors"]["sensor2"]["spread"]
+        if not (sp["p2.5"]["peak_mean"] * (1 - a.spread_tol) <= m["sensors"]["sensor2"]["peak_mean"] <=
+                sp["p97.5"]["peak_mean"] * (1 + a.spread_tol)):
+            ok = False
+            msgs.append("sensor2.peak_mean.spread")
     for g, d in m["levels"].items():
         if d["mean_abs_diff"] > a.level_tol:
             ok = False
             msgs.append(g + ".level")
     m["bounds"] = {"rise_tol": a.rise_tol, "peak_band": a.peak_band, "level_tol": a.level_tol,
-                   "sensors_checked": a.sensors}
+                   "sensors_checked": a.sensors, "spread_tol": a.spread_tol}
     m["pass"] = ok
     m["failed"] = msgs
 
@@ -178,6 +205,14 @@ def main():
     for n, s in m["sensors"].items():
         print("%s: peak %.2f (exp %.2f, x%.2f); %g ms mean %.2f (exp %.2f, x%.2f)" % (
             n, s["peak"], s["peak_exp"], s["ratio"], a.window, s["peak_mean"], s["peak_mean_exp"], s["ratio_mean"]))
+        if "spread" in s:
+            sp = s["spread"]
+            print("%s against the experiment's repeat spread (2.5-97.5 %%, median): peak %.2f-%.2f (%.2f): %s; "
+                  "%g ms mean %.2f-%.2f (%.2f): %s" % (
+                      n, sp["p2.5"]["peak"], sp["p97.5"]["peak"], sp["median"]["peak"],
+                      "inside" if sp["peak_inside"] else "outside by %+.1f %%" % (100 * sp["peak_rel_outside"]),
+                      a.window, sp["p2.5"]["peak_mean"], sp["p97.5"]["peak_mean"], sp["median"]["peak_mean"],
+                      "inside" if sp["peak_mean_inside"] else "outside by %+.1f %%" % (100 * sp["peak_mean_rel_outside"])))
     for g, d in m["levels"].items():
         print("%s: mean |h - h_exp| / H = %.3f over t* <= %.2f%s%s" % (
             g, d["mean_abs_diff"], d["t_star_max"],
@@ -193,6 +228,9 @@ def main():
             ax = axes[k, 0]
             t, p = run_p[n]
             ax.plot(te, exp_p[n], "k", lw=1.2, label="Lobovsky 2014, peak event 5")
+            if n == "sensor2":
+                ax.fill_between(se[:, 0], se[:, sh.index("p2_5")], se[:, sh.index("p97_5")], color="0.75",
+                                label="Lobovsky 2014, 2.5-97.5 % of the runs")
             ax.plot(t, p, lw=0.7, label="lahar, dx %g mm" % (1e3 * dx))
             w = max(1, int(round(tau / np.median(np.diff(t)))))
             ax.plot(t, np.convolve(p, np.ones(w) / w, mode="same"), lw=1.0,
@@ -200,7 +238,7 @@ def main():
             ax.set_xlim(2.2, min(7.0, t[-1]))
             ax.set_ylabel("p/ρgH, " + n)
             ax.grid(alpha=0.3)
-            if k == 0:
+            if k <= 1:
                 ax.legend(fontsize=7)
         axes[-1, 0].set_xlabel("t √(g/H)")
         for k, (g, xg) in enumerate(GAUGES):

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Derive the compact experimental series of docs/references-data/ from their public sources.
 
-  tools/impact_reference_data.py TNL_SPH_GIT_DIR [-o docs/references-data]
+  tools/impact_reference_data.py [TNL_SPH_GIT_DIR] [--aquagpusph AQUAGPUSPH_GIT_DIR] [-o docs/references-data]
 
 TNL_SPH_GIT_DIR is a clone of https://gitlab.com/tnl-project/tnl-sph (its GitHub mirror
 TNL-Project/TNL-SPH), which distributes, under examples/resources/:
@@ -9,6 +9,10 @@ TNL-Project/TNL-SPH), which distributes, under examples/resources/:
       from the paper's Fig. 16 (water levels, two test runs) and Fig. 18 (pressure, peak event 5);
   damBreak3D/test_case_2_exp_data-experimental_data.csv  SPHERIC Test 2 (Kleefsman et al. 2005,
       MARIN), as distributed by SPHERIC (decimal commas).
+AQUAGPUSPH_GIT_DIR is a clone of https://github.com/sanguinariojoe/aquagpusph (CEHINAV, the
+experimenters' group), whose example examples/2D/lobovsky_etal_2014/ distributes the repeat spread
+of sensor 2 at H = 300 mm: the 2.5 %, 50 % and 97.5 % percentiles of p/(rho g H) at each instant
+over the test runs (src/templates/Fig31_Wemmenhove_sensor2_compared_graph.csv; t*, 20 kHz).
 The files are read from the repository's HEAD with `git show`. Written (CSV, '#' header lines
 citing the source and the derivation):
   lobovsky_2014_pressure.csv   t* = t sqrt(g/H), p/(rho g H) of sensors 1, 2, 2L, 3, 4, linearly
@@ -17,6 +21,8 @@ citing the source and the derivation):
                                the source's own time grid (dt* = 0.019)
   kleefsman_2005_test2.csv     t (s), P1-P8 (Pa), H1-H4 (m), 0-2 s, the source's own samples
                                (~1 kHz), rounded to 0.1 Pa and 0.1 mm
+  lobovsky_2014_sensor2_percentiles.csv (from AQUAGPUSPH_GIT_DIR) t*, p/(rho g H) percentiles
+                               2.5, 50, 97.5 of sensor 2, linearly resampled to dt* = 0.002
 """
 import argparse
 import csv
@@ -33,6 +39,7 @@ import numpy as np  # noqa: E402
 
 L2D = "examples/resources/damBreak2D/damBreak2D_experimentalDataLobovsky2014/"
 K3D = "examples/resources/damBreak3D/test_case_2_exp_data-experimental_data.csv"
+A2D = "examples/2D/lobovsky_etal_2014/src/templates/"  # in AQUAgpusph
 # the source's file number of each sensor (its first line names the sensor)
 PRESSURE = [("sensor1", 5, "sensor 1"), ("sensor2", 4, "sensor 2"), ("sensor2L", 3, "sensor 2L"),
             ("sensor3", 2, "sensor 3"), ("sensor4", 1, "sensor 4")]
@@ -57,11 +64,50 @@ def table(text):
     return first, np.loadtxt(text.splitlines())
 
 
+def sensor2_percentiles(repo, out):
+    """Sensor 2's repeat spread at H = 300 mm (AQUAgpusph's lobovsky_etal_2014 example) on the
+    dt* = 0.002 grid of lobovsky_2014_pressure.csv."""
+    commit = subprocess.run(["git", "--git-dir", repo, "rev-parse", "HEAD"], check=True, capture_output=True,
+                            text=True).stdout.strip()
+    text = git_show(repo, A2D + "Fig31_Wemmenhove_sensor2_compared_graph.csv").splitlines()
+    if [h.strip('"') for h in text[0].split(",")] != ["p2.5", "median", "p97.5"]:
+        sys.exit("%s: unexpected header %s" % (repo, text[0]))
+    d = np.loadtxt(text[1:], delimiter=",")
+    if not (np.all(d[:, 1] <= d[:, 2]) and np.all(d[:, 2] <= d[:, 3])):
+        sys.exit("%s: the percentiles are not ordered" % repo)
+    ts = np.arange(0.0, 7.148 + 1e-9, 0.002)
+    cols = [ts] + [np.interp(ts, d[:, 0], d[:, k]) for k in (1, 2, 3)]
+    for k, name in ((1, "p2.5"), (2, "median"), (3, "p97.5")):
+        print("sensor 2 %s: source peak %.3f at t* %.4f, resampled %.3f" % (name, d[:, k].max(), d[d[:, k].argmax(), 0],
+                                                                          cols[k].max()))
+    with open(os.path.join(out, "lobovsky_2014_sensor2_percentiles.csv"), "w") as fh:
+        fh.write("# Source: L. Lobovsky, E. Botia-Vera, F. Castellana, J. Mas-Soler, A. Souto-Iglesias, Experimental\n"
+                 "# investigation of dynamic pressure loads during dam break, J. Fluids Struct. 48 (2014) 407-434;\n"
+                 "# H = 300 mm, sensor 2 (15 mm above the floor on the downstream wall). The repeat spread as\n"
+                 "# distributed with AQUAgpusph (https://github.com/sanguinariojoe/aquagpusph, CEHINAV,\n"
+                 "# examples/2D/lobovsky_etal_2014/src/templates/Fig31_Wemmenhove_sensor2_compared_graph.csv, commit\n"
+                 "# %s): at each instant the 2.5 %%, 50 %% and 97.5 %% percentiles of p/(rho g H)\n"
+                 "# over the test runs, against t* = t sqrt(g/H) (20 kHz; the example plots it against its own run's\n"
+                 "# time from the release; the file's name points to the paper's Fig. 31; the rise at t* 2.44-2.49\n"
+                 "# matches peak event 5's). Derived by tools/impact_reference_data.py: linear resampling to\n"
+                 "# dt* = 0.002 (peaks change by less than 0.5 %%: 97.5 %%: 2.032 -> 2.028).\n" % commit)
+        fh.write("t_star,p2_5,median,p97_5\n")
+        for row in np.column_stack(cols):
+            fh.write("%.3f," % row[0] + ",".join("%.4f" % v for v in row[1:]) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("repo", help="git directory of a TNL-SPH clone (bare or .git)")
+    ap.add_argument("repo", nargs="?", help="git directory of a TNL-SPH clone (bare or .git)")
+    ap.add_argument("--aquagpusph", metavar="GIT_DIR", help="git directory of an AQUAgpusph clone: sensor 2's spread")
     ap.add_argument("-o", "--out", default=os.path.join(os.path.dirname(__file__), "..", "docs", "references-data"))
     a = ap.parse_args()
+    if not a.repo and not a.aquagpusph:
+        ap.error("give TNL_SPH_GIT_DIR, --aquagpusph GIT_DIR or both")
+    if a.aquagpusph:
+        sensor2_percentiles(a.aquagpusph, a.out)
+    if not a.repo:
+        return
     commit = subprocess.run(["git", "--git-dir", a.repo, "rev-parse", "HEAD"], check=True, capture_output=True,
                             text=True).stdout.strip()
 
