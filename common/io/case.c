@@ -392,6 +392,62 @@ static void read_case(reader *r, lahar_case *c)
     read_check(r, rmap_get(&m, "check"), c);
 }
 
+/* The message of a parser that failed: file, line and column of the problem, and what to do. The
+ * reader's errors (a byte that is not UTF-8 text, a control character) carry a byte offset instead
+ * of a mark: their line is counted here (libyaml reports line 1 for them). A tab in the
+ * indentation of the line gets its own hint (YAML forbids tabs there). */
+static void yaml_syntax_error(const char *path, const yaml_parser_t *p, const char *data, size_t size, char *err,
+                              size_t errlen)
+{
+    const char *problem = p->problem ? p->problem : "unknown problem";
+    if (p->error == YAML_READER_ERROR) {
+        size_t off = p->problem_offset < size ? p->problem_offset : size, line_start = 0;
+        int line = 1;
+        for (size_t i = 0; i < off; i++)
+            if (data[i] == '\n')
+                line++, line_start = i + 1;
+        const int control = strstr(problem, "control") != NULL;
+        char byte[32] = "";
+        if (control)
+            snprintf(byte, sizeof byte, "byte 0x%02x, ", (unsigned)p->problem_value & 0xffu);
+        snprintf(err, errlen, "%s:%d: the file is not UTF-8 text: %s (%scolumn %d); %s", path, line, problem, byte,
+                 (int)(off - line_start) + 1,
+                 control ? "remove the control character" : "save the file as UTF-8 (an accented letter of a Latin-1 "
+                 "or Windows-1252 file, even in a comment, is not UTF-8)");
+        return;
+    }
+    const int line = (int)p->problem_mark.line + 1;
+    int tab = 0; /* a tab in the indentation of the problem's line */
+    size_t i = 0;
+    for (int l = 1; l < line && i < size; i++)
+        l += data[i] == '\n';
+    for (; i < size && (data[i] == ' ' || data[i] == '\t'); i++)
+        tab |= data[i] == '\t';
+    snprintf(err, errlen, "%s:%d: YAML syntax error: %s%s%s (column %d); %s", path, line, problem,
+             p->context ? " " : "", p->context ? p->context : "", (int)p->problem_mark.column + 1,
+             tab ? "the line is indented with a tab, which YAML does not allow: indent with spaces"
+                 : "fix the YAML syntax");
+}
+
+/* A case file is one YAML document: a second one (after a `---` line) would be ignored. 0, or -1
+ * with the message. */
+static int yaml_second_document(const char *path, yaml_parser_t *p, const char *data, size_t size, char *err,
+                                size_t errlen)
+{
+    yaml_document_t more;
+    if (!yaml_parser_load(p, &more)) {
+        yaml_syntax_error(path, p, data, size, err, errlen);
+        return -1;
+    }
+    const yaml_node_t *root = yaml_document_get_root_node(&more);
+    if (root)
+        snprintf(err, errlen, "%s:%d: a second YAML document starts here (after a `---` line); a case file holds one "
+                 "case: remove the `---` line and what follows, or put it in a file of its own", path,
+                 (int)(more.start_mark.line ? more.start_mark.line : root->start_mark.line) + 1);
+    yaml_document_delete(&more);
+    return root ? -1 : 0;
+}
+
 /* The one loader: YAML bytes in memory; `path` names them in messages, relative paths in the case
  * start from base_dir (NULL: the directory of `path`). */
 static int case_load_bytes(const char *path, const char *base_dir, const void *data, size_t size, lahar_case *out,
@@ -418,9 +474,12 @@ static int case_load_bytes(const char *path, const char *base_dir, const void *d
     }
     yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
     if (!yaml_parser_load(&parser, &doc)) {
-        snprintf(err, errlen, "%s:%d: YAML syntax error: %s%s%s (column %d); fix the YAML syntax", path,
-                 (int)parser.problem_mark.line + 1, parser.problem ? parser.problem : "unknown problem",
-                 parser.context ? " " : "", parser.context ? parser.context : "", (int)parser.problem_mark.column + 1);
+        yaml_syntax_error(path, &parser, data, size, err, errlen);
+        yaml_parser_delete(&parser);
+        return LAHAR_EXIT_BAD_INPUT;
+    }
+    if (yaml_document_get_root_node(&doc) && yaml_second_document(path, &parser, data, size, err, errlen) != 0) {
+        yaml_document_delete(&doc);
         yaml_parser_delete(&parser);
         return LAHAR_EXIT_BAD_INPUT;
     }
