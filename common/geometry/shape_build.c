@@ -631,7 +631,7 @@ static float stl_float_le(const unsigned char *b)
 /* Read the raw triangle corners (3 per triangle) of an ASCII or binary STL into *out. */
 static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char *err, size_t errlen)
 {
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = lahar_fopen_input(path, "rb");
     if (!fp) {
         lahar_errf(err, errlen, "cannot open STL file '%s': %s", path, strerror(errno));
         return -1;

@@ -14,6 +14,7 @@
 #include <yaml.h>
 
 #include "case_reader.h"
+#include "errmsg.h"
 #include "geometry.h"
 #include "terrain.h"
 
@@ -507,7 +508,7 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
     memset(out, 0, sizeof *out);
     if (errlen)
         err[0] = '\0';
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = lahar_fopen_input(path, "rb");
     if (!fp) {
         snprintf(err, errlen, "%s: cannot open the case file: %s; check the path", path, strerror(errno));
         return LAHAR_EXIT_BAD_INPUT;

@@ -1,5 +1,6 @@
 /* Inflow hydrographs and their CSV reader (declared in common/scene/inflow.h). */
 #include "inflow.h"
+#include "errmsg.h"
 
 #include <errno.h>
 #include <math.h>
@@ -78,7 +79,7 @@ static int csv_pair(char *s, double out[2])
 int lahar_hydrograph_read_csv(const char *path, int *kind, double **t, double **v, char *err, int errlen)
 {
     *t = *v = NULL;
-    FILE *f = fopen(path, "r");
+    FILE *f = lahar_fopen_input(path, "r");
     if (!f) {
         snprintf(err, (size_t)errlen, "cannot open the hydrograph %s (%s); give a CSV file with a header line "
                  "`t,u` or `t,Q`", path, strerror(errno));
@@ -107,7 +108,9 @@ int lahar_hydrograph_read_csv(const char *path, int *kind, double **t, double **
         }
         double pv[2];
         if (csv_pair(s, pv) != 0) {
-            snprintf(err, (size_t)errlen, "%s:%d: expected two numbers `t,value`, got '%.40s'", path, lineno, s);
+            s[strcspn(s, "\r\n")] = '\0'; /* the message is one line */
+            snprintf(err, (size_t)errlen, "%s:%d: expected two finite numbers `t,value` separated by a comma, got "
+                     "'%.40s'", path, lineno, s);
             goto fail;
         }
         if (n > 0 && !(pv[0] > (*t)[n - 1])) {

@@ -177,7 +177,7 @@ static int asc_read_values(tokens *t, const char *path, lahar_heightmap *h, char
 int lahar_heightmap_read_asc(const char *path, lahar_heightmap *h, char *err, size_t errlen)
 {
     memset(h, 0, sizeof *h);
-    FILE *fp = fopen(path, "r");
+    FILE *fp = lahar_fopen_input(path, "r");
     if (!fp) {
         lahar_errf(err, errlen, "%s: cannot open the grid file: %s; check the path", path, strerror(errno));
         return -1;
@@ -432,7 +432,7 @@ int lahar_profile_read_csv(const char *path, double (**p)[3], int *n, char *err,
 {
     *p = NULL;
     *n = 0;
-    FILE *fp = fopen(path, "r");
+    FILE *fp = lahar_fopen_input(path, "r");
     if (!fp) {
         lahar_errf(err, errlen, "%s: cannot open the profile file: %s; check the path", path, strerror(errno));
         return -1;

@@ -1,5 +1,6 @@
 /* Keys and MACs of authenticated runs (auth.h), on libsodium. */
 #include "auth.h"
+#include "errmsg.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <sodium.h>
@@ -24,7 +25,7 @@ int lahar_auth_key_load(const char *path, uint8_t key[LAHAR_AUTH_KEYBYTES], char
 {
     if (auth_init(err, n) != 0)
         return -1;
-    FILE *f = fopen(path, "r");
+    FILE *f = lahar_fopen_input(path, "r");
     if (!f) {
         snprintf(err, n, "auth key %s: %s (make one with `lahar keygen %s`)", path, strerror(errno), path);
         return -1;
