@@ -7,9 +7,10 @@
  * fragment (one `# expect:` line each, up to 4). Under the sanitizer build a leak on the error
  * path changes the exit status, so this also checks that nothing stays allocated on failure.
  * A fixture that needs an input file of HDF5 says so in a header line
- *     # h5: NAME DATASET N
+ *     # h5: NAME DATASET N [VALUE]
  * and is run from a copy in SCRATCH_DIR beside a file NAME holding DATASET of N doubles, written
- * here (inputs are made by the test, not kept in the source tree). */
+ * here (inputs are made by the test, not kept in the source tree): 0, 1, 2, ..., or N times VALUE
+ * (read by strtod: nan and inf too). */
 #include <dirent.h>
 #include <hdf5.h>
 #include <stdio.h>
@@ -18,8 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-/* dir/name with one dataset of n doubles (0, 1, 2, ...). 0 or -1. */
-static int write_h5_input(const char *dir, const char *name, const char *dataset, int n)
+/* dir/name with one dataset of n doubles (0, 1, 2, ..., or all `fill` when it is not ""). 0 or -1. */
+static int write_h5_input(const char *dir, const char *name, const char *dataset, int n, const char *fill)
 {
     char path[2048];
     snprintf(path, sizeof path, "%s/%s", dir, name);
@@ -31,7 +32,7 @@ static int write_h5_input(const char *dir, const char *name, const char *dataset
     hid_t ds = H5Dcreate2(f, dataset, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     double *v = calloc((size_t)(n > 0 ? n : 1), sizeof *v);
     for (int i = 0; v && i < n; i++)
-        v[i] = (double)i;
+        v[i] = fill[0] ? strtod(fill, NULL) : (double)i;
     int rc = ds >= 0 && v && H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0 ? 0 : -1;
     free(v);
     if (ds >= 0)
@@ -114,7 +115,7 @@ int main(int argc, char **argv)
     int failures = 0;
     for (int i = 0; i < n; i++) {
         char path[2048], expect[4][1100] = {"", "", "", ""}, line[1100] = "", buf[8192], want[4200];
-        char h5name[256] = "", h5set[256] = "";
+        char h5name[256] = "", h5set[256] = "", h5fill[64] = "";
         int nexpect = 0, h5n = -1;
         snprintf(path, sizeof path, "%s/%s", argv[2], names[i]);
         FILE *fp = fopen(path, "r");
@@ -130,12 +131,12 @@ int main(int argc, char **argv)
                 snprintf(expect[nexpect++], sizeof expect[0], "%.1000s", l + 10);
             else if (strncmp(l, "# line: ", 8) == 0)
                 snprintf(line, sizeof line, "%.1000s", l + 8);
-            else if (strncmp(l, "# h5: ", 6) == 0 && sscanf(l + 6, "%255s %255s %d", h5name, h5set, &h5n) != 3)
+            else if (strncmp(l, "# h5: ", 6) == 0 && sscanf(l + 6, "%255s %255s %d %63s", h5name, h5set, &h5n, h5fill) < 3)
                 h5n = -1;
         }
         fclose(fp);
         if (h5n >= 0) { /* run it from a copy beside its generated input */
-            if (copy_file(path, argv[3], names[i]) != 0 || write_h5_input(argv[3], h5name, h5set, h5n) != 0) {
+            if (copy_file(path, argv[3], names[i]) != 0 || write_h5_input(argv[3], h5name, h5set, h5n, h5fill) != 0) {
                 printf("FAIL %s: cannot make its input %s/%s\n", names[i], argv[3], h5name);
                 failures++;
                 continue;

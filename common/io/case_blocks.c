@@ -10,6 +10,7 @@
 #include <yaml.h>
 
 #include "case_reader.h"
+#include "errmsg.h"
 #include "geometry.h"
 #include "terrain.h"
 
@@ -336,43 +337,92 @@ static void check_block_expr(reader *r, yaml_node_t *n, const char *key, const c
 /* The initial-field datasets of an HDF5 file (initial: {file: F.h5}). */
 static const char *const init_sets[4] = {"vx", "vy", "vz", "pressure"};
 
-/* Open file `path` and, for k = 0..3 (vx, vy, vz, pressure), read dataset init_sets[k] into
- * out[k] (when out[k] is not NULL and the dataset exists) after checking it holds exactly n values;
- * found[k] = 1 when present. 0, or -1 with a message naming the file and the dataset. */
+/* H5Literate callback: the first link of the file's root that is not one of init_sets. */
+static herr_t init_file_other_link(hid_t g, const char *name, const H5L_info_t *info, void *data)
+{
+    (void)g, (void)info;
+    for (int k = 0; k < 4; k++)
+        if (strcmp(name, init_sets[k]) == 0)
+            return 0;
+    snprintf(data, LAHAR_NAME_MAX, "%.*s", LAHAR_NAME_MAX - 1, name);
+    return 1;
+}
+
+/* Open file `path` and, for k = 0..3 (vx, vy, vz, pressure), read dataset init_sets[k] after
+ * checking it holds exactly n finite numbers, into out[k] (when out[k] is not NULL; else into a
+ * buffer of its own, for the loader's check); found[k] = 1 when present. Anything else in the file
+ * (a misspelt name) is refused, with the name it is closest to. 0, or -1 with a message naming the
+ * file and the dataset. */
 int case_init_file_read(const char *path, int64_t n, double *out[4], int found[4], char *err, size_t errlen)
 {
+    FILE *probe = lahar_fopen_input(path, "rb"); /* a missing file or a directory: errno says which */
+    if (!probe) {
+        snprintf(err, errlen, "%s: %s; give an HDF5 file with datasets vx, vy (, vz) and/or pressure (paths are "
+                 "relative to the case file's directory)", path, strerror(errno));
+        return -1;
+    }
+    fclose(probe);
     H5E_auto2_t fn;
     void *data;
     H5Eget_auto2(H5E_DEFAULT, &fn, &data);
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     int rc = 0;
+    char other[LAHAR_NAME_MAX] = "";
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0) {
-        snprintf(err, errlen, "%s: cannot open as HDF5", path);
+        snprintf(err, errlen, "%s: not an HDF5 file; write the initial fields (e.g. with h5py) as "
+                 "datasets vx, vy (, vz) and/or pressure", path);
+        rc = -1;
+    } else if (H5Literate(f, H5_INDEX_NAME, H5_ITER_NATIVE, NULL, init_file_other_link, other) > 0) {
+        const char *near = NULL; /* a name it begins (p for pressure), else the closest one */
+        for (int k = 0; k < 4 && !near; k++)
+            if (strncmp(init_sets[k], other, strlen(other)) == 0)
+                near = init_sets[k];
+        if (!near)
+            near = rd_closest_name(other, init_sets);
+        snprintf(err, errlen, "%s: unknown dataset '%s'%s%s%s; the file may hold vx, vy, vz and pressure only", path,
+                 other, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
         rc = -1;
     }
+    double *own = NULL;
     for (int k = 0; k < 4 && !rc; k++) {
         found[k] = H5Lexists(f, init_sets[k], H5P_DEFAULT) > 0;
         if (!found[k])
             continue;
         hid_t d = H5Dopen2(f, init_sets[k], H5P_DEFAULT), s = d >= 0 ? H5Dget_space(d) : -1;
+        hid_t ty = d >= 0 ? H5Dget_type(d) : -1;
+        H5T_class_t cls = ty >= 0 ? H5Tget_class(ty) : H5T_NO_CLASS;
         hssize_t m = s >= 0 ? H5Sget_simple_extent_npoints(s) : -1;
-        if (d < 0 || s < 0 || m < 0 || H5Sget_simple_extent_ndims(s) != 1) {
+        double *buf = out[k];
+        if (d < 0 || s < 0 || m < 0 || H5Sget_simple_extent_ndims(s) != 1 ||
+            (cls != H5T_FLOAT && cls != H5T_INTEGER)) {
             snprintf(err, errlen, "%s: dataset '%s' is not a 1D array of numbers", path, init_sets[k]);
             rc = -1;
         } else if ((int64_t)m != n) {
             snprintf(err, errlen, "%s: dataset '%s' has %lld values, the block has %lld particles (one value per "
                      "particle, in lattice order)", path, init_sets[k], (long long)m, (long long)n);
             rc = -1;
-        } else if (out[k] && H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out[k]) < 0) {
+        } else if (!buf && !(buf = own = realloc(own, (size_t)(n > 0 ? n : 1) * sizeof *own))) {
+            snprintf(err, errlen, "%s: out of memory for %lld values", path, (long long)n);
+            rc = -1;
+        } else if (H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
             snprintf(err, errlen, "%s: dataset '%s' cannot be read as numbers", path, init_sets[k]);
             rc = -1;
         }
+        for (int64_t i = 0; i < n && !rc; i++)
+            if (!isfinite(buf[i])) {
+                snprintf(err, errlen, "%s: dataset '%s' value %lld is %g; every value must be a finite number", path,
+                         init_sets[k], (long long)i, buf[i]);
+                rc = -1;
+            }
+        if (ty >= 0)
+            H5Tclose(ty);
         if (s >= 0)
             H5Sclose(s);
         if (d >= 0)
             H5Dclose(d);
     }
+    free(own);
     if (f >= 0)
         H5Fclose(f);
     H5Eset_auto2(H5E_DEFAULT, fn, data);
@@ -392,18 +442,11 @@ int lahar_case_block_initial(const lahar_particle_block *pb, const double (*pts)
         double *out[4] = {buf, buf + n, buf + 2 * n, buf + 3 * n};
         int found[4] = {0, 0, 0, 0};
         int rc = case_init_file_read(pb->init_file, n, out, found, err, errlen);
-        for (int64_t i = 0; i < n && !rc; i++) {
+        for (int64_t i = 0; i < n && !rc; i++) { /* every value read is finite (case_init_file_read) */
             for (int a = 0; a < 3; a++)
                 v[i][a] = found[a] ? out[a][i] : pb->v[a];
             if (found[3])
                 p[i] = out[3][i];
-            for (int k = 0; k < 4; k++)
-                if (found[k] && !isfinite(out[k][i])) {
-                    snprintf(err, errlen, "%s: dataset '%s' value %lld is not finite", pb->init_file, init_sets[k],
-                             (long long)i);
-                    rc = -1;
-                    break;
-                }
         }
         *has_p = found[3];
         free(buf);

@@ -51,8 +51,9 @@ static void sph_node_block_density(const lahar_case *c, const double (*pts)[3], 
  * cells they fill, and the pressure gradient that holds them rises by up to rho g h / (rho0 c0^2)):
  * the lattice points of
  * lahar_case_block_lattice, i.e. inside the block and outside every body (a particle that starts
- * inside a body would be a crossing at step 0). 0, or -1 when out of memory or p has no room. */
-int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
+ * inside a body would be a crossing at step 0). 0, or -1 with the message in err (empty at the call):
+ * out of memory, p without room, or an initial field that cannot be read. */
+int sph_node_add_blocks(sph_particles *p, const lahar_case *c, char *err, size_t errlen)
 {
     int64_t most = 0;
     for (int b = 0; b < c->nblock; b++) {
@@ -66,6 +67,7 @@ int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         free(pts);
         free(rho);
         free(vel);
+        snprintf(err, errlen, "out of memory for blocks of %lld particles", (long long)most);
         return -1;
     }
     const double vol = pow(c->sph_dx, c->dim);
@@ -82,13 +84,13 @@ int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
         /* per-particle initial velocity and pressure (case keys velocity: / pressure: as
          * expressions): the pressure replaces the block's density by its inverse EOS */
         const lahar_particle_block *pb = &c->blocks[b];
+        if (n < 0)
+            snprintf(err, errlen, "out of memory for the lattice of block '%s'", pb->name);
         if (n > 0 && !rc) {
-            char err[600];
             int has_p = 0;
-            if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, rho, &has_p, err, sizeof err) != 0) {
-                fprintf(stderr, "lahar-sph: %s\n", err);
-                rc = -1;
-            } else if (has_p)
+            if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, rho, &has_p, err, errlen) != 0)
+                rc = -1; /* the message is in err */
+            else if (has_p)
                 for (int64_t i = 0; i < n; i++)
                     rho[i] = sph_node_eos_density(c, rho[i]);
         }
@@ -97,6 +99,8 @@ int sph_node_add_blocks(sph_particles *p, const lahar_case *c)
                                    soil ? SPH_SOIL_PHASE : 0) < 0
                      ? -1
                      : 0;
+        if (rc && !err[0])
+            snprintf(err, errlen, "out of memory for the particles of block '%s'", pb->name);
     }
     free(pts);
     free(rho);
@@ -121,7 +125,9 @@ int64_t lahar_sph_node_fill(sph_particles *p, const lahar_case *c)
     int64_t total = sph_node_count(c);
     if (total < 0 || sph_particles_init(p, total > 0 ? total : 1) != 0)
         return -1;
-    if (sph_node_add_blocks(p, c) != 0) {
+    char err[1400] = "";
+    if (sph_node_add_blocks(p, c, err, sizeof err) != 0) {
+        fprintf(stderr, "lahar-sph: %s\n", err);
         sph_particles_free(p);
         return -1;
     }

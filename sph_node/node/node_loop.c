@@ -450,10 +450,13 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
     if (sph_fluid_init(&s->f, &prm, total + room > 0 ? total + room : 1, err, (int)errlen) != 0)
         return -1;
     s->fluid_ready = 1;
-    if (total < 0 || sph_node_add_blocks(&s->f.p, c) != 0) {
-        snprintf(err, errlen, "out of memory for %lld particles", (long long)total);
+    err[0] = '\0';
+    if (total < 0) {
+        snprintf(err, errlen, "out of memory counting the particles");
         return -1;
     }
+    if (sph_node_add_blocks(&s->f.p, c, err, errlen) != 0)
+        return -1; /* the message is in err */
     if (s->has_flow && sph_inflow_start(&s->flow, &s->f, 0.0, err, (int)errlen) != 0)
         return -1;
     if (sph_node_alloc(s) != 0) {

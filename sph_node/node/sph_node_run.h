@@ -57,7 +57,7 @@ typedef struct {
 } sph_node;
 
 /* node_fill.c: the particles of the case's blocks (lahar_sph_node_fill, sph_node.h) */
-int sph_node_add_blocks(sph_particles *p, const lahar_case *c);
+int sph_node_add_blocks(sph_particles *p, const lahar_case *c, char *err, size_t errlen);
 int64_t sph_node_count(const lahar_case *c);
 
 /* node_output.c: snapshots, the final snapshot of a stopped run, the probes */
