@@ -288,6 +288,43 @@ void case_read_outlets(reader *r, yaml_node_t *n, lahar_case *c)
     }
 }
 
+/* The particles of every block and inlet start inside the domain box: what starts outside would be
+ * removed at the first step (a run that "finishes" with no fluid). Blocks by their box (a
+ * polygon's or mesh's bounding box: its extreme points are the region's), inlets by the corners
+ * of their section. */
+static void check_inside_domain(rmap *m, const lahar_case *c)
+{
+    const int dim = c->dim;
+    const double tol = 1e-9 * (c->sph_dx > 0.0 ? c->sph_dx : 1.0);
+    for (int b = 0; b < c->nblock; b++) {
+        const lahar_particle_block *pb = &c->blocks[b];
+        for (int a = 0; a < dim; a++)
+            if (pb->lo[a] < c->domain_lo[a] - tol || pb->hi[a] > c->domain_hi[a] + tol) {
+                rd_fail(m->r, m->node, "domain", "sph.blocks[%d] '%s' reaches outside the domain box (%c: block [%g, "
+                        "%g], domain [%g, %g]); its particles there would be removed at the first step: enlarge the "
+                        "domain or move the block", b, pb->name, "xyz"[a], pb->lo[a], pb->hi[a], c->domain_lo[a],
+                        c->domain_hi[a]);
+                return;
+            }
+    }
+    for (int i = 0; i < c->ninlet; i++) {
+        const lahar_inlet *in = &c->inlets[i];
+        for (int k = 0; k < (dim == 3 ? 4 : 2); k++) {
+            double p[3];
+            for (int a = 0; a < 3; a++)
+                p[a] = in->x0[a] + ((k & 1) ? in->e1[a] : 0.0) + ((k & 2) ? in->e2[a] : 0.0);
+            for (int a = 0; a < dim; a++)
+                if (p[a] < c->domain_lo[a] - tol || p[a] > c->domain_hi[a] + tol) {
+                    rd_fail(m->r, m->node, "domain", "inlets[%d] '%s' has its section outside the domain box (%c = %g "
+                            "at a corner, domain [%g, %g]); the particles it creates would be removed at once: enlarge "
+                            "the domain or move the inlet", i, in->name, "xyz"[a], p[a], c->domain_lo[a],
+                            c->domain_hi[a]);
+                    return;
+                }
+        }
+    }
+}
+
 void case_read_domain(reader *r, yaml_node_t *n, lahar_case *c)
 {
     if (!n || r->failed)
@@ -313,5 +350,6 @@ void case_read_domain(reader *r, yaml_node_t *n, lahar_case *c)
                       c->domain_hi[a]);
             return;
         }
+    check_inside_domain(&m, c);
     c->has_domain = 1;
 }
