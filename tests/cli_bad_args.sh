@@ -84,5 +84,15 @@ grep -q "^pid [0-9]" "$work/busy/.lahar.lock" && ! grep -q 4242 "$work/busy/.lah
 expect 2 "auth key $work/no.key: No such file or directory \(make one with \`lahar keygen FILE\`\)" -- \
     run "$good" -o "$work/auth" --auth-key "$work/no.key"
 expect 2 "auth key $good/run.key: Not a directory \(check the path and its permissions\)" -- run "$good" -o "$work/auth" --auth-key "$good/run.key"
+# lahar keys takes a section as a case writes it (bodies, materials, sph.blocks) or as the table does
+# (bodies[]); an unknown one is an error on stderr
+for section in bodies materials sph.blocks 'bodies[]'; do
+    if "$lahar" keys "$section" > "$work/keys.txt" 2>&1 && grep -q "^$(echo "$section" | sed 's/\[\]//')" "$work/keys.txt"; then
+        pass=$((pass + 1)); echo "ok   lahar keys $section: $(head -c 60 "$work/keys.txt")"
+    else
+        echo "FAIL lahar keys $section:"; sed 's/^/    /' "$work/keys.txt"; fail=$((fail + 1))
+    fi
+done
+expect 2 "lahar keys: unknown section 'nosuch'; the sections are: '' time materials.NAME" -- keys nosuch
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

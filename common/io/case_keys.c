@@ -424,12 +424,20 @@ int lahar_keys_print(FILE *f, const char *section)
 {
     int n = (int)(sizeof sections / sizeof sections[0]);
     if (section) {
+        /* as written in the table, or as written in a case: bodies for bodies[], materials for
+         * materials.NAME, sph.blocks for sph.blocks[] */
         const lahar_key_section *s = lahar_key_section_find(section);
+        for (int i = 0; i < n && !s; i++) {
+            size_t len = strlen(section), plen = strlen(sections[i].path);
+            if (len && plen > len && strncmp(sections[i].path, section, len) == 0 &&
+                (strcmp(sections[i].path + len, "[]") == 0 || strcmp(sections[i].path + len, ".NAME") == 0))
+                s = &sections[i];
+        }
         if (!s) {
-            fprintf(f, "lahar keys: unknown section '%s'; the sections are:", section);
+            fprintf(stderr, "lahar keys: unknown section '%s'; the sections are:", section);
             for (int i = 0; i < n; i++)
-                fprintf(f, " %s", sections[i].path[0] ? sections[i].path : "''");
-            fprintf(f, "\n");
+                fprintf(stderr, " %s", sections[i].path[0] ? sections[i].path : "''");
+            fprintf(stderr, "\n");
             return -1;
         }
         print_section(f, s);

@@ -55,8 +55,9 @@ double lahar_key_default(const lahar_key *k);
 int lahar_key_in_range(const lahar_key *k, double v);
 /* "must be > 0 Pa (got 3)"-style text for v outside the range, with the doc's hint. */
 void lahar_key_range_error(const lahar_key *k, double v, char *out, size_t n);
-/* `lahar keys [SECTION]`: a table of one section, or of all when section is NULL. Returns 0, or
- * -1 when the section is unknown (the known ones are printed to f). */
+/* `lahar keys [SECTION]`: a table of one section, or of all when section is NULL. SECTION is a
+ * table path (bodies[], materials.NAME) or the same without its [] / .NAME. Returns 0, or -1 when
+ * the section is unknown (the known ones are printed to stderr). */
 int lahar_keys_print(FILE *f, const char *section);
 /* cases/reference.yaml: every key with its default, as comments. */
 void lahar_keys_print_yaml(FILE *f);
