@@ -138,6 +138,30 @@ yaml_node_t *rmap_get(const rmap *m, const char *key)
     return NULL;
 }
 
+/* The sections other than `here` whose table has a key `name` ("time", "sph, probes[]"), in
+ * out; 0 when none has. */
+static int rd_key_elsewhere(const char *name, const lahar_key_section *here, char *out, size_t n)
+{
+    int count = 0, found = 0;
+    const lahar_key_section *secs = lahar_key_sections(&count);
+    size_t k = 0;
+    out[0] = '\0';
+    for (int i = 0; i < count && k < n; i++) {
+        if (&secs[i] == here || !lahar_key_find(&secs[i], name))
+            continue;
+        if (found == 3) { /* a common name (position, name, rate): a few examples do */
+            snprintf(out + k, n - k, ", ...");
+            break;
+        }
+        int w = snprintf(out + k, n - k, "%s%s", found ? ", " : "", secs[i].path[0] ? secs[i].path : "the top level");
+        if (w < 0)
+            break;
+        k += (size_t)w;
+        found++;
+    }
+    return found;
+}
+
 /* Report the first key that is not in known[] (with a suggestion) or appears twice. */
 void rmap_check_keys(rmap *m, const char *const *known)
 {
@@ -156,10 +180,16 @@ void rmap_check_keys(rmap *m, const char *const *known)
         for (int i = 0; known[i] && !ok; i++)
             ok = strcmp(known[i], rd_scalar(k)) == 0;
         if (!ok) {
-            char list[512];
+            char list[512], where[160];
             rd_join_names(known, list, sizeof list);
             const char *near = rd_closest_name(rd_scalar(k), known);
-            if (near)
+            if (rd_key_elsewhere(rd_scalar(k), m->sec, where, sizeof where))
+                rd_fail(r, k, key, "unknown key here; '%s' is a key of: %s (move it there; known keys here: %s)",
+                        rd_scalar(k), where, list);
+            else if (rd_scalar(k)[0] && strspn(rd_scalar(k), "0123456789") == strlen(rd_scalar(k)))
+                rd_fail(r, k, key, "unknown key '%s': a number with a decimal comma? In {key: 0,02} the comma "
+                        "separates entries; write decimals with a point (0.02)", rd_scalar(k));
+            else if (near)
                 rd_fail(r, k, key, "unknown key; did you mean '%s'? (known keys here: %s)", near, list);
             else
                 rd_fail(r, k, key, "unknown key; known keys here: %s", list);
