@@ -664,6 +664,13 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
                     for (int k = 0; k < 3; k++)
                         v[n].p[k] = stl_float_le(rec + 12 + 12 * c + 4 * k);
                     v[n].id = n;
+                    if (!isfinite(v[n].p[0]) || !isfinite(v[n].p[1]) || !isfinite(v[n].p[2])) {
+                        lahar_errf(err, errlen, "STL file '%s': triangle %u has a coordinate that is not a finite "
+                                   "number; repair the mesh", path, (unsigned)t + 1);
+                        free(v);
+                        fclose(fp);
+                        return -1;
+                    }
                 }
             }
             fclose(fp);
@@ -672,15 +679,18 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
             return 0;
         }
     }
-    /* ASCII: every "vertex x y z" is a corner; three corners make a facet */
+    /* ASCII: every "vertex x y z" is a corner; three corners make a facet; "endsolid" ends it (a
+     * file cut short, e.g. by a full disk or an interrupted copy, has none) */
     rewind(fp);
     char tok[64];
+    int ended = 0, ascii = got >= 5 && memcmp(hdr, "solid", 5) == 0;
     while (fscanf(fp, "%63s", tok) == 1) {
+        ended |= strcmp(tok, "endsolid") == 0;
         if (strcmp(tok, "vertex") != 0)
             continue;
         double x, y, z;
-        if (fscanf(fp, "%lf %lf %lf", &x, &y, &z) != 3) {
-            lahar_errf(err, errlen, "STL file '%s': 'vertex' not followed by three numbers", path);
+        if (fscanf(fp, "%lf %lf %lf", &x, &y, &z) != 3 || !isfinite(x) || !isfinite(y) || !isfinite(z)) {
+            lahar_errf(err, errlen, "STL file '%s': vertex %d is not followed by three finite numbers", path, n + 1);
             free(v);
             fclose(fp);
             return -1;
@@ -702,9 +712,18 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
         n++;
     }
     fclose(fp);
-    if (n == 0 || n % 3 != 0) {
-        lahar_errf(err, errlen, "STL file '%s' holds %d vertices, not a positive multiple of 3 (neither valid "
-                  "ASCII nor binary STL)", path, n);
+    if (!ascii && got == sizeof hdr) {
+        uint32_t ntri = (uint32_t)hdr[80] | (uint32_t)hdr[81] << 8 | (uint32_t)hdr[82] << 16 | (uint32_t)hdr[83] << 24;
+        lahar_errf(err, errlen, "STL file '%s' is not ASCII STL (it does not start with 'solid'), and as binary STL "
+                   "its header's %u triangles need %.0f bytes but the file has %ld: it is cut short or not STL; "
+                   "export it again", path, (unsigned)ntri, 84.0 + 50.0 * ntri, size);
+        free(v);
+        return -1;
+    }
+    if (n == 0 || n % 3 != 0 || !ended) {
+        lahar_errf(err, errlen, "STL file '%s' holds %d vertices%s (neither valid ASCII nor binary STL, or "
+                   "cut short); export it again", path, n,
+                   n == 0 || n % 3 ? ", not a positive multiple of 3" : " and no 'endsolid' line");
         free(v);
         return -1;
     }
