@@ -352,8 +352,15 @@ int rmap_enum(rmap *m, const char *key, const char *const *names, int required, 
 int rmap_bool(rmap *m, const char *key, int def)
 {
     static const char *const names[] = {"false", "true", "no", "yes", NULL};
-    int v = rmap_enum(m, key, names, 0, def ? 1 : 0);
-    return v == 1 || v == 3;
+    const char *s = rmap_str(m, key, 0, NULL, "true");
+    if (!s || m->r->failed)
+        return def;
+    for (int i = 0; names[i]; i++)
+        if (strcmp(s, names[i]) == 0)
+            return i == 1 || i == 3;
+    /* no "did you mean": the nearest name of on / off / True is as likely the opposite */
+    rmap_fail(m, key, "expected true or false (or yes / no, in lower case), got '%s'", s);
+    return def;
 }
 
 /* The keys of this mapping are those of `path`'s table (case_keys.c): report the first unknown or
