@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "checkpoint.h"
 #include "coord_run.h"
@@ -218,6 +219,16 @@ int coord_save_case(const char *outdir, const lahar_case *c)
 int lahar_coord_resume_case(const char *outdir, lahar_case *c)
 {
     char path[PATH_MAX + 64], src[PATH_MAX + 64], line1[PATH_MAX], line2[PATH_MAX];
+    struct stat st;
+    const int missing = stat(outdir, &st) != 0;
+    if (missing || !S_ISDIR(st.st_mode)) { /* a case file, or a mistyped OUT */
+        const size_t len = strlen(outdir);
+        const int yaml = len > 5 && strcmp(outdir + len - 5, ".yaml") == 0;
+        fprintf(stderr, "lahar resume: %s %s; resume takes the output directory of a run (lahar resume OUT)%s\n",
+                outdir, missing ? "does not exist" : "is not a directory",
+                yaml ? ", not its case: to start the case, lahar run CASE.yaml -o OUT" : "");
+        return LAHAR_EXIT_SETUP;
+    }
     snprintf(src, sizeof src, "%s/" LAHAR_CKPT_DIR "/case_source", outdir);
     FILE *f = fopen(src, "r");
     if (!f) {
