@@ -335,7 +335,7 @@ static void check_block_expr(reader *r, yaml_node_t *n, const char *key, const c
 }
 
 /* The initial-field datasets of an HDF5 file (initial: {file: F.h5}). */
-static const char *const init_sets[4] = {"vx", "vy", "vz", "pressure"};
+static const char *const init_sets[5] = {"vx", "vy", "vz", "pressure", NULL}; /* NULL: for rd_closest_name */
 
 /* H5Literate callback: the first link of the file's root that is not one of init_sets. */
 static herr_t init_file_other_link(hid_t g, const char *name, const H5L_info_t *info, void *data)
