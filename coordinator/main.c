@@ -429,6 +429,10 @@ static int check_case_arguments(const cli_command *a, int argc, const lahar_coor
         fprintf(stderr, "lahar %s: missing -o OUT (output directory)\n", cmd);
         return -1;
     }
+    if (o->outdir && !o->outdir[0]) { /* -o "" (an unset shell variable) */
+        fprintf(stderr, "lahar %s: -o is empty; give the output directory's name, e.g. -o out/run\n", cmd);
+        return -1;
+    }
     if (a->evaluate_only && !a->is_check) {
         fprintf(stderr, "lahar %s: --evaluate-only belongs to `lahar check`\n", cmd);
         return -1;

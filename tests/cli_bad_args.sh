@@ -34,6 +34,7 @@ expect 2 "--threads takes a whole number" -- run "$good" -o "$work/run" --thread
 expect 2 "--threads takes a whole number" -- check "$good" -o "$work/run" --threads 2x
 expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait soon
 expect 2 "--wait takes a number of seconds" -- run "$good" -o "$work/run" --wait 0
+expect 2 "-o is empty; give the output directory's name" -- run "$good" -o "" --in-process
 [ ! -e "$work/run" ] || { echo "FAIL an output directory was created for a refused command"; fail=$((fail + 1)); }
 expect 0 "" -- validate "$good"
 # validate says what the case costs; a case over the machine's memory is refused unless --allow-large
