@@ -94,6 +94,11 @@ def averaged_force(run, barrier, window, grid):
     return favg, impulse
 
 
+def relative(diff, ref):
+    """diff / ref; a barrier no run loads (both 0) differs by 0, one loaded only by run b by inf."""
+    return diff / ref if ref > 0 else (0.0 if diff == 0 else float("inf"))
+
+
 def compare(a, b, barrier, window):
     free = [n for n, m in zip(a["names"], a["motion"]) if m == 0]
     res = {"a": a["out"], "b": b["out"], "bodies": {}}
@@ -120,10 +125,10 @@ def compare(a, b, barrier, window):
         "name": barrier, "window_s": window, "t_end_s": float(t_end),
         "peak_a_N": pa, "peak_b_N": pb, "peak_at_a_s": float(grid[int(np.argmax(ma))]),
         "peak_at_b_s": float(grid[int(np.argmax(mb))]),
-        "peak_rel_diff": abs(pa - pb) / pa if pa > 0 else float("inf"),
+        "peak_rel_diff": relative(abs(pa - pb), pa),
         "impulse_a_Ns": float(np.linalg.norm(ja)), "impulse_b_Ns": float(np.linalg.norm(jb)),
-        "impulse_rel_diff": float(np.linalg.norm(ja - jb) / np.linalg.norm(ja)) if np.linalg.norm(ja) > 0 else float("inf"),
-        "history_max_diff_N": hist, "history_max_diff_rel_peak": hist / pa if pa > 0 else float("inf"),
+        "impulse_rel_diff": relative(float(np.linalg.norm(ja - jb)), float(np.linalg.norm(ja))),
+        "history_max_diff_N": hist, "history_max_diff_rel_peak": relative(hist, pa),
     }
     res["max_position_diff_m"] = max((v["max_position_diff_m"] for v in res["bodies"].values()), default=0.0)
     return res, grid, ma, mb
