@@ -1,5 +1,5 @@
 # SPH node driving the WCSPH core and the SPH-DEM coupling over the protocol:
-# sph_node/node/node_loop.c, dem_node/dem_node.c (LOADS, BODY_STATE), contacts.h5 (common/io/output.c).
+# sph_node/node/node_loop.c, dem_node/dem_node.c (LOADS, BODY_STATE), contacts.h5 (common/io/output_contacts.c).
 # coupling_sph_runs.sh TEST BIN_DIR TOOLS_DIR WORK_DIR; `modes` runs nodes as processes in lahar's
 # own private network namespace (label netns).
 function(lahar_coupling_sph_test name labels)

@@ -124,7 +124,7 @@ void fuzz_decode_message(int type, const uint8_t *data, int size)
         lahar_loads_buf b = {0};
         if (lahar_loads_decode(data, size, &b) == 0) {
             FUZZ_ASSERT(b.nbody >= 0 && b.nbody <= b.cap_body && b.ntotal >= 0 && b.ntotal <= b.cap_points);
-            /* the points of body i as the contact writer (common/io/output.c) finds them */
+            /* the points of body i as the contact writer (common/io/output_contacts.c) finds them */
             int64_t off = 0;
             double s = 0.0;
             for (int i = 0; i < b.nbody; i++) {
