@@ -26,7 +26,7 @@ lahar_validation_test(dam_break_3d dam_break_3d dx=0.02 paraview=1)
 # Floating box at dx = 10 mm (5 particles across the box's draft), the issue's 2 %: the case's
 # ghost wall pressure, quintic at h = dx and alpha 0.2 settle the box within 6 s; measured -1.07 %
 # (the penalty wall alone: +6.9 %, which this test would fail). The draft is taken from the
-# pressure-zero level (coordinator/check/check_fluid.c); also: settled (the late window's spread < 5 % of the
+# pressure-zero level (coordinator/check/check_fluid_still.c); also: settled (the late window's spread < 5 % of the
 # draft) and upright.
 lahar_validation_test(floating_box_2d floating_box_2d dx=0.01 "draft_spread_rel<=0.05" "tilt_deg<=2")
 

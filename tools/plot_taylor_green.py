@@ -4,7 +4,7 @@
   tools/plot_taylor_green.py OUT.png LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 
 RUN_DIR is the output of `lahar check` on cases/taylor_green_2d.yaml (or a variant): its
-check.json holds the measured E/E0 and the exact curve (coordinator/check/check_fluid.c, taylor_green)."""
+check.json holds the measured E/E0 and the exact curve (coordinator/check/check_fluid_internal.c, taylor_green)."""
 import json
 import os
 import sys

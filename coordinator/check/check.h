@@ -127,8 +127,8 @@ typedef struct {
 
 const lahar_check_reference *lahar_check_find(const char *name);
 
-/* The SPH references (coordinator/check/check_fluid.c; what each computes is documented there and in
- * cases/README.md). */
+/* The SPH references (coordinator/check/check_fluid_*.c, one file per family, table in
+ * coordinator/check/README.md; what each computes is documented there and in cases/README.md). */
 int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_sphere_array(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
