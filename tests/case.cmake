@@ -1,4 +1,4 @@
-# Case files, shapes and mass properties (common/io/case*.c, common/geometry/shape_build.c).
+# Case files, shapes and mass properties (common/io/case*.c, common/geometry/shape_*.c).
 add_executable(lahar-case-check ${LAHAR_TEST_DIR}/case_check_main.c)
 target_link_libraries(lahar-case-check PRIVATE lahar_common)
 

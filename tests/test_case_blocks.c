@@ -1,5 +1,5 @@
 /* Particle blocks: the lattice fill of boxes, polygons and closed STL meshes, and the cut-out of
- * bodies (common/geometry/shape_build.c lahar_particle_block_*, common/io/case.c lahar_case_block_lattice),
+ * bodies (common/geometry/particle_block.c lahar_particle_block_*, common/io/case.c lahar_case_block_lattice),
  * against exact counts and analytic areas/volumes:
  *  - an L-shaped (non-convex) polygon whose corners lie on lattice-cell boundaries holds exactly
  *    area / dx^2 points, in either orientation, and the notch stays empty;

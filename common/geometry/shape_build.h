@@ -1,5 +1,6 @@
 /* Building sphero-polyhedra (lahar_shape, scene.h): primitive shapes, convex hulls, polyhedra
- * from vertices + faces, STL import, convexity, and mass properties of the swept solid.
+ * from vertices + faces, STL import, convexity, and mass properties of the swept solid
+ * (shape_build.c, shape_hull.c, shape_stl.c, shape_mass.c; common/geometry/README.md).
  *
  * Conventions:
  * - 3D shapes carry vertices, edges and faces (faces counter-clockwise seen from outside).
@@ -85,7 +86,7 @@ void lahar_shape_to_principal(lahar_shape *s, const lahar_mass_props *mp);
  * V = identity, so symmetric shapes keep the axes the user wrote. Deterministic. */
 void lahar_sym3_eigen(const double a[3][3], double d[3], double V[3][3]);
 
-/* ---- SPH particle regions (lahar_particle_block, scene.h) ------------------------------------
+/* ---- SPH particle regions (lahar_particle_block, scene.h; particle_block.c) -------------------
  * The SPH node fills a block with the lattice points that lie inside it; the loader uses the same
  * functions to check a case (particles inside bodies, empty blocks) before a run. */
 #include <stdint.h>
