@@ -6,7 +6,7 @@
 # (--spread-tol 0.05; measured 1.70, 2.0 % under the spread, the Riemann scheme 1.75, inside), water
 # levels H1-H4 (the case's level gauges) within 0.05 H (mean over t* <= 5.5).
 # Data: docs/references-data/lobovsky_2014_*.csv; comparison: tools/compare_lobovsky.py;
-# measured values: cases/README.md "Lobovsky dam break".
+# measured values: docs/bench/impact_pressure.md "Lobovsky dam break: summary".
 # tests/experiment_check.py runs a case with overrides on one thread and checks it with its tools/compare_*.py --check.
 set(LAHAR_LOBOVSKY_CASE ${CMAKE_SOURCE_DIR}/cases/dam_break_lobovsky_2d.yaml compare_lobovsky.py sph.dx=0.01)
 lahar_test(sph_dam_break_lobovsky_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
@@ -20,7 +20,7 @@ lahar_test(sph_dam_break_lobovsky_2d_riemann COMMAND ${LAHAR_OUTPUT_PYTHON} ${LA
   -- --spread-tol 0.05
   LABELS sph validation slow TIMEOUT 300)
 # SPHERIC Test 2 (Kleefsman et al. 2005; docs/references-data/kleefsman_2005_test2.csv), compared by
-# tools/compare_spheric2.py --check; measured values: cases/README.md "SPHERIC Test 2".
+# tools/compare_spheric2.py --check; measured values: docs/bench/impact_pressure.md "SPHERIC Test 2: summary".
 # The centre plane in 2D (cases/dam_break_obstacle_plane_2d.yaml) at dx 10 mm, 0.45 s (12 s of CPU):
 # the first impact on P1 within 6 % of the experiment's 0.394 s (measured +5.04 %; +4.6 % at the
 # case's dx 5 mm, the 3D case at dx 10 mm +4.86 %), every level gauge within 15 mm (mean |dh|,

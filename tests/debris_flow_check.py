@@ -27,7 +27,7 @@ RUN is the output folder of the run (its case: the header's case_path). Asserts:
   - the inlet's volume: the particles that entered x dx^2 against 5 m x the integral of eq. 36
     (a_G [G(t) - G(t0)], G the Gumbel CDF, up to t and the inlet's end) within one row (5 m x dx)
     + 2 %.
-Also printed (information, cases/README.md "Debris flow"): the front (99 % quantile of the soil's and
+Also printed (information, docs/bench/debris_flow.md): the front (99 % quantile of the soil's and
 the water's x) per snapshot, its largest speed between snapshots and where it ends; the trackers'
 peak speeds; the control volumes' peak E_K (total and the bodies' part) and when, and per passage
 of a body through a control volume its peak E_K, the body's part and which boulder it was.

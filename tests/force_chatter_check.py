@@ -13,7 +13,7 @@ constant rho g h^2 / 2 = 196.2 N/m, so its step-to-step change is noise. Asserts
   - penalty_stiffness: step (Trujillo-Vela et al. 2020 eq. 15 as printed, K_n = 0.1 m / dt^2): std of the change
     >= 2 %: the chatter the acoustic stiffness removes (so this test fails if it ever stops
     showing).
-Measured (cases/README.md "Wall force chatter"): step 9.05 %, acoustic 0.20 %."""
+Measured (docs/bench/wall_force_chatter.md): step 9.05 %, acoustic 0.20 %."""
 import os
 import subprocess
 import sys

@@ -6,8 +6,8 @@
 # particle count; the impulse of every body's force against M g_t T - dP within 5 % (action and
 # reaction of the coupling); the 10 ms peak force within a factor 2 of rho u^2 A of the arriving
 # soil + M g sin(theta); the first impact between the frictionless dam-break front on the slope
-# and a rigid block sliding with mu_phi = tan 26 deg. Measured values: cases/README.md ("Granular
-# impact").
+# and a rigid block sliding with mu_phi = tan 26 deg. Measured values: docs/bench/validation.md ("Granular
+# impact on a wall").
 lahar_test(soil_granular_impact_3d
   COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_impact_3d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_impact_3d dx=0.05 end=1.2 threads=2

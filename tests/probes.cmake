@@ -18,6 +18,6 @@ lahar_test(probes_tank_3d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/probe
 # Wall-force chatter (sph.penalty_stiffness): a tank at rest with penalty walls at a step 8 times
 # below the CFL step; the step-to-step change of the wall force is <= 0.5 % of rho g h^2 / 2 with
 # the acoustic stiffness and >= 2 % with Trujillo-Vela et al. 2020 eq. 15's K_n = 0.1 m / dt^2 (measured 0.20 %
-# and 9.05 %; cases/README.md "Wall force chatter"). ~40 s on 1 thread.
+# and 9.05 %; docs/bench/wall_force_chatter.md). ~40 s on 1 thread.
 lahar_test(sph_wall_force_chatter_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/force_chatter_check.py $<TARGET_FILE:lahar> ${CMAKE_CURRENT_BINARY_DIR}/probes/force_chatter_2d
   LABELS sph probes slow TIMEOUT 300)

@@ -1,7 +1,7 @@
 # Soil phase the Drucker-Prager SPH soil of sph_node/soil/sph_soil.[ch] against
 # closed forms (return mapping, elastic and Jaumann stress rates, equilibrium of a uniform
 # stress), and its cases end to end through `lahar check` at CI resolution (the cases' own bounds;
-# measured values in cases/README.md, "Soil").
+# measured values in docs/bench/validation.md, "Soil").
 lahar_test(soil_sph_unit PROGRAM test_sph_soil SOURCES test_sph_soil.c
   LIBS lahar_sph LABELS fast soil TIMEOUT 120)
 
@@ -12,7 +12,7 @@ lahar_test(soil_geostatic_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<
 # The soil's ghost-layer wall stress (sph.soil_wall_stress: ghost, sph_coupling_set_soil_wall):
 # the row resting on the floor within 5 % of rho g z (the penalty wall alone: +23 % in 2D, +18 %
 # in 3D), every row deeper than H/4 within 7 % in 2D (the row-by-row mode of the start-up, +-3.4 %
-# about the mean in 2D, +-13 % in 3D, cases/README.md), the 2-row bins, K0 and the creep as in
+# about the mean in 2D, +-13 % in 3D, docs/bench/validation.md), the 2-row bins, K0 and the creep as in
 # soil_geostatic_2d.
 lahar_test(soil_geostatic_ghost_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/soil_geostatic_ghost_2d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/geostatic_ghost_2d
@@ -45,7 +45,7 @@ lahar_test(soil_darcy_column_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh
 # Lajeunesse et al. (2005) (docs/soil/column_collapse_scalings.md): the mass run-out L_99 inside
 # the band of the two experiments at a = 1 and a = 2, the deposit at rest (E_k end / peak < 0.01),
 # no particle through the floor or wall, the surface at or below phi. dx = 10 mm (the cases' 5 mm
-# and the 2.5 mm sweep in cases/README.md); about 5 s and 10 s on 1 thread.
+# and the 2.5 mm sweep in docs/bench/validation.md); about 5 s and 10 s on 1 thread.
 lahar_test(soil_granular_column_a1_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/granular_column_a1_2d.yaml
           ${CMAKE_CURRENT_BINARY_DIR}/soil/granular_column_a1_2d dx=0.01
   LABELS validation slow soil TIMEOUT 600 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

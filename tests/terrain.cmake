@@ -41,7 +41,7 @@ endforeach()
 # resolution (dx = 0.76 m, 840 particles, the whole 30 s; 13 s on 2 cores): nothing through the
 # terrain, no particle lost, the deposit's length within 30 % of the field's 140 m (here 172.5 m,
 # +23 %) and its thickness within the field's 1-5 m (`lahar check`, reference landslide). The full
-# case (dx = 0.38 m, 6 min on 2 cores) is run by hand; its numbers are in cases/README.md
+# case (dx = 0.38 m, 6 min on 2 cores) is run by hand; its numbers are in docs/bench/validation.md
 # ("Yangbaodi landslide").
 lahar_test(terrain_yangbaodi_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_check.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/yangbaodi_2d.yaml ${CMAKE_CURRENT_BINARY_DIR}/terrain/yangbaodi_2d dx=0.76 threads=2
   LABELS slow validation terrain TIMEOUT 900 ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")
