@@ -32,7 +32,7 @@ enum {
     LAHAR_EXIT_NODE_LOST = 3,   /* a node went silent for 2 s */
 };
 
-/* Time stepping without accumulated sums (see coordinator/README.md, "Time"). */
+/* Time stepping without accumulated sums (lcm_types/README.md "Time and Δt"). */
 typedef struct {
     double t_end, out_interval;
     int64_t nout;      /* number of output times after t = 0: T_j = j * out_interval, T_nout = t_end */

@@ -57,3 +57,7 @@ lahar_test(tools_no_impact COMMAND sh ${LAHAR_TEST_DIR}/tools_no_impact.sh $<TAR
 # e.g. common/ never includes from the nodes or the coordinator)
 lahar_test(include_deps COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/include_deps.py ${CMAKE_SOURCE_DIR}
   LABELS fast output)
+# Every <file>.md "<section>" reference in code, tests, cases and docs names a section that exists
+# (tests/doc_section_refs.py): a section renamed or moved leaves no reader pointed at nothing
+lahar_test(doc_section_refs COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/doc_section_refs.py ${CMAKE_SOURCE_DIR}
+  LABELS fast output)

@@ -131,7 +131,7 @@ static double bounce(int dim, lahar_contact_model model, double e_req, const cha
 static void bounces(void)
 {
     /* linear e = 0.1 comes out 1.1 % low at dt_safety 0.001 (first-order error of the dashpot
-     * switching on inside a substep, dem_node/README.md "Step size"), so the linear law is held
+     * switching on inside a substep, dem_node/engines/spheropoly/README.md "Step size"), so the linear law is held
      * to 1 % from e = 0.2 */
     static const double el[] = {0.2, 0.5, 0.9}, eh[] = {0.1, 0.5, 0.9};
     for (int i = 0; i < 3; i++) {

@@ -1,4 +1,4 @@
-/* The sphere fast path's Verlet list (dem_node/README.md, "Sphere fast path"):
+/* The sphere fast path's Verlet list (dem_node/engines/spheropoly/README.md "Sphere fast path"):
  * - a hot gas of 2500 spheres in a walled box (speeds ~1 m/s, the list is rebuilt many times):
  *   after every 100 substeps the engine's contact count equals the brute-force count of
  *   overlapping pairs plus spheres touching a wall (a pair missed by a stale list would show);

@@ -89,7 +89,7 @@ static inline double dem_normal_force(const dem_pair_law *law, double delta, dou
  * Hertz duration 2.868266 (m*^2/(R* E*^2 v))^(1/5) (reference 06 sec. 6.1) at impact speed v. */
 double dem_contact_period(const dem_pair_law *law, double mstar, double rstar, double v_impact);
 
-/* The engines' stable step (dem_node/README.md "Step size"): safety x the shortest contact period
+/* The engines' stable step (dem_node/engines/spheropoly/README.md "Step size"): safety x the shortest contact period
  * of every free body against every material it may meet, m* = m/2 against free bodies (when there
  * are two or more), m against the others, R* the larger of the body's sweep radius and the largest
  * one of that material, Hertz at the impact speed v_impact = v_max + sqrt(2 |g| L) + 1 m/s

@@ -1,4 +1,4 @@
-/* The sphere fast path of the spheropoly engine (dem_node/README.md, "Sphere fast path").
+/* The sphere fast path of the spheropoly engine (dem_node/engines/spheropoly/README.md "Sphere fast path").
  *
  * A free body with one vertex at its centre and no edge or face is a sphere (a disc in 2D). Pairs
  * of such spheres, and a sphere against a fixed flat wall (one face, 3D), skip the feature
