@@ -7,7 +7,7 @@
 # lahar's own private network namespace or in-process.
 #
 #   checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
-#   TEST: water | dem | coupled_killed | soil | sigterm | sigusr1 | errors | inflow
+#   TEST: water | dem | coupled_killed | soil | sigterm | group_signals | sigusr1 | errors | inflow
 set -u
 test_name=$1 bin=$2 tools=$3 cases=$4 work=$5
 python=/usr/bin/python3
@@ -185,6 +185,43 @@ sigterm)
     echo "stopped at t = $(summary term "d['sim_time']") s: $(summary term "d['message']")"
     nice -n 10 "$lahar" resume term --threads 1 -q || fail "resume"
     same_output full term particles.h5 bodies.h5 forces.h5 contacts.h5
+    ;;
+group_signals)
+    # A terminal (Ctrl-C, SIGHUP when it closes), a batch system (Slurm signals every process of
+    # the job) or `kill -- -PGID` signal the nodes with lahar. SIGTERM and SIGHUP to lahar's whole
+    # process group: a checkpoint and a clean stop as for SIGTERM to lahar alone (exit 1, status
+    # "stopped", both nodes exit 0, not killed by the signal: the run ended "node lost" with exit 3,
+    # or died of SIGHUP leaving summary.json "running"); resume finishes it bitwise.
+    override "$cases/debris_2d.yaml" cpl.yaml sph.dx=0.01 time.end=0.4 time.output_interval=0.05 \
+        'checkpoint={interval: 1.0}'
+    nice -n 10 "$lahar" run cpl.yaml -o full --threads 1 -q || fail "full run"
+    for sig in TERM HUP; do
+        out=group_$sig
+        setsid nice -n 10 "$lahar" run cpl.yaml -o $out --threads 1 -q 2> $out.err &
+        pid=$!
+        for i in $(seq 1 500); do [ -f $out/particles.h5 ] && break; sleep 0.01; done
+        sleep 0.5
+        read -r _ _ _ _ pgid _ < /proc/$pid/stat
+        [ "$pgid" = "$pid" ] || fail "setsid did not make lahar ($pid) a process group leader ($pgid)"
+        kill -$sig -- -"$pid"
+        wait "$pid"
+        rc=$?
+        [ "$rc" = 1 ] || fail "SIG$sig to the process group: exit $rc, expected 1: $(cat $out.err)"
+        [ "$(summary $out "d['status']")" = stopped ] || fail "SIG$sig to the process group: status $(summary $out "d['status'], d['message']")"
+        summary $out "d['message']" | grep -q "stopped by SIG$sig after the checkpoint" ||
+            fail "SIG$sig: message $(summary $out "d['message']")"
+        nodes=$(summary $out "sorted((k, v['exit_status']) for k, v in d['nodes'].items())")
+        [ "$nodes" = "[('dem', 0), ('sph', 0)]" ] || fail "SIG$sig to the process group: nodes' exit statuses $nodes"
+        echo "SIG$sig to the process group: $(summary $out "d['message']")"
+        nice -n 10 "$lahar" resume $out --threads 1 -q || fail "resume after SIG$sig"
+        same_output full $out particles.h5 bodies.h5 forces.h5 contacts.h5
+    done
+    # the log lahar writes to goes away (`lahar run ... | tee log`, tee ended with the terminal):
+    # the run goes on to its end (it died of SIGPIPE at its next progress line)
+    { nice -n 10 "$lahar" run cpl.yaml -o piped --threads 1 --progress-every 0.05 2>&1; echo $? > piped.rc; } | head -n 1
+    [ "$(cat piped.rc)" = 0 ] || fail "the run whose log reader ended: exit $(cat piped.rc)"
+    [ "$(summary piped "d['status']")" = finished ] || fail "the run whose log reader ended: status $(summary piped "d['status']")"
+    same_output full piped particles.h5 bodies.h5 forces.h5 contacts.h5
     ;;
 sigusr1)
     # SIGUSR1: a checkpoint after the next step, in a case whose interval would write none

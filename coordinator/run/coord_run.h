@@ -114,8 +114,9 @@ typedef struct {
  * with. */
 #define COORD_GO_ON (-1)
 
-/* Ctrl-C or SIGTERM came; SIGTERM with checkpoints (a checkpoint, then a clean stop); SIGUSR1 (a
- * checkpoint after the next step). Set by run.c's signal handlers. */
+/* The signal that ended the run (SIGINT, SIGTERM, SIGHUP; 0: none); SIGTERM or SIGHUP with
+ * checkpoints (a checkpoint, then a clean stop); SIGUSR1 (a checkpoint after the next step). Set by
+ * run.c's signal handlers. */
 extern volatile sig_atomic_t coord_interrupted;
 extern volatile sig_atomic_t coord_term;
 extern volatile sig_atomic_t coord_ckpt_request;

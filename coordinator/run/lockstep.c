@@ -6,6 +6,12 @@
 #include "coord_run.h"
 #include "lahar_step_t.h"
 
+/* The signal a run stopped on, for its message (coord_interrupted, coord_term). */
+static const char *coord_signal_name(int sig)
+{
+    return sig == SIGHUP ? "SIGHUP" : sig == SIGTERM ? "SIGTERM" : "SIGINT";
+}
+
 /* A duration for a person: seconds up to 2 min, minutes up to 2 h, then hours. */
 static const char *coord_duration(double s, char *buf, size_t n)
 {
@@ -109,7 +115,8 @@ static int coord_lockstep(coord *co)
     for (int64_t k = k0;; k++) {
         if (coord_interrupted && !(coord_term && co->ckpt_on)) {
             co->status = "interrupted";
-            snprintf(co->message, sizeof co->message, "interrupted at step %lld (t = %.9g s)", (long long)k, co->sim_time);
+            snprintf(co->message, sizeof co->message, "interrupted by %s at step %lld (t = %.9g s)",
+                     coord_signal_name(coord_interrupted), (long long)k, co->sim_time);
             return LAHAR_EXIT_RUN_ERROR;
         }
         if (k == 0)
@@ -170,8 +177,9 @@ static int coord_lockstep(coord *co)
         if (stop_after && clk.j < clk.nout) { /* (at the end time the run simply finishes) */
             co->status = "stopped";
             co->clean_stop = 1;
-            snprintf(co->message, sizeof co->message, "stopped by SIGTERM after the checkpoint of step %lld (t = %.9g "
-                     "s); continue with `lahar resume %.800s`", (long long)(k + 1), co->sim_time, co->outdir);
+            snprintf(co->message, sizeof co->message, "stopped by %s after the checkpoint of step %lld (t = %.9g "
+                     "s); continue with `lahar resume %.800s`", coord_signal_name(coord_term), (long long)(k + 1),
+                     co->sim_time, co->outdir);
             return LAHAR_EXIT_RUN_ERROR;
         }
         coord_progress(co, 0);

@@ -142,11 +142,16 @@ static int coord_start_node(coord *co, coord_node *n)
         return -1;
     }
     if (pid == 0) {
-        /* never outlive the coordinator; Ctrl-C is the coordinator's to handle */
+        /* never outlive the coordinator. Ctrl-C, SIGTERM and SIGHUP are the coordinator's to
+         * handle (a checkpoint, then STOP): a terminal, a batch system (Slurm signals every
+         * process of the job) or `kill -- -PGID` sends them to the nodes too, which would
+         * otherwise die at once and turn the clean stop into a lost node */
         prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (getppid() != parent)
             _exit(3);
         signal(SIGINT, SIG_IGN);
+        signal(SIGTERM, SIG_IGN);
+        signal(SIGHUP, SIG_IGN);
         execv(exe, argv);
         fprintf(stderr, "lahar: exec %s: %s\n", exe, strerror(errno));
         _exit(127);

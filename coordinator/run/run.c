@@ -21,9 +21,8 @@ volatile sig_atomic_t coord_ckpt_request;
 
 static void coord_on_sigterm(int sig)
 {
-    (void)sig;
-    coord_term = 1;
-    coord_interrupted = 1;
+    coord_term = sig;
+    coord_interrupted = sig;
 }
 
 static void coord_on_sigusr1(int sig)
@@ -34,8 +33,7 @@ static void coord_on_sigusr1(int sig)
 
 static void coord_on_sigint(int sig)
 {
-    (void)sig;
-    coord_interrupted = 1;
+    coord_interrupted = sig;
 }
 
 static int64_t coord_random_run_id(void)
@@ -156,19 +154,24 @@ static void coord_choose_progress(coord *co)
     co->last_progress = co->wall0;
 }
 
-/* Ctrl-C ends the run (the nodes are stopped, summary.json written); SIGTERM too, or with
- * checkpoints a checkpoint first and a clean, resumable stop; SIGUSR1 asks for a checkpoint. */
+/* Ctrl-C ends the run (the nodes are stopped, summary.json written); SIGTERM and SIGHUP (the
+ * terminal or the ssh session closed) too, or with checkpoints a checkpoint first and a clean,
+ * resumable stop; SIGUSR1 asks for a checkpoint. A log reader that went away (`| tee` closed
+ * with the terminal) must not end a run of hours: SIGPIPE is ignored, writes to it just fail. */
 static void coord_catch_signals(const coord *co)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = coord_on_sigint;
     sigaction(SIGINT, &sa, NULL);
-    if (co->ckpt_on) /* SIGTERM: a checkpoint, then a clean stop (resumable) */
+    if (co->ckpt_on) /* SIGTERM, SIGHUP: a checkpoint, then a clean stop (resumable) */
         sa.sa_handler = coord_on_sigterm;
     sigaction(SIGTERM, &sa, NULL);
+    sigaction(SIGHUP, &sa, NULL);
     sa.sa_handler = coord_on_sigusr1;
     sigaction(SIGUSR1, &sa, NULL);
+    sa.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &sa, NULL);
 }
 
 /* The transport and the coordinator's link on it (with the run's key). LAHAR_EXIT_OK, or
