@@ -7,7 +7,7 @@
 # lahar's own private network namespace or in-process.
 #
 #   checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
-#   TEST: water | dem | coupled_killed | soil | sigterm | group_signals | sigusr1 | errors | inflow
+#   TEST: water | dem | coupled_killed | soil | sigterm | group_signals | disk_full | sigusr1 | errors | inflow
 set -u
 test_name=$1 bin=$2 tools=$3 cases=$4 work=$5
 python=/usr/bin/python3
@@ -222,6 +222,40 @@ group_signals)
     [ "$(cat piped.rc)" = 0 ] || fail "the run whose log reader ended: exit $(cat piped.rc)"
     [ "$(summary piped "d['status']")" = finished ] || fail "the run whose log reader ended: status $(summary piped "d['status']")"
     same_output full piped particles.h5 bodies.h5 forces.h5 contacts.h5
+    ;;
+disk_full)
+    # The disk fills up (another job's file) between two checkpoints of a particle-only case (no
+    # force stream: the checkpoint is the next thing written): the SPH node says which checkpoint
+    # file, "no space left on device" and the bytes free (it said only "cannot write 'x' (N
+    # values) into the checkpoint"); exit 1, status "error"; the previous checkpoint is complete,
+    # and once the space is freed `lahar resume` ends bitwise as the run on a roomy disk. OUT is a
+    # 8 MB tmpfs in a private user + mount namespace.
+    override "$cases/taylor_green_2d.yaml" tg.yaml sph.dx=0.02 time.end=1.0 time.output_interval=1.0 \
+        'checkpoint={interval: 0.1, keep: 1}'
+    nice -n 10 "$lahar" run tg.yaml -o full --threads 1 -q || fail "full run"
+    mkdir -p mnt
+    unshare --user --map-root-user --mount bash -c "
+        mount -t tmpfs -o size=8m tmpfs mnt || exit 9
+        nice -n 10 '$lahar' run tg.yaml -o mnt/out --threads 1 -q 2> full.stderr & pid=\$!
+        until compgen -G 'mnt/out/checkpoints/[0-9]*[0-9]/coord.h5' > /dev/null; do
+            kill -0 \$pid 2>/dev/null || break
+            sleep 0.01
+        done
+        free=\$(df -k --output=avail mnt | tail -n 1)
+        dd if=/dev/zero of=mnt/filler bs=1k count=\$((free - 200)) 2> /dev/null
+        wait \$pid; echo \$? > full_rc.txt
+        rm mnt/filler
+        nice -n 10 '$lahar' resume mnt/out --threads 1 -q 2> resume.stderr; echo \$? > resume_rc.txt
+        cp -r mnt/out out"
+    [ -s full_rc.txt ] || fail "the tmpfs could not be mounted in a private mount namespace"
+    cat full.stderr
+    [ "$(cat full_rc.txt)" = 1 ] || fail "the run on the full disk: exit $(cat full_rc.txt), expected 1"
+    msg=$(summary out "d.get('resumed_from') and 'resumed' or ''")
+    grep -q "checkpoints/[0-9]*\.tmp/sph\.h5: no space left on device ([0-9]* bytes free): the checkpoint's" full.stderr ||
+        fail "the message does not name the checkpoint file and say the disk is full"
+    [ "$(cat resume_rc.txt)" = 0 ] || fail "resume after freeing the space: exit $(cat resume_rc.txt): $(cat resume.stderr)"
+    [ "$msg" = resumed ] || fail "summary.json of the resumed run has no resumed_from"
+    same_output full out particles.h5
     ;;
 sigusr1)
     # SIGUSR1: a checkpoint after the next step, in a case whose interval would write none

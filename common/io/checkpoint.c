@@ -38,6 +38,7 @@ int lahar_ckpt_create(lahar_ckpt_file *f, const char *path, const char *role)
 {
     memset(f, 0, sizeof *f);
     f->writing = 1;
+    snprintf(f->path, sizeof f->path, "%s", path);
     f->file = lahar_h5_file_open(path, H5F_ACC_TRUNC, H5P_DEFAULT, 1);
     if (f->file < 0) {
         ckpt_fail(f, "%s: cannot create the checkpoint file", path);
@@ -117,6 +118,22 @@ static void ckpt_array(lahar_ckpt_file *f, const char *name, hid_t mt, hid_t ft,
         return;
     hid_t file = (hid_t)f->file;
     if (f->writing) {
+        /* room first, as every output writer (output.h, LAHAR_OUTPUT_RESERVE): HDF5 that runs
+         * out of space says only that a write failed */
+        double need = 1.5 * (double)(n > 0 ? n : 0) * (double)H5Tget_size(ft) + LAHAR_OUTPUT_RESERVE;
+        char dir[sizeof f->path];
+        snprintf(dir, sizeof dir, "%s", f->path);
+        char *slash = strrchr(dir, '/');
+        if (slash)
+            *slash = '\0';
+        double avail = lahar_output_free_bytes(slash ? dir : ".");
+        if (avail >= 0.0 && avail < need) {
+            ckpt_fail(f, "%s: no space left on device (%.0f bytes free): the checkpoint's '%s' (%" PRId64 " values) "
+                      "needs about %.0f bytes; this checkpoint is not written (the previous one is kept); free space "
+                      "there and `lahar resume` the run",
+                      f->path, avail, name, n, need);
+            return;
+        }
         hsize_t d = (hsize_t)(n > 0 ? n : 0);
         hid_t sp = H5Screate_simple(1, &d, NULL);
         hid_t ds = H5Dcreate2(file, name, ft, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);

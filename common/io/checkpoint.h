@@ -19,7 +19,8 @@ typedef struct {
     int64_t file;   /* hid_t */
     int writing;    /* 1: store, 0: load */
     int failed;     /* a call failed; the first message is in err */
-    char err[512];
+    char err[1024];
+    char path[1024]; /* the file (writing: its directory's room is checked before each array) */
 } lahar_ckpt_file;
 
 /* Create path (writing) or open it (reading, format and version checked). 0, or -1 with f->err. */

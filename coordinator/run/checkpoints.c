@@ -150,7 +150,7 @@ int coord_checkpoint(coord *co, int64_t k, lahar_clock *clk, double dt_allowed, 
     if (lahar_ckpt_create(&f, path, "coordinator") == 0)
         coord_state_io(co, &f, &kk, clk, &dt_allowed, &dt_first, &is_output);
     if (lahar_ckpt_close(&f) != 0) {
-        snprintf(co->message, sizeof co->message, "%s", f.err);
+        snprintf(co->message, sizeof co->message, "%.1000s", f.err);
         return -1;
     }
     if (access(fin, F_OK) == 0) /* a checkpoint of this step from before a resume: replaced */
