@@ -191,10 +191,28 @@ group_signals)
     # the job) or `kill -- -PGID` signal the nodes with lahar. SIGTERM and SIGHUP to lahar's whole
     # process group: a checkpoint and a clean stop as for SIGTERM to lahar alone (exit 1, status
     # "stopped", both nodes exit 0, not killed by the signal: the run ended "node lost" with exit 3,
-    # or died of SIGHUP leaving summary.json "running"); resume finishes it bitwise.
+    # or died of SIGHUP leaving summary.json "running"); resume finishes it bitwise. Ctrl-C
+    # (SIGINT to the group) after the first checkpoint: status "interrupted", the nodes write their
+    # final snapshot, and resume goes on from that checkpoint, cutting the snapshot back.
     override "$cases/debris_2d.yaml" cpl.yaml sph.dx=0.01 time.end=0.4 time.output_interval=0.05 \
         'checkpoint={interval: 1.0}'
+    override "$cases/debris_2d.yaml" cpl_int.yaml sph.dx=0.01 time.end=0.4 time.output_interval=0.05 \
+        'checkpoint={interval: 0.1}'
     nice -n 10 "$lahar" run cpl.yaml -o full --threads 1 -q || fail "full run"
+    setsid nice -n 10 "$lahar" run cpl_int.yaml -o group_INT --threads 1 -q 2> group_INT.err &
+    pid=$!
+    wait_checkpoint group_INT "$pid" || fail "no checkpoint appeared"
+    sleep 0.3
+    kill -INT -- -"$pid"
+    wait "$pid"
+    rc=$?
+    [ "$rc" = 1 ] || fail "SIGINT to the process group: exit $rc, expected 1: $(cat group_INT.err)"
+    [ "$(summary group_INT "d['status']")" = interrupted ] || fail "SIGINT: status $(summary group_INT "d['status'], d['message']")"
+    nodes=$(summary group_INT "sorted((k, v['exit_status']) for k, v in d['nodes'].items())")
+    [ "$nodes" = "[('dem', 0), ('sph', 0)]" ] || fail "SIGINT to the process group: nodes' exit statuses $nodes"
+    echo "SIGINT to the process group: $(summary group_INT "d['message']"); checkpoints: $(ls group_INT/checkpoints | tr '\n' ' ')"
+    nice -n 10 "$lahar" resume group_INT --threads 1 -q || fail "resume after SIGINT"
+    same_output full group_INT particles.h5 bodies.h5 forces.h5 contacts.h5
     for sig in TERM HUP; do
         out=group_$sig
         setsid nice -n 10 "$lahar" run cpl.yaml -o $out --threads 1 -q 2> $out.err &
