@@ -27,6 +27,10 @@ lahar_test(output_swmr COMMAND test_output_swmr ${LAHAR_OUTPUT_TEST_DIR}/swmr LA
 lahar_test(output_swmr_h5py COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_output_swmr_h5py.py $<TARGET_FILE:test_output_swmr> ${LAHAR_OUTPUT_TEST_DIR}/swmr_h5py
   LABELS fast output TIMEOUT 60)
 
+lahar_output_test(test_output_memory)
+lahar_test(output_memory COMMAND test_output_memory ${LAHAR_OUTPUT_TEST_DIR}/memory LABELS fast output TIMEOUT 120
+  PROPERTIES SKIP_RETURN_CODE 77)
+
 lahar_output_test(test_check lahar_coord)
 lahar_test(output_check COMMAND test_check ${LAHAR_OUTPUT_TEST_DIR}/check LABELS fast output TIMEOUT 120
   ENVIRONMENT "LAHAR_PYTHON=${LAHAR_OUTPUT_PYTHON}")

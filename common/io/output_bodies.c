@@ -343,6 +343,7 @@ static int forces_open(forces_stream *fs, const char *path, const lahar_case *c,
     /* SWMR needs the latest file format; datasets must all exist before SWMR writing starts. */
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    out_stream_cache(fapl, (double)fs->cap * (fs->nbody > 0 ? fs->nbody : 1) * 3.0 * sizeof(double));
     snprintf(fs->path, sizeof fs->path, "%s", path);
     if (c->resume) {
         int rc = forces_reopen(fs, fapl, err, n);

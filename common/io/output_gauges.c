@@ -292,6 +292,7 @@ lahar_gauge_output *lahar_gauge_output_open(const char *outdir, const lahar_case
     snprintf(o->path, sizeof o->path, "%s/gauges.h5", outdir);
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+    out_stream_cache(fapl, GAUGE_BUFFER_ROWS * sizeof(double));
     if (c->resume) { /* continue the stream as lahar_output_resume_trim left it */
         int rc = gauge_output_reopen(o, c, fapl);
         H5Pclose(fapl);

@@ -38,6 +38,7 @@ int out_append_rows(hid_t id, hid_t mtype, int rank, hsize_t start, hsize_t rows
 hid_t out_snapshot_open(const char *path, double need, const char *what, int64_t nsnap, int64_t step, double t,
                         hid_t *file);
 double out_wall_seconds(void);
+void out_stream_cache(hid_t fapl, double chunk_bytes);
 
 /* output_resume.c: one snapshot group of a file as found on disk */
 typedef struct {
