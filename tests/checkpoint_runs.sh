@@ -234,6 +234,16 @@ group_signals)
         nice -n 10 "$lahar" resume $out --threads 1 -q || fail "resume after SIG$sig"
         same_output full $out particles.h5 bodies.h5 forces.h5 contacts.h5
     done
+    # started with nohup (SIGHUP ignored): the terminal's SIGHUP leaves the run going to its end
+    setsid nohup nice -n 10 "$lahar" run cpl.yaml -o nohup --threads 1 -q > /dev/null 2> nohup.err &
+    pid=$!
+    for i in $(seq 1 500); do [ -f nohup/particles.h5 ] && break; sleep 0.01; done
+    sleep 0.5
+    kill -HUP -- -"$pid"
+    wait "$pid"
+    rc=$?
+    [ "$rc" = 0 ] || fail "nohup lahar run: exit $rc after SIGHUP, expected 0 (the run goes on): $(cat nohup.err)"
+    same_output full nohup particles.h5 bodies.h5 forces.h5 contacts.h5
     # the log lahar writes to goes away (`lahar run ... | tee log`, tee ended with the terminal):
     # the run goes on to its end (it died of SIGPIPE at its next progress line)
     { nice -n 10 "$lahar" run cpl.yaml -o piped --threads 1 --progress-every 0.05 2>&1; echo $? > piped.rc; } | head -n 1

@@ -155,9 +155,10 @@ static void coord_choose_progress(coord *co)
 }
 
 /* Ctrl-C ends the run (the nodes are stopped, summary.json written); SIGTERM and SIGHUP (the
- * terminal or the ssh session closed) too, or with checkpoints a checkpoint first and a clean,
- * resumable stop; SIGUSR1 asks for a checkpoint. A log reader that went away (`| tee` closed
- * with the terminal) must not end a run of hours: SIGPIPE is ignored, writes to it just fail. */
+ * terminal or the ssh session closed; unless started with SIGHUP ignored, as by nohup) too, or
+ * with checkpoints a checkpoint first and a clean, resumable stop; SIGUSR1 asks for a checkpoint.
+ * A log reader that went away (`| tee` closed with the terminal) must not end a run of hours:
+ * SIGPIPE is ignored, writes to it just fail. */
 static void coord_catch_signals(const coord *co)
 {
     struct sigaction sa;
@@ -167,7 +168,10 @@ static void coord_catch_signals(const coord *co)
     if (co->ckpt_on) /* SIGTERM, SIGHUP: a checkpoint, then a clean stop (resumable) */
         sa.sa_handler = coord_on_sigterm;
     sigaction(SIGTERM, &sa, NULL);
-    sigaction(SIGHUP, &sa, NULL);
+    struct sigaction hup;
+    sigaction(SIGHUP, NULL, &hup);
+    if (hup.sa_handler != SIG_IGN) /* `nohup lahar run ...`: the user wants the run to outlive the terminal */
+        sigaction(SIGHUP, &sa, NULL);
     sa.sa_handler = coord_on_sigusr1;
     sigaction(SIGUSR1, &sa, NULL);
     sa.sa_handler = SIG_IGN;
