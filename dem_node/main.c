@@ -6,9 +6,11 @@
 #include "dem_engine.h"
 #include "output.h"
 #include "dem_node.h"
+#include "link.h"
 
 int main(int argc, char **argv)
 {
+    lahar_link_watch_parent(); /* lahar that started this node dies: close the files, exit */
     char about[1024];
     snprintf(about, sizeof about,
              "The DEM node of lahar: joins a run announced by the coordinator (`lahar run`), builds the\n"

@@ -4,9 +4,11 @@
 #include <unistd.h>
 #include "output.h"
 #include "sph_node.h"
+#include "link.h"
 
 int main(int argc, char **argv)
 {
+    lahar_link_watch_parent(); /* lahar that started this node dies: close the files, exit */
     lahar_sph_node_options o;
     int rc = lahar_node_parse_args(argc, argv, "lahar-sph",
                                    "The SPH node of lahar: joins a run announced by the coordinator (`lahar run`), "

@@ -1,6 +1,6 @@
 # Coordinated checkpoints and `lahar resume` (coordinator/README.md "Checkpoints and resume"): an
 # interrupted or early-ended run, resumed, ends with output bitwise equal to the uninterrupted
-# run's (water, DEM only, coupled with the DEM node and then the resumed run's SPH node killed by SIGKILL, soil, SIGTERM; SIGTERM and SIGHUP to lahar's whole process group, a log pipe that closed; a disk that fills up before a checkpoint), SIGUSR1 writes a
+# run's (water, DEM only, coupled with the DEM node and then the resumed run's SPH node killed by SIGKILL, soil, SIGTERM; SIGTERM and SIGHUP to lahar's whole process group, a log pipe that closed; a disk that fills up before a checkpoint; lahar itself killed), SIGUSR1 writes a
 # checkpoint, and the errors a user can meet exit 2 with a message. Runs use lahar's own private
 # network namespace (label netns) or --in-process.
 # checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
@@ -15,6 +15,7 @@ lahar_checkpoint_test(soil "slow;checkpoint")
 lahar_checkpoint_test(sigterm "slow;netns;checkpoint")
 lahar_checkpoint_test(group_signals "slow;netns;checkpoint")
 lahar_checkpoint_test(disk_full "slow;netns;checkpoint")
+lahar_checkpoint_test(coordinator_killed "slow;netns;checkpoint")
 lahar_checkpoint_test(sigusr1 "slow;netns;checkpoint")
 lahar_checkpoint_test(errors "slow;netns;checkpoint")
 lahar_checkpoint_test(inflow "fast;netns;checkpoint")

@@ -7,7 +7,8 @@
 # lahar's own private network namespace or in-process.
 #
 #   checkpoint_runs.sh TEST BIN_DIR TOOLS_DIR CASES_DIR WORK_DIR
-#   TEST: water | dem | coupled_killed | soil | sigterm | group_signals | disk_full | sigusr1 | errors | inflow
+#   TEST: water | dem | coupled_killed | soil | sigterm | group_signals | disk_full | coordinator_killed |
+#         sigusr1 | errors | inflow
 set -u
 test_name=$1 bin=$2 tools=$3 cases=$4 work=$5
 python=/usr/bin/python3
@@ -284,6 +285,44 @@ disk_full)
     [ "$(cat resume_rc.txt)" = 0 ] || fail "resume after freeing the space: exit $(cat resume_rc.txt): $(cat resume.stderr)"
     [ "$msg" = resumed ] || fail "summary.json of the resumed run has no resumed_from"
     same_output full out particles.h5
+    ;;
+coordinator_killed)
+    # lahar itself killed with SIGKILL (or crashed, or taken by the OOM killer) mid-run: the nodes
+    # it started close their files and exit within a second (they were killed with it and left
+    # forces.h5 and gauges.h5 flagged open for writing: h5py and h5dump refused both until
+    # `h5clear -s`); every HDF5 file reads; resume goes on from the newest checkpoint, bitwise.
+    override "$cases/debris_2d.yaml" cpl.yaml sph.dx=0.01 time.end=0.6 time.output_interval=0.05 \
+        'checkpoint={interval: 0.1}' 'probes=[{name: p1, position: [1.1, 0.02], rate: 1000}]'
+    nice -n 10 "$lahar" run cpl.yaml -o full --threads 1 -q || fail "full run"
+    nice -n 10 "$lahar" run cpl.yaml -o killed --threads 1 -q 2> killed.err &
+    pid=$!
+    wait_checkpoint killed "$pid" || fail "no checkpoint appeared"
+    sleep 0.3
+    nodes="$(child_pid "$pid" lahar-dem) $(child_pid "$pid" lahar-sph)"
+    [ "$(echo $nodes | wc -w)" = 2 ] || fail "the nodes of $pid: '$nodes'"
+    kill -KILL "$pid"
+    wait "$pid"
+    # gone, or a zombie that the process that inherited it has not reaped yet
+    alive() { local st; read -r _ _ st _ < /proc/$1/stat 2>/dev/null && [ "$st" != Z ]; }
+    for i in $(seq 1 300); do
+        left=""
+        for n in $nodes; do alive "$n" && left="$left $n"; done
+        [ -z "$left" ] && break
+        sleep 0.01
+    done
+    [ -z "$left" ] || fail "node processes$left still running 3 s after lahar was killed"
+    cat killed.err
+    "$python" - killed <<'PY' || fail "the files of the run whose lahar was killed"
+import sys, h5py
+for name in ("particles", "bodies", "forces", "contacts", "gauges"):
+    with h5py.File("%s/%s.h5" % (sys.argv[1], name), "r") as f:  # opens, and every dataset reads
+        f.visititems(lambda n, o: o[()] if isinstance(o, h5py.Dataset) else None)
+with h5py.File(sys.argv[1] + "/forces.h5", "r") as f, h5py.File(sys.argv[1] + "/gauges.h5", "r") as g:
+    print("lahar killed: forces.h5 to t = %.4f s, gauges.h5 to t = %.4f s, both read" % (f["t"][-1], g["probes/p1/t"][-1]))
+PY
+    grep -q "lahar-dem: lahar, which started this node, has ended" killed.err || fail "the DEM node did not say why it stopped"
+    nice -n 10 "$lahar" resume killed --threads 1 -q || fail "resume"
+    same_output full killed particles.h5 bodies.h5 forces.h5 contacts.h5 gauges.h5
     ;;
 sigusr1)
     # SIGUSR1: a checkpoint after the next step, in a case whose interval would write none

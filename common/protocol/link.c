@@ -3,11 +3,13 @@
  * only when a larger message than ever before shows up. */
 #include "link.h"
 #include <pthread.h>
+#include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #include "auth.h"
 #include "msg_check.h"
 #include "lahar_heartbeat_t.h"
@@ -527,8 +529,28 @@ int lahar_link_take(lahar_link *l, int sender, int type, int64_t step, lahar_lin
     return link_find(l, sender, type, step, out);
 }
 
+static volatile sig_atomic_t link_parent_died;
+static void link_on_parent_death(int sig)
+{
+    (void)sig;
+    link_parent_died = 1;
+    alarm(LAHAR_LINK_PARENT_GRACE_S);
+}
+void lahar_link_watch_parent(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = link_on_parent_death;
+    sigaction(SIGUSR2, &sa, NULL);
+}
+int lahar_link_parent_gone(void) { return link_parent_died; }
+
 static int link_check_lost(lahar_link *l, double now)
 {
+    if (link_parent_died && l->role != LAHAR_ROLE_COORDINATOR) {
+        l->lost_role = LAHAR_ROLE_COORDINATOR;
+        return 1;
+    }
     for (int r = 0; r < LAHAR_NROLES; r++)
         if (l->watch_silence[r] > 0.0 && now - l->last_heard[r] > l->watch_silence[r]) {
             l->lost_role = r;

@@ -83,6 +83,14 @@ void lahar_link_unwatch(lahar_link *l, int role);
  * (the coordinator: a node it started whose CPU time is advancing). */
 void lahar_link_heard_now(lahar_link *l, int role);
 int lahar_link_lost_role(const lahar_link *l);
+/* A node process lahar started gets SIGUSR2 when lahar dies (PR_SET_PDEATHSIG), if it called
+ * this first: from then on every wait of its links finds the coordinator lost at once, so the
+ * node closes its files (forces.h5 and gauges.h5 then read without h5clear) and exits; SIGALRM
+ * ends it LAHAR_LINK_PARENT_GRACE_S later if it does not get there (a long step). */
+#define LAHAR_LINK_PARENT_GRACE_S 10
+void lahar_link_watch_parent(void);
+/* 1 once that signal came. */
+int lahar_link_parent_gone(void);
 /* When the last frame of a peer was heard (lahar_now() clock; 0 never). */
 double lahar_link_last_heard(const lahar_link *l, int role);
 /* Longest time between two frames heard from a peer so far (heartbeats included), in s. */

@@ -106,8 +106,12 @@ int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_
     if (rc == LAHAR_LINK_STOP)
         return 0;
     if (rc == LAHAR_LINK_LOST) {
-        fprintf(stderr, "%s: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n", prog,
-                LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
+        if (lahar_link_parent_gone())
+            fprintf(stderr, "%s: lahar, which started this node, has ended (waiting for step %lld); closing the "
+                    "output files and exiting\n", prog, (long long)k);
+        else
+            fprintf(stderr, "%s: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n", prog,
+                    LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
         return 3;
     }
     if (rc != LAHAR_LINK_OK || LAHAR_MSG_DECODE(lahar_step_t, msg->data, msg->size, step) < 0)

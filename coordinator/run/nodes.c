@@ -142,11 +142,13 @@ static int coord_start_node(coord *co, coord_node *n)
         return -1;
     }
     if (pid == 0) {
-        /* never outlive the coordinator. Ctrl-C, SIGTERM and SIGHUP are the coordinator's to
-         * handle (a checkpoint, then STOP): a terminal, a batch system (Slurm signals every
-         * process of the job) or `kill -- -PGID` sends them to the nodes too, which would
-         * otherwise die at once and turn the clean stop into a lost node */
-        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        /* never outlive the coordinator: when it dies the node gets SIGUSR2, closes its files
+         * (the SWMR streams stay readable) and exits (lahar_link_watch_parent). Ctrl-C, SIGTERM
+         * and SIGHUP are the coordinator's to handle (a checkpoint, then STOP): a terminal, a
+         * batch system (Slurm signals every process of the job) or `kill -- -PGID` sends them
+         * to the nodes too, which would otherwise die at once and turn the clean stop into a
+         * lost node */
+        prctl(PR_SET_PDEATHSIG, SIGUSR2);
         if (getppid() != parent)
             _exit(3);
         signal(SIGINT, SIG_IGN);
