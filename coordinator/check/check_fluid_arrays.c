@@ -6,6 +6,35 @@
 #include <stdio.h>
 #include "check_fluid.h"
 
+/* K at solid fraction x, interpolated in ln K between the tabulated (c_i, K_i), x within the table. */
+static double table_ln_interp(const double *tc, const double *tK, int n, double x)
+{
+    int i = 0;
+    while (i + 2 < n && x > tc[i + 1])
+        i++;
+    double s = (x - tc[i]) / (tc[i + 1] - tc[i]);
+    return exp((1.0 - s) * log(tK[i]) + s * log(tK[i + 1]));
+}
+
+/* The obstacle of an array case: the first body that is one vertex (a disc or a sphere) and not
+ * free; -1 if none. */
+static int array_obstacle(const lahar_case *c)
+{
+    for (int j = 0; j < c->nbody; j++)
+        if (c->bodies[j].shape.nv == 1 && c->bodies[j].motion != LAHAR_MOTION_FREE)
+            return j;
+    return -1;
+}
+
+/* The sum over the particles of a snapshot of their velocity along eg. */
+static double velocity_sum_along(const lahar_check_particles *p, vec3 eg)
+{
+    double s = 0.0;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        s += v3_dot(fluid_vel(p, i), eg);
+    return s;
+}
+
 /* ---------------------------------------------------------------- cylinder array -------- */
 
 /* Sangani & Acrivos (1982) Table 1, square array . */
@@ -19,11 +48,7 @@ double lahar_check_sangani_acrivos_K(double c)
         return NAN;
     if (c < sa_c[0]) /* low-c asymptote (Hasimoto 1959, Sangani & Acrivos 1982) */
         return 4.0 * M_PI / (-0.5 * log(c) - 0.738 + c - 0.887 * c * c + 2.038 * c * c * c);
-    int i = 0;
-    while (i + 2 < SA_N && c > sa_c[i + 1])
-        i++;
-    double s = (c - sa_c[i]) / (sa_c[i + 1] - sa_c[i]);
-    return exp((1.0 - s) * log(sa_K[i]) + s * log(sa_K[i + 1]));
+    return table_ln_interp(sa_c, sa_K, SA_N, c);
 }
 
 /* Periodic square cell with one fixed disc (Trujillo-Vela et al. 2020 section 5.2), flow driven by the
@@ -37,10 +62,7 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
     lahar_check_particles *p = d->particles;
     vec3 gv = fluid_accel(c);
     double g = v3_norm(gv), rho = c->sph_density, mu = c->sph.mu;
-    int disc = -1;
-    for (int j = 0; j < c->nbody && disc < 0; j++)
-        if (c->bodies[j].shape.nv == 1 && c->bodies[j].motion != LAHAR_MOTION_FREE)
-            disc = j;
+    const int disc = array_obstacle(c);
     if (c->dim != 2 || disc < 0 || !c->sph.periodic[0] || !c->sph.periodic[1] || !(g > 0.0) || !(mu > 0.0)) {
         snprintf(r->err, sizeof r->err,
                  "cylinder_array: needs a 2D case periodic in x and y with one fixed disc, a driving acceleration "
@@ -66,9 +88,7 @@ int lahar_check_cylinder_array(const lahar_case *c, const lahar_check_data *d, l
     for (int64_t k = 0; k < p->nsnap; k++) {
         if (fluid_read(d, k, r))
             return -1;
-        double s = 0.0;
-        for (int64_t i = 0; i < p->cur_n; i++)
-            s += v3_dot(fluid_vel(p, i), eg);
+        const double s = velocity_sum_along(p, eg);
         Us_prev = Us;
         Us = (1.0 - conc) * s / (double)(p->cur_n ? p->cur_n : 1);
         lahar_check_point(r, p->t[k], Us);
@@ -127,11 +147,7 @@ double lahar_check_zick_homsy_K(double c)
         return NAN;
     if (c < zh_c[0]) /* dilute series: Hasimoto 1959, Sangani & Acrivos 1982 (K = 2.0087 at 0.027) */
         return 1.0 / (1.0 - 1.7601 * cbrt(c) + c - 1.5593 * c * c);
-    int i = 0;
-    while (i + 2 < ZH_N && c > zh_c[i + 1])
-        i++;
-    double s = (c - zh_c[i]) / (zh_c[i + 1] - zh_c[i]);
-    return exp((1.0 - s) * log(zh_K[i]) + s * log(zh_K[i + 1]));
+    return table_ln_interp(zh_c, zh_K, ZH_N, c);
 }
 
 /* Periodic cubic cell with one fixed sphere, flow driven by the acceleration g = |gravity +
@@ -145,10 +161,7 @@ int lahar_check_sphere_array(const lahar_case *c, const lahar_check_data *d, lah
     lahar_check_particles *p = d->particles;
     vec3 gv = fluid_accel(c);
     double g = v3_norm(gv), rho = c->sph_density, mu = c->sph.mu;
-    int sph = -1;
-    for (int j = 0; j < c->nbody && sph < 0; j++)
-        if (c->bodies[j].shape.nv == 1 && c->bodies[j].motion != LAHAR_MOTION_FREE)
-            sph = j;
+    const int sph = array_obstacle(c);
     if (c->dim != 3 || sph < 0 || !c->sph.periodic[0] || !c->sph.periodic[1] || !c->sph.periodic[2] || !(g > 0.0) ||
         !(mu > 0.0)) {
         snprintf(r->err, sizeof r->err,
@@ -178,9 +191,7 @@ int lahar_check_sphere_array(const lahar_case *c, const lahar_check_data *d, lah
     for (int64_t k = 0; k < p->nsnap; k++) {
         if (fluid_read(d, k, r))
             return -1;
-        double s = 0.0;
-        for (int64_t i = 0; i < p->cur_n; i++)
-            s += v3_dot(fluid_vel(p, i), eg);
+        const double s = velocity_sum_along(p, eg);
         Us = (1.0 - conc) * s / (double)(p->cur_n ? p->cur_n : 1);
         if (p->t[k] <= 0.75 * t_end + 1e-9 * t_end) {
             Us_q = Us;
