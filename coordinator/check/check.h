@@ -127,6 +127,10 @@ typedef struct {
 
 const lahar_check_reference *lahar_check_find(const char *name);
 
+/* The DEM references (coordinator/check/check_dem.c). */
+int lahar_check_restitution(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+int lahar_check_incline_roll(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
+
 /* The SPH references (coordinator/check/check_fluid_*.c, one file per family, table in
  * coordinator/check/README.md; what each computes is documented there and in cases/README.md). */
 int lahar_check_poiseuille(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
