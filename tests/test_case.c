@@ -373,28 +373,33 @@ static void test_stl(const char *tmpdir)
 {
     char path[1024], err[512] = "";
     lahar_shape s;
-    /* ASCII tetrahedron, outward facets */
-    snprintf(path, sizeof path, "%s/tetra.stl", tmpdir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) {
-        CHECK(0, "cannot write %s", path);
-        return;
-    }
+    /* ASCII tetrahedron, outward facets; again after a UTF-8 byte-order mark and a blank line, which
+     * some exporters write before "solid" (an ASCII file all the same) */
     static const double tv[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     static const int tf[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-    fprintf(fp, "solid tetra\n");
-    for (int f = 0; f < 4; f++) {
-        fprintf(fp, " facet normal 0 0 0\n  outer loop\n");
-        for (int c = 0; c < 3; c++)
-            fprintf(fp, "   vertex %g %g %g\n", tv[tf[f][c]][0], tv[tf[f][c]][1], tv[tf[f][c]][2]);
-        fprintf(fp, "  endloop\n endfacet\n");
+    static const char *const lead[2] = {"", "\xef\xbb\xbf\n"};
+    FILE *fp = NULL;
+    for (int variant = 0; variant < 2; variant++) {
+        snprintf(path, sizeof path, "%s/tetra%d.stl", tmpdir, variant);
+        fp = fopen(path, "w");
+        if (!fp) {
+            CHECK(0, "cannot write %s", path);
+            return;
+        }
+        fprintf(fp, "%ssolid tetra\n", lead[variant]);
+        for (int f = 0; f < 4; f++) {
+            fprintf(fp, " facet normal 0 0 0\n  outer loop\n");
+            for (int c = 0; c < 3; c++)
+                fprintf(fp, "   vertex %g %g %g\n", tv[tf[f][c]][0], tv[tf[f][c]][1], tv[tf[f][c]][2]);
+            fprintf(fp, "  endloop\n endfacet\n");
+        }
+        fprintf(fp, "endsolid tetra\n");
+        fclose(fp);
+        CHECK(lahar_shape_read_stl(&s, path, 0.01, err, sizeof err) == 0, "ascii stl (variant %d): %s", variant, err);
+        CHECK(s.nv == 4 && s.nf == 4 && s.ne == 6, "tetra: nv %d nf %d ne %d", s.nv, s.nf, s.ne);
+        CHECK(rel(lahar_shape_core_volume(&s), 1.0 / 6.0) < 1e-12, "tetra volume %.15g", lahar_shape_core_volume(&s));
+        lahar_shape_free(&s);
     }
-    fprintf(fp, "endsolid tetra\n");
-    fclose(fp);
-    CHECK(lahar_shape_read_stl(&s, path, 0.01, err, sizeof err) == 0, "ascii stl: %s", err);
-    CHECK(s.nv == 4 && s.nf == 4 && s.ne == 6, "tetra: nv %d nf %d ne %d", s.nv, s.nf, s.ne);
-    CHECK(rel(lahar_shape_core_volume(&s), 1.0 / 6.0) < 1e-12, "tetra volume %.15g", lahar_shape_core_volume(&s));
-    lahar_shape_free(&s);
     /* binary unit cube, 12 triangles: the 36 corners merge into 8 vertices */
     snprintf(path, sizeof path, "%s/cube.stl", tmpdir);
     fp = fopen(path, "wb");

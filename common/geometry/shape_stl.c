@@ -119,7 +119,10 @@ static int stl_read_corners(const char *path, stl_vert **out, int *ncorner, char
         n++;
     }
     fclose(fp);
-    if (!ascii && got == sizeof hdr) {
+    /* a file that does not start with "solid" is still read as ASCII when it holds whole facets and
+     * "endsolid" (a byte-order mark or a blank line before "solid"); only one that gives nothing as
+     * ASCII either is told about the binary header it failed */
+    if (!ascii && got == sizeof hdr && n == 0) {
         uint32_t ntri = (uint32_t)hdr[80] | (uint32_t)hdr[81] << 8 | (uint32_t)hdr[82] << 16 | (uint32_t)hdr[83] << 24;
         lahar_errf(err, errlen, "STL file '%s' is not ASCII STL (it does not start with 'solid'), and as binary STL "
                    "its header's %u triangles need %.0f bytes but the file has %ld: it is cut short or not STL; "
