@@ -220,6 +220,7 @@ group_signals)
         pid=$!
         for i in $(seq 1 500); do [ -f $out/particles.h5 ] && break; sleep 0.01; done
         sleep 0.5
+        kill -0 "$pid" 2>/dev/null || fail "the run ended before SIG$sig was sent: nothing tested"
         read -r _ _ _ _ pgid _ < /proc/$pid/stat
         [ "$pgid" = "$pid" ] || fail "setsid did not make lahar ($pid) a process group leader ($pgid)"
         kill -$sig -- -"$pid"
@@ -240,11 +241,31 @@ group_signals)
     pid=$!
     for i in $(seq 1 500); do [ -f nohup/particles.h5 ] && break; sleep 0.01; done
     sleep 0.5
+    kill -0 "$pid" 2>/dev/null || fail "the nohup run ended before its SIGHUP was sent: nothing tested"
     kill -HUP -- -"$pid"
     wait "$pid"
     rc=$?
     [ "$rc" = 0 ] || fail "nohup lahar run: exit $rc after SIGHUP, expected 0 (the run goes on): $(cat nohup.err)"
     same_output full nohup particles.h5 bodies.h5 forces.h5 contacts.h5
+    # SIGUSR1 and SIGUSR2 to the whole group (a batch system's --signal=USR1 before its time
+    # limit, or by hand): lahar writes a checkpoint on USR1 and goes on; the nodes neither die of
+    # USR1 (its default action) nor take USR2 for the signal that lahar has died (they ended the
+    # run "node lost" before)
+    setsid nice -n 10 "$lahar" run cpl.yaml -o group_USR --threads 1 -q 2> group_USR.err &
+    pid=$!
+    for i in $(seq 1 500); do [ -f group_USR/particles.h5 ] && break; sleep 0.01; done
+    sleep 0.5
+    kill -0 "$pid" 2>/dev/null || fail "the run ended before SIGUSR1 was sent: nothing tested"
+    kill -USR1 -- -"$pid"
+    sleep 0.3
+    kill -USR2 -- -"$pid"
+    wait "$pid"
+    rc=$?
+    [ "$rc" = 0 ] || fail "SIGUSR1, SIGUSR2 to the process group: exit $rc, expected 0: $(cat group_USR.err)"
+    written=$(summary group_USR "d['checkpoints']['written']")
+    [ "$written" -ge 2 ] || fail "SIGUSR1 to the process group: $written checkpoints written, expected the end's and one more"
+    echo "SIGUSR1, SIGUSR2 to the process group: finished, $written checkpoints"
+    same_output full group_USR particles.h5 bodies.h5 forces.h5 contacts.h5
     # the log lahar writes to goes away (`lahar run ... | tee log`, tee ended with the terminal):
     # the run goes on to its end (it died of SIGPIPE at its next progress line)
     { nice -n 10 "$lahar" run cpl.yaml -o piped --threads 1 --progress-every 0.05 2>&1; echo $? > piped.rc; } | head -n 1

@@ -530,14 +530,20 @@ int lahar_link_take(lahar_link *l, int sender, int type, int64_t step, lahar_lin
 }
 
 static volatile sig_atomic_t link_parent_died;
+static pid_t link_parent_pid; /* the parent when the watch began */
 static void link_on_parent_death(int sig)
 {
     (void)sig;
+    /* the kernel sends the death signal after the node is given a new parent; a SIGUSR2 while
+     * the parent lives (sent to the whole process group by hand or by a batch system) is not it */
+    if (getppid() == link_parent_pid)
+        return;
     link_parent_died = 1;
     alarm(LAHAR_LINK_PARENT_GRACE_S);
 }
 void lahar_link_watch_parent(void)
 {
+    link_parent_pid = getppid();
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = link_on_parent_death;

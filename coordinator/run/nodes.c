@@ -154,6 +154,7 @@ static int coord_start_node(coord *co, coord_node *n)
         signal(SIGINT, SIG_IGN);
         signal(SIGTERM, SIG_IGN);
         signal(SIGHUP, SIG_IGN);
+        signal(SIGUSR1, SIG_IGN); /* lahar's checkpoint request; a node's default would be to die */
         execv(exe, argv);
         fprintf(stderr, "lahar: exec %s: %s\n", exe, strerror(errno));
         _exit(127);

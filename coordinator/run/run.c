@@ -176,6 +176,10 @@ static void coord_catch_signals(const coord *co)
     sigaction(SIGUSR1, &sa, NULL);
     sa.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &sa, NULL);
+    /* SIGUSR2 means nothing to lahar; sent to the whole process group (by hand, a batch system)
+     * it would end the run by its default action (the nodes take it only as lahar's death,
+     * lahar_link_watch_parent, and only when their parent is gone) */
+    sigaction(SIGUSR2, &sa, NULL);
 }
 
 /* The transport and the coordinator's link on it (with the run's key). LAHAR_EXIT_OK, or
