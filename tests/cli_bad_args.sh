@@ -86,9 +86,9 @@ expect 2 "auth key $work/no.key: No such file or directory \(make one with \`lah
     run "$good" -o "$work/auth" --auth-key "$work/no.key"
 expect 2 "auth key $good/run.key: Not a directory \(check the path and its permissions\)" -- run "$good" -o "$work/auth" --auth-key "$good/run.key"
 # lahar resume given the case instead of the run's output directory, or a directory that is not there
-expect 2 "lahar resume: .*dem_bounce_3d.yaml is not a directory; resume takes the output directory of a run \(lahar resume OUT\), not its case" -- \
+expect 2 "lahar resume: .*dem_bounce_3d.yaml: not a directory; resume takes the output directory of a run \(lahar resume OUT\), not its case" -- \
     resume "$good"
-expect 2 "lahar resume: $work/no_such_run does not exist; resume takes the output directory of a run" -- resume "$work/no_such_run"
+expect 2 "lahar resume: $work/no_such_run: No such file or directory; resume takes the output directory of a run" -- resume "$work/no_such_run"
 # lahar keys takes a section as a case writes it (bodies, materials, sph.blocks) or as the table does
 # (bodies[]); an unknown one is an error on stderr
 for section in bodies materials sph.blocks 'bodies[]'; do

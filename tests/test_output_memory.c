@@ -1,8 +1,8 @@
 /* The append-only streams (forces.h5, gauges.h5) do not grow the writer's memory over a long run.
  * HDF5's default chunk cache keeps up to 1 MiB of chunks per dataset, so every dataset of a
  * stream grew its node by up to 1 MiB although nothing is read back (gauges.h5 of 30 probes
- * written every step: +30 MB in 40,000 steps of debris_2d, docs/bench/liveness.md). Here: 6
- * the force stream of 2 bodies and 6 trackers (9 datasets each) are written for 40,960 rows after
+ * written every step: +30 MB in 40,000 steps of debris_2d, docs/bench/liveness.md). Here the
+ * force stream of 2 bodies and 6 trackers (9 datasets each) are written for 40,960 rows after
  * 4,096 rows of warm-up; the resident set may grow by at most 1.5 MB in each phase (with the default
  * cache it grew by about 3 MB for the forces and 18 MB for the trackers).
  * Skipped (77) under AddressSanitizer.
@@ -94,6 +94,10 @@ int main(int argc, char **argv)
             fprintf(stderr, "FAIL forces.h5: row %lld failed\n", (long long)i);
             return 1;
         }
+    }
+    if (before < 0 || rss_kb() < 0) {
+        fprintf(stderr, "FAIL cannot read VmRSS from /proc/self/status: nothing measured\n");
+        return 1;
     }
     long grown = rss_kb() - before;
     lahar_body_output_close(o);

@@ -95,8 +95,13 @@ def averaged_force(run, barrier, window, grid):
 
 
 def relative(diff, ref):
-    """diff / ref; a barrier no run loads (both 0) differs by 0, one loaded only by run b by inf."""
-    return diff / ref if ref > 0 else (0.0 if diff == 0 else float("inf"))
+    """diff / ref; a barrier no run loads (both 0) differs by 0; one loaded only by run b has no
+    relative difference (None: null in the JSON, "n/a" printed)."""
+    return diff / ref if ref > 0 else (0.0 if diff == 0 else None)
+
+
+def percent(x, digits):
+    return "n/a" if x is None else "%.*f %%" % (digits, 100 * x)
 
 
 def compare(a, b, barrier, window):
@@ -141,11 +146,11 @@ def print_result(r, la, lb):
               f"{v['at_s']:.3f} s (at the end {v['final_position_diff_m']*1e3:.3f} mm)")
     c = r["barrier"]
     print(f"  {c['name']}: peak |F| ({c['window_s']*1e3:g} ms average) {c['peak_a_N']:.2f} N at {c['peak_at_a_s']:.3f} s "
-          f"vs {c['peak_b_N']:.2f} N at {c['peak_at_b_s']:.3f} s ({100*c['peak_rel_diff']:.1f} %)")
+          f"vs {c['peak_b_N']:.2f} N at {c['peak_at_b_s']:.3f} s ({percent(c['peak_rel_diff'], 1)})")
     print(f"  {c['name']}: impulse |J| over 0-{c['t_end_s']:.3f} s {c['impulse_a_Ns']:.4f} vs {c['impulse_b_Ns']:.4f} N s "
-          f"(|J_a - J_b| / |J_a| = {100*c['impulse_rel_diff']:.2f} %)")
+          f"(|J_a - J_b| / |J_a| = {percent(c['impulse_rel_diff'], 2)})")
     print(f"  {c['name']}: largest difference of the averaged force histories {c['history_max_diff_N']:.2f} N "
-          f"({100*c['history_max_diff_rel_peak']:.1f} % of the peak)")
+          f"({percent(c['history_max_diff_rel_peak'], 1)} of the peak)")
 
 
 def plot(runs, labels, grid, forces, barrier, window, path):

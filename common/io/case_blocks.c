@@ -402,7 +402,7 @@ int case_init_file_read(const char *path, int64_t n, double *out[4], int found[4
             snprintf(err, errlen, "%s: dataset '%s' has %lld values, the block has %lld particles (one value per "
                      "particle, in lattice order)", path, init_sets[k], (long long)m, (long long)n);
             rc = -1;
-        } else if (!buf && !(buf = own = realloc(own, (size_t)(n > 0 ? n : 1) * sizeof *own))) {
+        } else if (!buf && !(buf = own ? own : (own = malloc((size_t)(n > 0 ? n : 1) * sizeof *own)))) {
             snprintf(err, errlen, "%s: out of memory for %lld values", path, (long long)n);
             rc = -1;
         } else if (H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {

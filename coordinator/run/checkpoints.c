@@ -222,10 +222,11 @@ int lahar_coord_resume_case(const char *outdir, lahar_case *c)
     struct stat st;
     const int missing = stat(outdir, &st) != 0;
     if (missing || !S_ISDIR(st.st_mode)) { /* a case file, or a mistyped OUT */
+        const int e = errno;
         const size_t len = strlen(outdir);
         const int yaml = len > 5 && strcmp(outdir + len - 5, ".yaml") == 0;
-        fprintf(stderr, "lahar resume: %s %s; resume takes the output directory of a run (lahar resume OUT)%s\n",
-                outdir, missing ? "does not exist" : "is not a directory",
+        fprintf(stderr, "lahar resume: %s: %s; resume takes the output directory of a run (lahar resume OUT)%s\n",
+                outdir, missing ? strerror(e) : "not a directory",
                 yaml ? ", not its case: to start the case, lahar run CASE.yaml -o OUT" : "");
         return LAHAR_EXIT_SETUP;
     }

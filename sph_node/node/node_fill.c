@@ -85,7 +85,8 @@ int sph_node_add_blocks(sph_particles *p, const lahar_case *c, char *err, size_t
          * expressions): the pressure replaces the block's density by its inverse EOS */
         const lahar_particle_block *pb = &c->blocks[b];
         if (n < 0)
-            snprintf(err, errlen, "out of memory for the lattice of block '%s'", pb->name);
+            snprintf(err, errlen, "cannot build the lattice of block '%s' (too many points, or out of memory)",
+                     pb->name);
         if (n > 0 && !rc) {
             int has_p = 0;
             if (lahar_case_block_initial(pb, (const double(*)[3])pts, n, vel, rho, &has_p, err, errlen) != 0)

@@ -452,7 +452,7 @@ static int sph_node_setup(sph_node *s, char *err, size_t errlen)
     s->fluid_ready = 1;
     err[0] = '\0';
     if (total < 0) {
-        snprintf(err, errlen, "out of memory counting the particles");
+        snprintf(err, errlen, "cannot count the particles (a lattice with too many points, or out of memory)");
         return -1;
     }
     if (sph_node_add_blocks(&s->f.p, c, err, errlen) != 0)
