@@ -2,7 +2,7 @@
 # The impact tools on runs that end before the impact (a short first look at a case, the way a user
 # tries a tool): plot_impact.py writes its table with first impact "none" (it raised a TypeError on
 # first_impact_s = null), compare_spheric2.py exits 2 saying the water has not hit the box (it
-# raised a ValueError on an empty array).
+# raised a ValueError on an empty array), compare_lobovsky.py --check fails on the impact time.
 # usage: tools_no_impact.sh LAHAR SRC_DIR OUT_DIR PYTHON
 set -u
 lahar=$1 src=$2 out=$3 py=$4
@@ -24,4 +24,17 @@ rc=$?
 cat "$out/sp.err"
 [ $rc -eq 2 ] || fail "compare_spheric2.py: exit $rc on a run without impact, expected 2"
 grep -q "P1 never reaches" "$out/sp.err" || fail "compare_spheric2.py: no message saying why"
+
+# compare_lobovsky.py --check on a run that ends before the water reaches the wall: exit 1 with
+# the impact time among the failures and sensor 2 "no value" against the spread (NaN passed the
+# impact-time test and read "outside by +0.0 %")
+"$py" "$src/tools/case_override.py" "$src/cases/dam_break_lobovsky_2d.yaml" "$out/lb.yaml" sph.dx=0.02 \
+  time.end=0.2 time.output_interval=0.1 || fail "case_override dam_break_lobovsky_2d"
+"$lahar" run "$out/lb.yaml" -o "$out/lb" --in-process -q --overwrite --threads 1 || fail "lahar run dam_break_lobovsky_2d"
+"$py" "$src/tools/compare_lobovsky.py" "$out/lb" --no-plot --check --spread-tol 0.05 > "$out/lb.txt" 2>&1
+rc=$?
+cat "$out/lb.txt"
+[ $rc -eq 1 ] || fail "compare_lobovsky.py --check: exit $rc on a run without impact, expected 1"
+grep -q "^FAIL: rise," "$out/lb.txt" || fail "compare_lobovsky.py: the impact time is not among the failures"
+grep -q "10 ms mean 1.73-1.98 (1.86): no value" "$out/lb.txt" || fail "compare_lobovsky.py: sensor 2 not 'no value' against the spread"
 echo "tools_no_impact: ok"
