@@ -433,6 +433,44 @@ static void out_xdmf_bodies_info(const lahar_body_output *o, lahar_xdmf_bodies *
     x->fixed_cells = o->nfixed_cell;
 }
 
+/* bodies.h5 and bodies.xmf of a resumed run: continued as the checkpoint left them
+ * (lahar_output_resume_trim). 0, or -1 with the message in err. */
+static int bodies_file_continue(lahar_body_output *o, const char *outdir, char *err, size_t n)
+{
+    char path[OUT_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
+    lahar_xdmf_bodies xb;
+    out_xdmf_bodies_info(o, &xb);
+    return out_resume_sidecar(o->h5path, path, &o->xmf, &xb, NULL, &o->nsnap, err, n) != 0 ? -1 : 0;
+}
+
+/* bodies.h5 of a new run (header, geometry, an empty snapshots group) and its bodies.xmf. 0, or -1
+ * with the message in err. */
+static int bodies_file_create(lahar_body_output *o, const lahar_case *c, const char *outdir, char *err, size_t n)
+{
+    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
+    if (f < 0) {
+        snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
+        return -1;
+    }
+    int rc = out_write_header(f, c);
+    rc |= out_write_geometry(f, o, c);
+    hid_t sg = out_group(f, "snapshots");
+    if (sg < 0)
+        rc = -1;
+    else
+        H5Gclose(sg);
+    if (H5Fclose(f) < 0)
+        rc = -1;
+    if (rc) {
+        snprintf(err, n, "%s: writing header/geometry failed", o->h5path);
+        return -1;
+    }
+    char path[OUT_PATH_MAX + 16];
+    snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
+    return lahar_xdmf_open(&o->xmf, path, err, n) ? -1 : 0;
+}
+
 lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *c, char *err, size_t n)
 {
     lahar_body_output *o = calloc(1, sizeof *o);
@@ -479,48 +517,11 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     char stale[OUT_PATH_MAX + 16];
     snprintf(stale, sizeof stale, "%s/lahar.xmf", outdir); /* a previous run's, rebuilt at close */
     unlink(stale);
-    if (c->resume) { /* continue bodies.h5 as the checkpoint left it (lahar_output_resume_trim) */
-        char path[OUT_PATH_MAX + 16];
-        snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
-        lahar_xdmf_bodies xb;
-        out_xdmf_bodies_info(o, &xb);
-        if (out_resume_sidecar(o->h5path, path, &o->xmf, &xb, NULL, &o->nsnap, err, n) != 0) {
-            lahar_body_output_close(o);
-            return NULL;
-        }
-        snprintf(path, sizeof path, "%s/forces.h5", outdir);
-        if (c->output_forces && c->nbody > 0 && forces_open(&o->fs, path, c, err, n)) {
-            lahar_body_output_close(o);
-            return NULL;
-        }
-        return o;
-    }
-    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
-    if (f < 0) {
-        snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
-        lahar_body_output_close(o);
-        return NULL;
-    }
-    int rc = out_write_header(f, c);
-    rc |= out_write_geometry(f, o, c);
-    hid_t sg = out_group(f, "snapshots");
-    if (sg < 0)
-        rc = -1;
-    else
-        H5Gclose(sg);
-    if (H5Fclose(f) < 0)
-        rc = -1;
-    if (rc) {
-        snprintf(err, n, "%s: writing header/geometry failed", o->h5path);
+    if ((c->resume ? bodies_file_continue(o, outdir, err, n) : bodies_file_create(o, c, outdir, err, n)) != 0) {
         lahar_body_output_close(o);
         return NULL;
     }
     char path[OUT_PATH_MAX + 16];
-    snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
-    if (lahar_xdmf_open(&o->xmf, path, err, n)) {
-        lahar_body_output_close(o);
-        return NULL;
-    }
     snprintf(path, sizeof path, "%s/forces.h5", outdir);
     if (c->output_forces && c->nbody > 0 && forces_open(&o->fs, path, c, err, n)) {
         lahar_body_output_close(o);
