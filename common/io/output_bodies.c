@@ -455,11 +455,7 @@ static int bodies_file_create(lahar_body_output *o, const lahar_case *c, const c
     }
     int rc = out_write_header(f, c);
     rc |= out_write_geometry(f, o, c);
-    hid_t sg = out_group(f, "snapshots");
-    if (sg < 0)
-        rc = -1;
-    else
-        H5Gclose(sg);
+    rc |= out_snapshots_group(f);
     if (H5Fclose(f) < 0)
         rc = -1;
     if (rc) {

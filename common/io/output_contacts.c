@@ -100,11 +100,7 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
         free(gn);
         H5Gclose(h);
     }
-    hid_t sg = out_group(f, "snapshots");
-    if (sg < 0)
-        rc = -1;
-    else
-        H5Gclose(sg);
+    rc |= out_snapshots_group(f);
     if (H5Fclose(f) < 0 || rc) {
         snprintf(err, n, "%s: writing the header failed", o->h5path);
         lahar_contact_output_close(o);

@@ -137,6 +137,16 @@ hid_t out_group(hid_t loc, const char *name)
     return g;
 }
 
+/* The empty "snapshots" group of a new snapshot file (bodies.h5, particles.h5, contacts.h5). 0 or -1. */
+int out_snapshots_group(hid_t f)
+{
+    hid_t g = out_group(f, "snapshots");
+    if (g < 0)
+        return -1;
+    H5Gclose(g);
+    return 0;
+}
+
 /* Files that are closed between snapshots are opened without HDF5's file lock so that a viewer
  * holding the file open (ParaView) never makes the next snapshot fail. */
 static hid_t out_fapl_unlocked(void)

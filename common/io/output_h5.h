@@ -24,6 +24,7 @@ int out_close(hid_t f);
 /* output_h5.c: HDF5 objects without time stamps, files without locks */
 hid_t out_dcpl(void);
 hid_t out_group(hid_t loc, const char *name);
+int out_snapshots_group(hid_t f);
 hid_t out_file_open(const char *path, unsigned flags, int create);
 hid_t out_str_type(void);
 int out_attr(hid_t loc, const char *name, hid_t type, int n, const void *data);

@@ -62,11 +62,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
         rc |= out_attr_double(h, "rest_density", c->sph_density);
         H5Gclose(h);
     }
-    hid_t sg = out_group(f, "snapshots");
-    if (sg < 0)
-        rc = -1;
-    else
-        H5Gclose(sg);
+    rc |= out_snapshots_group(f);
     if (H5Fclose(f) < 0 || rc) {
         snprintf(err, n, "%s: writing the header failed", o->h5path);
         lahar_particle_output_close(o);
