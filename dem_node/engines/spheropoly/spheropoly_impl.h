@@ -1,5 +1,6 @@
-/* Internal data of the "spheropoly" engine, shared by spheropoly.c (general sphero-polyhedra path)
- * and spheropoly_spheres.c (the sphere fast path). Not part of the engine contract (dem_engine.h). */
+/* Internal data of the "spheropoly" engine, shared by the files of its general sphero-polyhedra
+ * path (spheropoly*.c, README.md "Files") and spheropoly_spheres.c (the sphere fast path). Not
+ * part of the engine contract (dem_engine.h). */
 #ifndef LAHAR_SPHEROPOLY_IMPL_H
 #define LAHAR_SPHEROPOLY_IMPL_H
 #include "dem_contact.h"
@@ -123,6 +124,15 @@ struct lahar_dem_engine {
     int *move_ids, nmove, nmove_free; /* with sph: the bodies kick/drift move besides the fast
                                          spheres, the free ones first (nmove_free), then prescribed */
 };
+
+/* ---- general path: what one of its files calls in another ----------------------------------- */
+/* spheropoly.c: grow *p (elements of `size` bytes) to hold `need`, doubling *cap; 0 or -1. */
+int spp_grow(void **p, int *cap, int need, size_t size);
+/* spheropoly_narrow.c: the contact history's hash over e->prev (after each evaluation and a
+ * restart; 0 or -1: no memory), and the contacts of broad-phase pair (a, b), a < b, with their
+ * forces into the thread buffer t (h: time since the last evaluation). */
+int spp_history_rebuild(lahar_dem_engine *e);
+void spp_pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread *t);
 
 /* ---- sphere fast path (spheropoly_spheres.c) ------------------------------------------------ */
 /* Set up after the bodies are built (NULL sph when there is no free sphere). 0 or -1 with err. */
