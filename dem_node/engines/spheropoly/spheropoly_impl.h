@@ -133,6 +133,8 @@ int spp_grow(void **p, int *cap, int need, size_t size);
  * forces into the thread buffer t (h: time since the last evaluation). */
 int spp_history_rebuild(lahar_dem_engine *e);
 void spp_pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread *t);
+/* spheropoly_broad.c: the candidate pairs of the general path into e->pairs; 0 or -1: no memory. */
+int spp_broad_phase(lahar_dem_engine *e);
 
 /* ---- sphere fast path (spheropoly_spheres.c) ------------------------------------------------ */
 /* Set up after the bodies are built (NULL sph when there is no free sphere). 0 or -1 with err. */
