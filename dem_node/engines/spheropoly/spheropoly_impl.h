@@ -128,6 +128,13 @@ struct lahar_dem_engine {
 /* ---- general path: what one of its files calls in another ----------------------------------- */
 /* spheropoly.c: grow *p (elements of `size` bytes) to hold `need`, doubling *cap; 0 or -1. */
 int spp_grow(void **p, int *cap, int need, size_t size);
+/* spheropoly.c: world vertices, face polygons and normals, and the box of a non-free body i. */
+void spp_body_update_world(lahar_dem_engine *e, int i);
+/* spheropoly.c: contacts and contact forces at the current positions (h: time since the last
+ * evaluation), and the check that the free bodies' states are finite and not runaway; 0, or -1
+ * with err (and e->fault). */
+int spp_compute_forces(lahar_dem_engine *e, double h, char *err, size_t errlen);
+int spp_check_finite(lahar_dem_engine *e, char *err, size_t errlen);
 /* spheropoly_narrow.c: the contact history's hash over e->prev (after each evaluation and a
  * restart; 0 or -1: no memory), and the contacts of broad-phase pair (a, b), a < b, with their
  * forces into the thread buffer t (h: time since the last evaluation). */
@@ -135,6 +142,9 @@ int spp_history_rebuild(lahar_dem_engine *e);
 void spp_pair_contacts(lahar_dem_engine *e, int a, int b, double h, sp_thread *t);
 /* spheropoly_broad.c: the candidate pairs of the general path into e->pairs; 0 or -1: no memory. */
 int spp_broad_phase(lahar_dem_engine *e);
+/* spheropoly_create.c: the engine's create and destroy (lahar_dem_engine_ops). */
+lahar_dem_engine *spp_create(const lahar_case *c, char *err, size_t errlen);
+void spp_destroy(lahar_dem_engine *e);
 
 /* ---- sphere fast path (spheropoly_spheres.c) ------------------------------------------------ */
 /* Set up after the bodies are built (NULL sph when there is no free sphere). 0 or -1 with err. */

@@ -1060,7 +1060,7 @@ void sps_accumulate_walls(lahar_dem_engine *e)
 /* Contact force and torque of sphere k as the kick takes them. */
 static inline void sphere_fc(const lahar_dem_engine *e, const sp_spheres *s, int k, vec3 *f, vec3 *t)
 {
-    if (s->deferred) { /* what sps_accumulate (and compute_forces' 2D projection) would have written */
+    if (s->deferred) { /* what sps_accumulate (and spp_compute_forces' 2D projection) would have written */
         *f = s->sf[k];
         *t = s->st[k];
         if (e->dim == 2) {
