@@ -1,6 +1,6 @@
 /* Internal data of the "spheropoly" engine, shared by the files of its general sphero-polyhedra
- * path (spheropoly*.c, README.md "Files") and spheropoly_spheres.c (the sphere fast path). Not
- * part of the engine contract (dem_engine.h). */
+ * path (spheropoly*.c, the table of files in README.md) and of the sphere fast path
+ * (spheropoly_spheres*.c). Not part of the engine contract (dem_engine.h). */
 #ifndef LAHAR_SPHEROPOLY_IMPL_H
 #define LAHAR_SPHEROPOLY_IMPL_H
 #include "dem_contact.h"
@@ -9,7 +9,7 @@
 #include "geometry.h"
 #include "vec.h"
 
-typedef struct sp_spheres sp_spheres; /* the sphere fast path (spheropoly_spheres.c) */
+typedef struct sp_spheres sp_spheres; /* the sphere fast path (spheropoly_spheres_impl.h) */
 /* Contact types: which features of body a (lower index) and b meet. */
 enum { SP_VF = 0, SP_FV, SP_EE, SP_VE, SP_EV, SP_VV };
 
@@ -146,7 +146,7 @@ int spp_broad_phase(lahar_dem_engine *e);
 lahar_dem_engine *spp_create(const lahar_case *c, char *err, size_t errlen);
 void spp_destroy(lahar_dem_engine *e);
 
-/* ---- sphere fast path (spheropoly_spheres.c) ------------------------------------------------ */
+/* ---- sphere fast path (spheropoly_spheres*.c) ----------------------------------------------- */
 /* Set up after the bodies are built (NULL sph when there is no free sphere). 0 or -1 with err. */
 int sps_create(lahar_dem_engine *e, char *err, size_t errlen);
 void sps_destroy(lahar_dem_engine *e);
