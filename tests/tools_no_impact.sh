@@ -10,7 +10,7 @@ fail() { echo "tools_no_impact: $*" >&2; exit 1; }
 mkdir -p "$out"
 "$py" "$src/tools/case_override.py" "$src/cases/granular_impact_3d.yaml" "$out/gi.yaml" sph.dx=0.05 time.end=0.02 \
   time.output_interval=0.01 || fail "case_override granular_impact_3d"
-"$lahar" check "$out/gi.yaml" -o "$out/gi" --in-process -q --overwrite --threads 1
+(cd "$out" && "$lahar" check gi.yaml -o gi --in-process -q --overwrite --threads 1)
 [ -f "$out/gi/check.json" ] || fail "lahar check wrote no check.json"
 "$py" "$src/tools/plot_impact.py" "$out/gi.png" "$out/gi" > "$out/gi.md" || fail "plot_impact.py failed on a run without impact"
 grep -q '^| 45° | 0.05 | none |' "$out/gi.md" || { cat "$out/gi.md"; fail "plot_impact.py: no row with first impact 'none'"; }
@@ -18,7 +18,10 @@ grep -q '^| 45° | 0.05 | none |' "$out/gi.md" || { cat "$out/gi.md"; fail "plot
 
 "$py" "$src/tools/case_override.py" "$src/cases/dam_break_obstacle_plane_2d.yaml" "$out/sp.yaml" sph.dx=0.04 \
   time.end=0.1 time.output_interval=0.05 || fail "case_override dam_break_obstacle_plane_2d"
-"$lahar" run "$out/sp.yaml" -o "$out/sp" --in-process -q --overwrite --threads 1 || fail "lahar run dam_break_obstacle_plane_2d"
+# Run from OUT_DIR with the case named relative to it, the tools from elsewhere: they find the case
+# through summary.json's absolute "case" (a relative one sent them looking in their own directory)
+(cd "$out" && "$lahar" run sp.yaml -o sp --in-process -q --overwrite --threads 1) || fail "lahar run dam_break_obstacle_plane_2d"
+grep -q "\"case\":[[:space:]]*\"/" "$out/sp/summary.json" || fail "summary.json: \"case\" is not an absolute path"
 "$py" "$src/tools/compare_spheric2.py" "$out/sp" --no-plot 2> "$out/sp.err"
 rc=$?
 cat "$out/sp.err"
@@ -30,7 +33,7 @@ grep -q "P1 never reaches" "$out/sp.err" || fail "compare_spheric2.py: no messag
 # impact-time test and read "outside by +0.0 %")
 "$py" "$src/tools/case_override.py" "$src/cases/dam_break_lobovsky_2d.yaml" "$out/lb.yaml" sph.dx=0.02 \
   time.end=0.2 time.output_interval=0.1 || fail "case_override dam_break_lobovsky_2d"
-"$lahar" run "$out/lb.yaml" -o "$out/lb" --in-process -q --overwrite --threads 1 || fail "lahar run dam_break_lobovsky_2d"
+(cd "$out" && "$lahar" run lb.yaml -o lb --in-process -q --overwrite --threads 1) || fail "lahar run dam_break_lobovsky_2d"
 "$py" "$src/tools/compare_lobovsky.py" "$out/lb" --no-plot --check --spread-tol 0.05 > "$out/lb.txt" 2>&1
 rc=$?
 cat "$out/lb.txt"

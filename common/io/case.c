@@ -560,6 +560,14 @@ int lahar_case_load(const char *path, lahar_case *out)
     return rc;
 }
 
+const char *lahar_case_path_abs(const lahar_case *c, char *buf, size_t size)
+{
+    char *abs = realpath(c->path, NULL);
+    snprintf(buf, size, "%s", abs ? abs : c->path);
+    free(abs);
+    return buf;
+}
+
 void lahar_case_free(lahar_case *c)
 {
     if (!c)

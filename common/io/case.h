@@ -29,6 +29,10 @@ int lahar_case_load_dir(const char *path, const char *base_dir, lahar_case *out,
  * relative paths in it (STL meshes, initial files) start from. lahar_case_load_err reads the file
  * and calls this. */
 int lahar_case_load_mem(const char *path, const void *data, size_t size, lahar_case *out, char *err, size_t errlen);
+/* The case file's absolute path into buf (for the records a run leaves, summary.json and
+ * check.json, so that a tool run from another directory finds the case); the path as the case
+ * holds it when that cannot be resolved (the file is gone, a case built in memory). Returns buf. */
+const char *lahar_case_path_abs(const lahar_case *c, char *buf, size_t size);
 /* Every sph: option at the default the loader gives it (the key table, case_keys.c), for programs
  * that build a solver without a case file; c0 and the halo, whose defaults depend on the case,
  * are 0. */

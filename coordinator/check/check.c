@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "case.h"
 #include "geometry.h"
 #include "output.h"
 #include "vec.h"
@@ -666,7 +667,8 @@ static void evaluation_json(const lahar_case *c, evaluation *ev)
     cJSON_AddStringToObject(ev->info, "note", r->note);
     cJSON_AddBoolToObject(root, "pass", ev->all_pass);
     cJSON_AddStringToObject(root, "reference", ev->ref->name);
-    cJSON_AddStringToObject(root, "case", c->path);
+    char case_path[sizeof c->path + 4096];
+    cJSON_AddStringToObject(root, "case", lahar_case_path_abs(c, case_path, sizeof case_path));
     if (r->convention[0])
         cJSON_AddStringToObject(root, "convention", r->convention);
     cJSON_AddItemToObject(root, "metrics", ev->metrics);

@@ -132,7 +132,8 @@ static void coord_summary_outcome(const coord *co, cJSON *root)
     cJSON_AddStringToObject(root, "status", co->status);
     cJSON_AddNumberToObject(root, "exit_status", co->exit_status);
     cJSON_AddStringToObject(root, "message", co->message);
-    cJSON_AddStringToObject(root, "case", co->c->path);
+    char case_path[sizeof co->c->path + 4096];
+    cJSON_AddStringToObject(root, "case", lahar_case_path_abs(co->c, case_path, sizeof case_path));
     cJSON_AddStringToObject(root, "output_dir", co->outdir);
     cJSON_AddStringToObject(root, "mode", co->mode);
     cJSON_AddStringToObject(root, "lcm_url", co->url ? co->url : "");
