@@ -11,14 +11,20 @@
 set(LAHAR_LOBOVSKY_CASE ${CMAKE_SOURCE_DIR}/cases/dam_break_lobovsky_2d.yaml compare_lobovsky.py sph.dx=0.01)
 lahar_test(sph_dam_break_lobovsky_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d ${LAHAR_LOBOVSKY_CASE} -- --spread-tol 0.05
-  LABELS sph validation slow TIMEOUT 300)
+  LABELS sph validation slow TIMEOUT 300 PROPERTIES FIXTURES_SETUP lobovsky_runs)
 # The same with the Riemann-solver scheme (sph.scheme: riemann, Zhang, Hu & Adams 2017; sph_node/fluid/sph_riemann.h):
 # the same bounds. Measured (dx 10 mm): impact t* within 0.2 %, sensor 1 peak 10.2 against delta-SPH's 12.9
 # rho g H (the experiment's 3.04): docs/bench/impact_pressure.md.
 lahar_test(sph_dam_break_lobovsky_2d_riemann COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/lobovsky_2d_riemann ${LAHAR_LOBOVSKY_CASE} sph.scheme=riemann sph.alpha=~ sph.delta=~
   -- --spread-tol 0.05
-  LABELS sph validation slow TIMEOUT 300)
+  LABELS sph validation slow TIMEOUT 300 PROPERTIES FIXTURES_SETUP lobovsky_runs)
+# tools/plot_lobovsky_convergence.py (pressures against dx, docs/bench/impact_pressure.md "Sensor
+# pressures against resolution") on the two runs above: a row per run with its lobovsky.json's
+# sensor 2 peak, a PNG, exit 2 on bad arguments
+lahar_test(tools_lobovsky_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_lobovsky_convergence.sh ${CMAKE_SOURCE_DIR}
+  ${CMAKE_CURRENT_BINARY_DIR}/impact ${CMAKE_CURRENT_BINARY_DIR}/tools_lobovsky_convergence ${LAHAR_OUTPUT_PYTHON}
+  LABELS output TIMEOUT 60 PROPERTIES FIXTURES_REQUIRED lobovsky_runs)
 # SPHERIC Test 2 (Kleefsman et al. 2005; docs/references-data/kleefsman_2005_test2.csv), compared by
 # tools/compare_spheric2.py --check; measured values: docs/bench/impact_pressure.md "SPHERIC Test 2: summary".
 # The centre plane in 2D (cases/dam_break_obstacle_plane_2d.yaml) at dx 10 mm, 0.45 s (12 s of CPU):

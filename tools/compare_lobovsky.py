@@ -21,7 +21,9 @@ Metrics (printed, and written to --json):
   spread      sensor 2: the same peak and peak_mean of the experiment's 2.5 %, 50 % and 97.5 %
               percentile series (the repeat spread; the mean of a percentile series stands in
               for the percentile of the runs' means), and whether the run's lie between the
-              2.5 % and 97.5 % values
+              2.5 % and 97.5 % values; and the whole series over the same 0.3 t* (run and spread
+              aligned on their impact): the RMS distance of the run's samples from the band (0 for
+              a sample inside it) and the fraction of samples inside it
   levels      per gauge H1-H4 (x = 0.300, 0.865, 1.114, 1.3625 m), the mean |h_run - h_exp| / H
               over the run's level-gauge samples with t* <= min(run end, --level-tmax, default 5.5:
               before the bore reflected from the wall reaches H4), against the experiment's mean
@@ -80,6 +82,19 @@ def peak(t, p, t0):
 
 def peak_mean(t, p, t0, tau):
     return lahar_py.window_mean_peak(t, p, t0, tau, PEAK_SPAN)
+
+
+def band_fit(t, p, t0, te, lo, hi, t0_exp):
+    """The run's series against the percentile series over the PEAK_SPAN after each one's impact
+    (aligned on the rise, as the peaks are): the RMS distance of p from the band between the 2.5 %
+    and 97.5 % series (0 inside it) and the fraction of samples inside it."""
+    sel = (t >= t0) & (t <= t0 + PEAK_SPAN)
+    if not sel.any():
+        return float("nan"), float("nan")
+    s = t0_exp + (t[sel] - t0)
+    q, qlo, qhi = p[sel], np.interp(s, te, lo), np.interp(s, te, hi)
+    out = np.maximum(q - qhi, 0.0) + np.maximum(qlo - q, 0.0)
+    return float(np.sqrt(np.mean(out ** 2))), float(np.mean(out == 0.0))
 
 
 def main():
@@ -145,6 +160,9 @@ def main():
         # None: the run has no value (no impact in it)
         spread[q + "_rel_outside"] = ((v - hi) / hi if v > hi else (v - lo) / lo if v < lo else 0.0) \
             if np.isfinite(v) else None
+    t2, p2 = run_p["sensor2"]
+    spread["rms_outside"], spread["inside_fraction"] = band_fit(
+        t2, p2, r_run, se[:, 0], se[:, sh.index("p2_5")], se[:, sh.index("p97_5")], r_exp)
     s2["spread"] = spread
 
     # levels: the level gauges H1-H4 of the case (kind: level, gauges.h5)
@@ -217,6 +235,8 @@ def main():
                       n, sp["p2.5"]["peak"], sp["p97.5"]["peak"], sp["median"]["peak"], where("peak"),
                       a.window, sp["p2.5"]["peak_mean"], sp["p97.5"]["peak_mean"], sp["median"]["peak_mean"],
                       where("peak_mean")))
+            print("%s against the spread over %.2f t* after the impact: RMS distance from the band %.3f, "
+                  "%.0f %% of the samples inside it" % (n, PEAK_SPAN, sp["rms_outside"], 100 * sp["inside_fraction"]))
     for g, d in m["levels"].items():
         print("%s: mean |h - h_exp| / H = %.3f over t* <= %.2f%s%s" % (
             g, d["mean_abs_diff"], d["t_star_max"],

@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Lobovsky dam break: the wall pressures of several runs against their particle spacing.
+
+usage: plot_lobovsky_convergence.py OUT.png "LABEL=RUN[,RUN...]" ["LABEL=RUN[,RUN...]" ...]
+
+Each RUN is the output directory of a run of cases/dam_break_lobovsky_2d.yaml (any dx, any
+scheme) on which tools/compare_lobovsky.py has been run: the script reads only RUN/lobovsky.json
+(a path to a .json file works too), so every number is compare_lobovsky's own. A LABEL names one
+series, e.g. the scheme: "delta-SPH=/tmp/d10,/tmp/d5" "Riemann=/tmp/r10,/tmp/r5".
+
+Draws, per sensor 1-3, the peak (largest sample within 52 ms of the impact) and the largest
+10 ms mean (the window compare_lobovsky was run with) against dx, with the experiment: peak
+event 5 (Lobovsky et al. 2014, Fig. 18) for every sensor, and for sensor 2 the repeat spread
+(2.5-97.5 % percentile series over the test runs) as a band; below, sensor 2's whole series
+against that band (RMS distance from it, fraction of samples inside). Prints a Markdown table:
+series, dx, impact t*, peaks and means of sensors 1-3, sensor 2 against the spread.
+Exit 0, 2 on bad usage or a RUN without a readable lobovsky.json."""
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import lahar_py  # noqa: E402
+
+lahar_py.require("matplotlib")
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+SENSORS = ("sensor1", "sensor2", "sensor3")
+
+
+def fail(msg):
+    print("plot_lobovsky_convergence: " + msg, file=sys.stderr)
+    sys.exit(2)
+
+
+def load(run):
+    path = run if run.endswith(".json") else os.path.join(run, "lobovsky.json")
+    try:
+        with open(path) as f:
+            m = json.load(f)
+    except (OSError, ValueError) as e:
+        fail("%s: no readable lobovsky.json (%s); run tools/compare_lobovsky.py on it first" % (run, e))
+    if "sensors" not in m or "dx" not in m or any(s not in m["sensors"] for s in SENSORS):
+        fail("%s: not the JSON of tools/compare_lobovsky.py (no dx or sensors 1-3)" % path)
+    return m
+
+
+def spread_note(s2):
+    sp = s2.get("spread")
+    if sp is None:
+        return "-", "-", "-"
+    out = []
+    for q in ("peak", "peak_mean"):
+        r = sp.get(q + "_rel_outside")
+        out.append("no value" if r is None else "inside" if sp[q + "_inside"] else
+                   "x%.2f of the top" % (s2[q] / sp["p97.5"][q]) if r > 0 else "%+.1f %%" % (100 * r))
+    sp = s2["spread"]
+    out.append("%.3f / %.0f %%" % (sp["rms_outside"], 100 * sp["inside_fraction"]) if "rms_outside" in sp else "-")
+    return out
+
+
+def main():
+    args = sys.argv[1:]
+    if len(args) < 2 or args[0] in ("-h", "--help"):
+        print(__doc__)
+        return 0 if args and args[0] in ("-h", "--help") else 2
+    png = args[0]
+    if not png.endswith(".png"):
+        fail("the first argument is the PNG to write (got %r)" % png)
+    series = []
+    for spec in args[1:]:
+        label, eq, runs = spec.partition("=")
+        if not eq or not label or not runs:
+            fail("%r: expected LABEL=RUN[,RUN...]" % spec)
+        ms = sorted((load(r) for r in runs.split(",") if r), key=lambda m: -m["dx"])
+        series.append((label, ms))
+
+    first = series[0][1][0]
+    window = first.get("window_ms", 10)
+    print("| series | dx [mm] | impact t* (exp. %.3f) | peak s1 / s2 / s3 (exp. %s) | %g ms mean s1 / s2 / s3 "
+          "(exp. %s) | s2 peak against the spread | s2 mean against the spread | s2 series: RMS distance from the "
+          "spread / inside |" % (
+              first["rise"]["experiment"], " / ".join("%.2f" % first["sensors"][s]["peak_exp"] for s in SENSORS),
+              window, " / ".join("%.2f" % first["sensors"][s]["peak_mean_exp"] for s in SENSORS)))
+    print("|---|---|---|---|---|---|---|---|")
+    for label, ms in series:
+        for m in ms:
+            s = m["sensors"]
+            n_peak, n_mean, n_series = spread_note(s["sensor2"])
+            print("| %s | %g | %.3f (%+.1f %%) | %s | %s | %s | %s | %s |" % (
+                label, 1e3 * m["dx"], m["rise"]["run"], 100 * m["rise"]["rel"],
+                " / ".join("%.2f" % s[n]["peak"] for n in SENSORS),
+                " / ".join("%.2f" % s[n]["peak_mean"] for n in SENSORS), n_peak, n_mean, n_series))
+
+    fig, axes = plt.subplots(3, 3, figsize=(13, 10), sharex=True)
+    dxs = [1e3 * m["dx"] for _, ms in series for m in ms]
+    lo, hi = min(dxs) / 1.3, max(dxs) * 1.3
+    for k, n in enumerate(SENSORS):
+        for row, (q, name) in enumerate((("peak", "peak"), ("peak_mean", "%g ms mean" % window))):
+            ax = axes[row, k]
+            ax.axhline(first["sensors"][n][q + "_exp"], color="k", lw=1.2, label="Lobovsky 2014, peak event 5")
+            sp = first["sensors"][n].get("spread")
+            if sp is not None:
+                ax.axhspan(sp["p2.5"][q], sp["p97.5"][q], color="0.8", label="Lobovsky 2014, 2.5-97.5 % of the runs")
+            for label, ms in series:
+                ax.plot([1e3 * m["dx"] for m in ms], [m["sensors"][n][q] for m in ms], "o-", label="lahar, " + label)
+            ax.set_xscale("log")
+            if q == "peak":
+                ax.set_yscale("log")
+            ax.set_xlim(hi, lo)  # finer to the right
+            ax.set_title("%s: %s" % (n, name), fontsize=10)
+            ax.grid(alpha=0.3, which="both")
+            if k == 0:
+                ax.set_ylabel("p/ρgH")
+    for k, (q, name) in enumerate((("rms_outside", "RMS distance from the spread [ρgH]"),
+                                   ("inside_fraction", "fraction of samples inside the spread"))):
+        ax = axes[2, k]
+        for label, ms in series:
+            pts = [(1e3 * m["dx"], m["sensors"]["sensor2"]["spread"][q]) for m in ms
+                   if q in m["sensors"]["sensor2"].get("spread", {})]
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label="lahar, " + label)
+        ax.set_xscale("log")
+        if q == "rms_outside":
+            ax.set_yscale("log")
+        else:
+            ax.set_ylim(0, 1)
+        ax.set_xlim(hi, lo)
+        ax.set_title("sensor 2, series over 52 ms: " + name, fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+        ax.set_xlabel("dx [mm]")
+    axes[2, 2].axis("off")
+    axes[0, 1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(png, dpi=90)
+    print("wrote", png)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
