@@ -20,8 +20,8 @@ lahar_test(sph_dam_break_lobovsky_2d_riemann COMMAND ${LAHAR_OUTPUT_PYTHON} ${LA
   -- --spread-tol 0.05
   LABELS sph validation slow TIMEOUT 300 PROPERTIES FIXTURES_SETUP lobovsky_runs)
 # tools/plot_lobovsky_convergence.py (pressures against dx, docs/bench/impact_pressure.md "Sensor
-# pressures against resolution") on the two runs above: a row per run with its lobovsky.json's
-# sensor 2 peak, a PNG, exit 2 on bad arguments
+# pressures against resolution") on the two runs above: each row's numbers and verdicts those of
+# the run's lobovsky.json, an older lobovsky.json read, a PNG, exit 2 on bad arguments
 lahar_test(tools_lobovsky_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_lobovsky_convergence.sh ${CMAKE_SOURCE_DIR}
   ${CMAKE_CURRENT_BINARY_DIR}/impact ${CMAKE_CURRENT_BINARY_DIR}/tools_lobovsky_convergence ${LAHAR_OUTPUT_PYTHON}
   LABELS output TIMEOUT 60 PROPERTIES FIXTURES_REQUIRED lobovsky_runs)

@@ -2,7 +2,9 @@
 # The impact tools on runs that end before the impact (a short first look at a case, the way a user
 # tries a tool): plot_impact.py writes its table with first impact "none" (it raised a TypeError on
 # first_impact_s = null), compare_spheric2.py exits 2 saying the water has not hit the box (it
-# raised a ValueError on an empty array), compare_lobovsky.py --check fails on the impact time.
+# raised a ValueError on an empty array), compare_lobovsky.py --check fails on the impact time
+# and reads "no value" against the spread (it printed nan), and plot_lobovsky_convergence.py's row
+# says there is no impact. check.json and summary.json name the case by its absolute path.
 # usage: tools_no_impact.sh LAHAR SRC_DIR OUT_DIR PYTHON
 set -u
 lahar=$1 src=$2 out=$3 py=$4
@@ -12,6 +14,7 @@ mkdir -p "$out"
   time.output_interval=0.01 || fail "case_override granular_impact_3d"
 (cd "$out" && "$lahar" check gi.yaml -o gi --in-process -q --overwrite --threads 1)
 [ -f "$out/gi/check.json" ] || fail "lahar check wrote no check.json"
+grep -q "\"case\":[[:space:]]*\"/" "$out/gi/check.json" || fail "check.json: \"case\" is not an absolute path"
 "$py" "$src/tools/plot_impact.py" "$out/gi.png" "$out/gi" > "$out/gi.md" || fail "plot_impact.py failed on a run without impact"
 grep -q '^| 45° | 0.05 | none |' "$out/gi.md" || { cat "$out/gi.md"; fail "plot_impact.py: no row with first impact 'none'"; }
 [ -s "$out/gi.png" ] || fail "plot_impact.py wrote no PNG"
@@ -40,4 +43,10 @@ cat "$out/lb.txt"
 [ $rc -eq 1 ] || fail "compare_lobovsky.py --check: exit $rc on a run without impact, expected 1"
 grep -q "^FAIL: rise," "$out/lb.txt" || fail "compare_lobovsky.py: the impact time is not among the failures"
 grep -q "10 ms mean 1.73-1.98 (1.86): no value" "$out/lb.txt" || fail "compare_lobovsky.py: sensor 2 not 'no value' against the spread"
+grep -q "after the impact: no value" "$out/lb.txt" || fail "compare_lobovsky.py: sensor 2's series not 'no value' against the band"
+# plot_lobovsky_convergence.py on it: a row saying so, not "nan"
+"$py" "$src/tools/plot_lobovsky_convergence.py" "$out/lbc.png" "delta=$out/lb" > "$out/lbc.md" || fail "plot_lobovsky_convergence.py: exit $?"
+cat "$out/lbc.md"
+grep -q '^| delta | 20 | none (no impact in the run) | .* | no value | no value | no value |$' "$out/lbc.md" ||
+  fail "plot_lobovsky_convergence.py: no row saying the run has no impact"
 echo "tools_no_impact: ok"

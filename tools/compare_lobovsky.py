@@ -235,8 +235,9 @@ def main():
                       n, sp["p2.5"]["peak"], sp["p97.5"]["peak"], sp["median"]["peak"], where("peak"),
                       a.window, sp["p2.5"]["peak_mean"], sp["p97.5"]["peak_mean"], sp["median"]["peak_mean"],
                       where("peak_mean")))
-            print("%s against the spread over %.2f t* after the impact: RMS distance from the band %.3f, "
-                  "%.0f %% of the samples inside it" % (n, PEAK_SPAN, sp["rms_outside"], 100 * sp["inside_fraction"]))
+            print("%s against the spread over %.2f t* after the impact: %s" % (
+                n, PEAK_SPAN, "RMS distance from the band %.3f, %.0f %% of the samples inside it" % (
+                    sp["rms_outside"], 100 * sp["inside_fraction"]) if np.isfinite(sp["rms_outside"]) else "no value"))
     for g, d in m["levels"].items():
         print("%s: mean |h - h_exp| / H = %.3f over t* <= %.2f%s%s" % (
             g, d["mean_abs_diff"], d["t_star_max"],

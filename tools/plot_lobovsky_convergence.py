@@ -14,8 +14,10 @@ event 5 (Lobovsky et al. 2014, Fig. 18) for every sensor, and for sensor 2 the r
 (2.5-97.5 % percentile series over the test runs) as a band; below, sensor 2's whole series
 against that band (RMS distance from it, fraction of samples inside). Prints a Markdown table:
 series, dx, impact t*, peaks and means of sensors 1-3, sensor 2 against the spread.
-Exit 0, 2 on bad usage or a RUN without a readable lobovsky.json."""
+Exit 0, 2 on bad usage, a RUN without a readable lobovsky.json, runs compared with different
+windows (--window of compare_lobovsky) or a PNG that cannot be written."""
 import json
+import math
 import os
 import sys
 
@@ -27,6 +29,7 @@ import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import NullFormatter  # noqa: E402
 
 SENSORS = ("sensor1", "sensor2", "sensor3")
 
@@ -43,22 +46,29 @@ def load(run):
             m = json.load(f)
     except (OSError, ValueError) as e:
         fail("%s: no readable lobovsky.json (%s); run tools/compare_lobovsky.py on it first" % (run, e))
-    if "sensors" not in m or "dx" not in m or any(s not in m["sensors"] for s in SENSORS):
-        fail("%s: not the JSON of tools/compare_lobovsky.py (no dx or sensors 1-3)" % path)
+    if not isinstance(m, dict) or any(k not in m for k in ("dx", "rise", "sensors")) or \
+            any(s not in m["sensors"] for s in SENSORS):
+        fail("%s: not the JSON of tools/compare_lobovsky.py (no dx, rise or sensors 1-3)" % path)
     return m
 
 
 def spread_note(s2):
+    """Sensor 2's peak and 10 ms mean against the spread, and its series against the band (from the
+    values themselves: a JSON of an older compare_lobovsky lacks the derived keys)."""
     sp = s2.get("spread")
     if sp is None:
         return "-", "-", "-"
     out = []
     for q in ("peak", "peak_mean"):
-        r = sp.get(q + "_rel_outside")
-        out.append("no value" if r is None else "inside" if sp[q + "_inside"] else
-                   "x%.2f of the top" % (s2[q] / sp["p97.5"][q]) if r > 0 else "%+.1f %%" % (100 * r))
-    sp = s2["spread"]
-    out.append("%.3f / %.0f %%" % (sp["rms_outside"], 100 * sp["inside_fraction"]) if "rms_outside" in sp else "-")
+        v, lo, hi = s2[q], sp["p2.5"][q], sp["p97.5"][q]
+        out.append("no value" if not math.isfinite(v) else "inside" if lo <= v <= hi else
+                   "x%.2f of the top" % (v / hi) if v > hi else "%+.1f %%" % (100 * (v - lo) / lo))
+    if "rms_outside" not in sp:
+        out.append("-")
+    elif not math.isfinite(sp["rms_outside"]):
+        out.append("no value")
+    else:
+        out.append("%.3f / %.0f %%" % (sp["rms_outside"], 100 * sp["inside_fraction"]))
     return out
 
 
@@ -70,47 +80,65 @@ def main():
     png = args[0]
     if not png.endswith(".png"):
         fail("the first argument is the PNG to write (got %r)" % png)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(png))):
+        fail("%s: its directory does not exist; create it or write the PNG elsewhere" % png)
     series = []
     for spec in args[1:]:
         label, eq, runs = spec.partition("=")
-        if not eq or not label or not runs:
+        paths = [r for r in runs.split(",") if r]
+        if not eq or not label or not paths:
             fail("%r: expected LABEL=RUN[,RUN...]" % spec)
-        ms = sorted((load(r) for r in runs.split(",") if r), key=lambda m: -m["dx"])
+        ms = sorted((load(r) for r in paths), key=lambda m: -m["dx"])
         series.append((label, ms))
 
     first = series[0][1][0]
     window = first.get("window_ms", 10)
+    # the means, the experiment's means and the spread's depend on the window: one for all runs
+    windows = sorted({m.get("window_ms", 10) for _, ms in series for m in ms})
+    if len(windows) > 1:
+        fail("the runs were compared with different --window (%s ms); run tools/compare_lobovsky.py on "
+             "them all with one" % ", ".join("%g" % w for w in windows))
+    # the experiment's values and the band: from a run whose JSON has sensor 2's spread
+    ref = next((m for _, ms in series for m in ms if "spread" in m["sensors"]["sensor2"]), first)
     print("| series | dx [mm] | impact t* (exp. %.3f) | peak s1 / s2 / s3 (exp. %s) | %g ms mean s1 / s2 / s3 "
           "(exp. %s) | s2 peak against the spread | s2 mean against the spread | s2 series: RMS distance from the "
           "spread / inside |" % (
-              first["rise"]["experiment"], " / ".join("%.2f" % first["sensors"][s]["peak_exp"] for s in SENSORS),
-              window, " / ".join("%.2f" % first["sensors"][s]["peak_mean_exp"] for s in SENSORS)))
+              ref["rise"]["experiment"], " / ".join("%.2f" % ref["sensors"][s]["peak_exp"] for s in SENSORS),
+              window, " / ".join("%.2f" % ref["sensors"][s]["peak_mean_exp"] for s in SENSORS)))
     print("|---|---|---|---|---|---|---|---|")
     for label, ms in series:
         for m in ms:
             s = m["sensors"]
             n_peak, n_mean, n_series = spread_note(s["sensor2"])
-            print("| %s | %g | %.3f (%+.1f %%) | %s | %s | %s | %s | %s |" % (
-                label, 1e3 * m["dx"], m["rise"]["run"], 100 * m["rise"]["rel"],
+            rise = "%.3f (%+.1f %%)" % (m["rise"]["run"], 100 * m["rise"]["rel"]) \
+                if math.isfinite(m["rise"]["run"]) else "none (no impact in the run)"
+            print("| %s | %g | %s | %s | %s | %s | %s | %s |" % (
+                label, 1e3 * m["dx"], rise,
                 " / ".join("%.2f" % s[n]["peak"] for n in SENSORS),
                 " / ".join("%.2f" % s[n]["peak_mean"] for n in SENSORS), n_peak, n_mean, n_series))
 
     fig, axes = plt.subplots(3, 3, figsize=(13, 10), sharex=True)
     dxs = [1e3 * m["dx"] for _, ms in series for m in ms]
     lo, hi = min(dxs) / 1.3, max(dxs) * 1.3
+    ticks = sorted(set(dxs))
+
+    def dx_axis(ax):
+        ax.set_xscale("log")
+        ax.set_xlim(hi, lo)  # finer to the right
+        ax.set_xticks(ticks, ["%g" % d for d in ticks])  # the runs' dx, not decades
+        ax.xaxis.set_minor_formatter(NullFormatter())
     for k, n in enumerate(SENSORS):
         for row, (q, name) in enumerate((("peak", "peak"), ("peak_mean", "%g ms mean" % window))):
             ax = axes[row, k]
-            ax.axhline(first["sensors"][n][q + "_exp"], color="k", lw=1.2, label="Lobovsky 2014, peak event 5")
-            sp = first["sensors"][n].get("spread")
+            ax.axhline(ref["sensors"][n][q + "_exp"], color="k", lw=1.2, label="Lobovsky 2014, peak event 5")
+            sp = ref["sensors"][n].get("spread")
             if sp is not None:
                 ax.axhspan(sp["p2.5"][q], sp["p97.5"][q], color="0.8", label="Lobovsky 2014, 2.5-97.5 % of the runs")
             for label, ms in series:
                 ax.plot([1e3 * m["dx"] for m in ms], [m["sensors"][n][q] for m in ms], "o-", label="lahar, " + label)
-            ax.set_xscale("log")
+            dx_axis(ax)
             if q == "peak":
                 ax.set_yscale("log")
-            ax.set_xlim(hi, lo)  # finer to the right
             ax.set_title("%s: %s" % (n, name), fontsize=10)
             ax.grid(alpha=0.3, which="both")
             if k == 0:
@@ -118,23 +146,28 @@ def main():
     for k, (q, name) in enumerate((("rms_outside", "RMS distance from the spread [ρgH]"),
                                    ("inside_fraction", "fraction of samples inside the spread"))):
         ax = axes[2, k]
+        drawn = []
         for label, ms in series:
+            # runs without the value (an older compare_lobovsky) or without an impact (NaN) left out
             pts = [(1e3 * m["dx"], m["sensors"]["sensor2"]["spread"][q]) for m in ms
-                   if q in m["sensors"]["sensor2"].get("spread", {})]
+                   if math.isfinite(m["sensors"]["sensor2"].get("spread", {}).get(q, math.nan))]
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label="lahar, " + label)
-        ax.set_xscale("log")
-        if q == "rms_outside":
+            drawn += [p[1] for p in pts]
+        dx_axis(ax)
+        if q == "rms_outside" and any(v > 0 for v in drawn):
             ax.set_yscale("log")
         else:
             ax.set_ylim(0, 1)
-        ax.set_xlim(hi, lo)
         ax.set_title("sensor 2, series over 52 ms: " + name, fontsize=9)
         ax.grid(alpha=0.3, which="both")
         ax.set_xlabel("dx [mm]")
     axes[2, 2].axis("off")
     axes[0, 1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(png, dpi=90)
+    try:
+        fig.savefig(png, dpi=90)
+    except OSError as e:
+        fail("%s: cannot write it (%s)" % (png, e))
     print("wrote", png)
     return 0
 
