@@ -44,6 +44,12 @@ cat "$out/lb.txt"
 grep -q "^FAIL: rise," "$out/lb.txt" || fail "compare_lobovsky.py: the impact time is not among the failures"
 grep -q "10 ms mean 1.73-1.98 (1.86): no value" "$out/lb.txt" || fail "compare_lobovsky.py: sensor 2 not 'no value' against the spread"
 grep -q "after the impact: no value" "$out/lb.txt" || fail "compare_lobovsky.py: sensor 2's series not 'no value' against the band"
+# its lobovsky.json is strict JSON (null, not NaN, for the values the run has none of: jq and
+# JavaScript reject NaN)
+"$py" -c 'import json, sys
+def bad(c): raise ValueError("non-standard constant " + c)
+m = json.load(open(sys.argv[1]), parse_constant=bad)
+assert m["rise"]["run"] is None, m["rise"]' "$out/lb/lobovsky.json" || fail "compare_lobovsky.py: lobovsky.json is not strict JSON with null for no value"
 # plot_lobovsky_convergence.py on it: a row saying so, not "nan"
 "$py" "$src/tools/plot_lobovsky_convergence.py" "$out/lbc.png" "delta=$out/lb" > "$out/lbc.md" || fail "plot_lobovsky_convergence.py: exit $?"
 cat "$out/lbc.md"

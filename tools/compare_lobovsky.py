@@ -245,7 +245,7 @@ def main():
             "; front (h >= 0.05 H) at t* %.2f (experiment %.2f, %+.1f %%)" % (
                 d["arrival"], d["arrival_exp"], 100 * d["arrival_rel"]) if "arrival" in d else ""))
     with open(a.json or os.path.join(a.out, "lobovsky.json"), "w") as fh:
-        json.dump(m, fh, indent=1)
+        lahar_py.dump_json(m, fh)
 
     if not a.no_plot:
         fig, axes = plt.subplots(4, 2, figsize=(12, 10), sharex="col")

@@ -158,7 +158,7 @@ def main():
         m["depths"] = depths(te, e, head, tls, hs, float(column["lo"][0]), float(column["hi"][-1]))
     ok, failed = check(m, a)
     with open(a.json or os.path.join(a.out, "spheric2.json"), "w") as fh:
-        json.dump(m, fh, indent=1)
+        lahar_py.dump_json(m, fh)
     if not a.no_plot:
         plot(a, te, e, head, run_p, tls, hs, dx, tau, column)
     if a.check and not ok:

@@ -44,3 +44,27 @@ def window_mean_peak(t, p, t0, tau, span):
             break
         best = max(best, (np.interp(s + tau, t, c) - np.interp(s, t, c)) / tau)
     return float(best)
+
+
+def _finite_or_none(x):
+    import math
+    if isinstance(x, dict):
+        return {k: _finite_or_none(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite_or_none(v) for v in x]
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def dump_json(obj, fh):
+    """obj as strict JSON (jq, JavaScript and other parsers reject NaN and Infinity): a quantity
+    with no value (a run without an impact, a ratio over zero) is written as null."""
+    import json
+    json.dump(_finite_or_none(obj), fh, indent=1, allow_nan=False)
+
+
+def null_as_nan(d):
+    """json.load(..., object_hook=null_as_nan): the nulls dump_json wrote read back as nan, so
+    that arithmetic and formatting on a quantity with no value give nan instead of a TypeError."""
+    return {k: float("nan") if v is None else v for k, v in d.items()}

@@ -43,7 +43,7 @@ def load(run):
     path = run if run.endswith(".json") else os.path.join(run, "lobovsky.json")
     try:
         with open(path) as f:
-            m = json.load(f)
+            m = json.load(f, object_hook=lahar_py.null_as_nan)
     except (OSError, ValueError) as e:
         fail("%s: no readable lobovsky.json (%s); run tools/compare_lobovsky.py on it first" % (run, e))
     if not isinstance(m, dict) or any(k not in m for k in ("dx", "rise", "sensors")) or \
