@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <hdf5.h>
 #include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -667,7 +668,7 @@ static void evaluation_json(const lahar_case *c, evaluation *ev)
     cJSON_AddStringToObject(ev->info, "note", r->note);
     cJSON_AddBoolToObject(root, "pass", ev->all_pass);
     cJSON_AddStringToObject(root, "reference", ev->ref->name);
-    char case_path[sizeof c->path + 4096];
+    char case_path[PATH_MAX];
     cJSON_AddStringToObject(root, "case", lahar_case_path_abs(c, case_path, sizeof case_path));
     if (r->convention[0])
         cJSON_AddStringToObject(root, "convention", r->convention);

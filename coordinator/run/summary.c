@@ -132,7 +132,7 @@ static void coord_summary_outcome(const coord *co, cJSON *root)
     cJSON_AddStringToObject(root, "status", co->status);
     cJSON_AddNumberToObject(root, "exit_status", co->exit_status);
     cJSON_AddStringToObject(root, "message", co->message);
-    char case_path[sizeof co->c->path + 4096];
+    char case_path[PATH_MAX];
     cJSON_AddStringToObject(root, "case", lahar_case_path_abs(co->c, case_path, sizeof case_path));
     cJSON_AddStringToObject(root, "output_dir", co->outdir);
     cJSON_AddStringToObject(root, "mode", co->mode);
