@@ -84,6 +84,14 @@ def peak_mean(t, p, t0, tau):
     return lahar_py.window_mean_peak(t, p, t0, tau, PEAK_SPAN)
 
 
+def rel_outside(v, lo, hi):
+    """How far v lies outside [lo, hi], relative to the edge it passes: (v - hi) / hi above,
+    (v - lo) / lo below, 0 inside; None when v has no value (a run without an impact)."""
+    if not np.isfinite(v):
+        return None
+    return (v - hi) / hi if v > hi else (v - lo) / lo if v < lo else 0.0
+
+
 def band_fit(t, p, t0, te, lo, hi, t0_exp):
     """The run's series against the percentile series over the PEAK_SPAN after each one's impact
     (aligned on the rise, as the peaks are): the RMS distance of p from the band between the 2.5 %
@@ -157,9 +165,7 @@ def main():
     for q in ("peak", "peak_mean"):
         lo, hi, v = spread["p2.5"][q], spread["p97.5"][q], s2[q]
         spread[q + "_inside"] = bool(lo <= v <= hi)
-        # None: the run has no value (no impact in it)
-        spread[q + "_rel_outside"] = ((v - hi) / hi if v > hi else (v - lo) / lo if v < lo else 0.0) \
-            if np.isfinite(v) else None
+        spread[q + "_rel_outside"] = rel_outside(v, lo, hi)
     t2, p2 = run_p["sensor2"]
     spread["rms_outside"], spread["inside_fraction"] = band_fit(
         t2, p2, r_run, se[:, 0], se[:, sh.index("p2_5")], se[:, sh.index("p97_5")], r_exp)

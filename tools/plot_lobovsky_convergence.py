@@ -30,6 +30,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import NullFormatter  # noqa: E402
+from compare_lobovsky import rel_outside  # noqa: E402
 
 SENSORS = ("sensor1", "sensor2", "sensor3")
 
@@ -60,9 +61,9 @@ def spread_note(s2):
         return "-", "-", "-"
     out = []
     for q in ("peak", "peak_mean"):
-        v, lo, hi = s2[q], sp["p2.5"][q], sp["p97.5"][q]
-        out.append("no value" if not math.isfinite(v) else "inside" if lo <= v <= hi else
-                   "x%.2f of the top" % (v / hi) if v > hi else "%+.1f %%" % (100 * (v - lo) / lo))
+        r = rel_outside(s2[q], sp["p2.5"][q], sp["p97.5"][q])
+        out.append("no value" if r is None else "inside" if r == 0 else
+                   "x%.2f of the top" % (1 + r) if r > 0 else "%+.1f %%" % (100 * r))
     if "rms_outside" not in sp:
         out.append("-")
     elif not math.isfinite(sp["rms_outside"]):
