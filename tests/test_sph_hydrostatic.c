@@ -7,20 +7,23 @@
  *   - the floor carries the weight of the water within 0.5 %;
  *   - the pressure profile at gauges on the centre line (kernel support above the floor to h
  *     below the surface) within 1 % of rho0 g H (RMS) and 1.5 % (max);
- *   - no particle crossed a wall, the free surface stays level (height spread < dx/2) and the
- *     kinetic energy has decayed (|v|max < 1 % of sqrt(g H)).
+ *   - no particle crossed a wall, the free surface stays level and at the depth H (level gauges,
+ *     sph_probes_level, at every dx a kernel support away from the side walls: spread < dx/2,
+ *     each within dx/4 of H) and the kinetic energy has decayed (|v|max < 1 % of sqrt(g H)).
  * usage: test_sph_hydrostatic [NY [T [ghost [riemann [ETA]]]]] (riemann: sph.scheme riemann, Zhang et al.
  * 2017, instead of the artificial viscosity, with the limiter eta = ETA, default 3; the same bounds). With "ghost" the walls carry the pressure of ghost
  * layers (LAHAR_SPH_WALL_PRESSURE_GHOST, sph_coupling.h) and the gauges start at dx/2 above the floor,
  * where the penalty wall alone reads +13 % of rho0 g H at 1.5 dx: the same bounds hold there; the
  * side walls then carry part of the weight (the ghosts beside a particle complete its vertical
- * pressure gradient), so the floor plus the side walls' vertical forces must carry it (0.5 %). */
+ * pressure gradient), so the floor plus the side walls' vertical forces must carry it (0.5 %).
+ * Environment: SPH_ROWS=1 prints each pressure gauge, SPH_LEVELS=1 each level gauge. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "shape_build.h"
 #include "sph_fluid.h"
+#include "sph_probes.h"
 
 #include "test_util.h"
 
@@ -128,19 +131,26 @@ int main(int argc, char **argv)
         rows++;
     }
     rms = sqrt(rms / rows);
-    double top[20]; /* column tops, columns of dx across the tank */
-    for (int c = 0; c < NX; c++)
-        top[c] = -1e9;
-    for (int64_t i = 0; i < f.p.n; i++) {
+    /* the free surface: the level gauge of the case's `kind: level` probes (sph_probes_level: where
+     * the water's kernel fraction falls to 1/2 going up from the floor) at every dx across the
+     * middle of the tank, a kernel support away from the side walls (whose ghosts it does not
+     * count). Not the top particle per dx-wide bin: when the surface row shifts sideways a bin
+     * loses its top particle and reads a dip of a whole dx on a level surface. */
+    double phi[400];
+    const double lstep = dx / 8.0;
+    const int lnpt = (int)(1.5 * H / lstep) + 1;
+    if (lnpt > (int)(sizeof phi / sizeof phi[0]))
+        abort();
+    for (double gx = f.k.support; gx <= W - f.k.support + 1e-12; gx += dx) {
+        const double foot[3] = {gx, 0.0, 0.0};
+        const double level = sph_probes_level(&f, foot, lnpt, lstep, phi);
+        if (getenv("SPH_LEVELS"))
+            printf("level at x %.4f: %.5f m (%+.3f dx from H)\n", gx, level, (level - H) / dx);
+        ytop_min = fmin(ytop_min, level);
+        ytop_max = fmax(ytop_max, level);
+    }
+    for (int64_t i = 0; i < f.p.n; i++)
         vmax = fmax(vmax, hypot(f.p.vx[i], f.p.vy[i]));
-        int c = (int)floor(f.p.x[i] / dx);
-        c = c < 0 ? 0 : (c >= NX ? NX - 1 : c);
-        top[c] = fmax(top[c], f.p.y[i]);
-    }
-    for (int c = 0; c < NX; c++) {
-        ytop_min = fmin(ytop_min, top[c]);
-        ytop_max = fmax(ytop_max, top[c]);
-    }
     printf("hydrostatic 2D, %d x %d particles, %d steps to t = %.2f s (dt %.3g s):\n", NX, NY, steps, f.t,
            sph_fluid_dt(&f));
     printf("  side walls %.5g, %.5g N/m vs rho g H^2/2 = %.5g (%+.3f %%, %+.3f %%)\n", fl, fr, f_wall,
@@ -148,7 +158,7 @@ int main(int argc, char **argv)
     printf("  floor%s %.5g N/m vs weight %.5g (%+.3f %%; side walls %.3g N/m); pressure gauges from %.2g dx: RMS %.3f %%, "
            "max %.3f %% of rho g H\n", ghost ? " + side walls" : "", ff, weight, 100 * (ff / weight - 1), fside,
            ghost ? 0.5 : f.k.support / dx, 100 * rms, 100 * worst);
-    printf("  |v|max %.3g m/s, column tops spread %.3g m, crossings %lld\n", vmax, ytop_max - ytop_min,
+    printf("  |v|max %.3g m/s, free surface spread %.3g m (level gauges), crossings %lld\n", vmax, ytop_max - ytop_min,
            (long long)crossings);
     CHECK(fabs(fl / f_wall - 1) <= 0.01 && fabs(fr / f_wall - 1) <= 0.01, "side wall force off rho g H^2/2 by > 1 %%");
     CHECK(fabs(ff / weight - 1) <= 0.005, "floor force off the weight by > 0.5 %%");
@@ -156,6 +166,8 @@ int main(int argc, char **argv)
           100 * worst);
     CHECK(crossings == 0, "%lld wall crossings", (long long)crossings);
     CHECK(ytop_max - ytop_min < 0.5 * dx, "free surface not level (spread %g m)", ytop_max - ytop_min);
+    CHECK(fabs(ytop_min - H) < 0.25 * dx && fabs(ytop_max - H) < 0.25 * dx,
+          "free surface moved off the water's depth H = %g m (levels %g to %g m; bound dx/4)", H, ytop_min, ytop_max);
     CHECK(vmax < 0.01 * sqrt(g * H), "not settled: |v|max %g m/s", vmax);
     sph_fluid_free(&f);
     for (int b = 0; b < 3; b++)
