@@ -22,7 +22,7 @@ target_include_directories(lahar_dem_pile PUBLIC ${LAHAR_TEST_DIR} ${LAHAR_TEST_
 target_link_libraries(lahar_dem_pile PUBLIC lahar_dem)
 
 # No allocation inside advance() in the steady state: malloc & co. wrapped by the linker.
-add_executable(test_dem_noalloc ${LAHAR_TEST_DIR}/test_dem_noalloc.c)
+add_executable(test_dem_noalloc ${LAHAR_TEST_DIR}/test_dem_noalloc.c ${LAHAR_TEST_DIR}/alloc_count.c)
 target_link_libraries(test_dem_noalloc PRIVATE lahar_dem_pile
   -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
 lahar_test(test_dem_noalloc COMMAND test_dem_noalloc LABELS fast dem TIMEOUT 300)

@@ -9,7 +9,7 @@ add_custom_target(bench_sph_table COMMAND bench_sph DEPENDS bench_sph WORKING_DI
 add_dependencies(bench bench_sph_table)
 
 # No allocation inside the SPH step in the steady state: malloc & co. wrapped by the linker.
-add_executable(test_sph_noalloc ${LAHAR_TEST_DIR}/test_sph_noalloc.c)
+add_executable(test_sph_noalloc ${LAHAR_TEST_DIR}/test_sph_noalloc.c ${LAHAR_TEST_DIR}/alloc_count.c ${LAHAR_TEST_DIR}/test_bodies.c)
 target_link_libraries(test_sph_noalloc PRIVATE lahar_sph -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free)
 lahar_test(sph_noalloc COMMAND test_sph_noalloc LABELS fast perf sph TIMEOUT 120
   ENVIRONMENT "OMP_NUM_THREADS=2")

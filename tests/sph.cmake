@@ -15,10 +15,10 @@ lahar_test(sph_riemann PROGRAM test_sph_riemann SOURCES test_sph_riemann.c LIBS 
 lahar_test(sph_coupling PROGRAM test_sph_coupling SOURCES test_sph_coupling.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 
-lahar_test(sph_hydrostatic PROGRAM test_sph_hydrostatic SOURCES test_sph_hydrostatic.c
+lahar_test(sph_hydrostatic PROGRAM test_sph_hydrostatic SOURCES test_sph_hydrostatic.c test_bodies.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 
-lahar_test(sph_hydrostatic3d PROGRAM test_sph_hydrostatic3d SOURCES test_sph_hydrostatic3d.c
+lahar_test(sph_hydrostatic3d PROGRAM test_sph_hydrostatic3d SOURCES test_sph_hydrostatic3d.c test_bodies.c
   LIBS lahar_sph ARGS 10 3 ghost LABELS slow sph TIMEOUT 600)
 
 lahar_test(sph_couette PROGRAM test_sph_couette SOURCES test_sph_couette.c
@@ -26,10 +26,10 @@ lahar_test(sph_couette PROGRAM test_sph_couette SOURCES test_sph_couette.c
 
 # SPS turbulence: nu_t of a uniform shear, zero force of a constant stress, a shear wave
 # against the analytic divergence, a dam break that stays stable.
-lahar_test(sph_sps PROGRAM test_sph_sps SOURCES test_sph_sps.c LIBS lahar_sph LABELS fast sph TIMEOUT 120)
+lahar_test(sph_sps PROGRAM test_sph_sps SOURCES test_sph_sps.c test_bodies.c LIBS lahar_sph LABELS fast sph TIMEOUT 120)
 
 # Split step: step_begin + step_end integrate at second order in time (observed order at dt, dt/2, dt/4).
-lahar_test(sph_split PROGRAM test_sph_split SOURCES test_sph_split.c
+lahar_test(sph_split PROGRAM test_sph_split SOURCES test_sph_split.c test_bodies.c
   LIBS lahar_sph LABELS fast sph TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=2")
 
 # Open boundaries (sph_node/inflow/sph_inflow.h): discharge through an inlet against the Gumbel
@@ -37,4 +37,4 @@ lahar_test(sph_split PROGRAM test_sph_split SOURCES test_sph_split.c
 # inlet, mass balance, outflow counts, unique ids, the capacity error, a supercritical channel at
 # its steady depth, saturated soil and water leaving through an outlet and the domain box (removed
 # and counted with their mass per phase).
-lahar_test(sph_inflow PROGRAM test_sph_inflow SOURCES test_sph_inflow.c LIBS lahar_sph LABELS fast sph TIMEOUT 300)
+lahar_test(sph_inflow PROGRAM test_sph_inflow SOURCES test_sph_inflow.c test_bodies.c LIBS lahar_sph LABELS fast sph TIMEOUT 300)

@@ -20,55 +20,25 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "dem_pile.h"
+#include "alloc_count.h"
 #include "dem_test_util.h"
-
-void *__real_malloc(size_t n);
-void *__real_calloc(size_t n, size_t size);
-void *__real_realloc(void *p, size_t n);
-void __real_free(void *p);
-
-/* volatile: the compiler knows malloc/free touch no program variable and would otherwise drop
- * the stores around them */
-static volatile int counting;
-static volatile long nalloc, nfree;
-
-void *__wrap_malloc(size_t n)
-{
-    if (counting) nalloc++;
-    return __real_malloc(n);
-}
-void *__wrap_calloc(size_t n, size_t size)
-{
-    if (counting) nalloc++;
-    return __real_calloc(n, size);
-}
-void *__wrap_realloc(void *p, size_t n)
-{
-    if (counting) nalloc++;
-    return __real_realloc(p, n);
-}
-void __wrap_free(void *p)
-{
-    if (counting && p) nfree++;
-    __real_free(p);
-}
 
 /* nsteps coordinator steps of 1 ms; returns the allocations + frees made inside advance. */
 static long steps_counted(const lahar_dem_engine_ops *ops, lahar_dem_engine *e, int nsteps, long *nsub)
 {
     char err[512];
-    long before = nalloc + nfree;
+    long before = alloc_nalloc + alloc_nfree;
     for (int k = 0; k < nsteps; k++) {
-        counting = 1;
+        alloc_counting = 1;
         int n = ops->advance(e, 1e-3, NULL, err, sizeof err);
-        counting = 0;
+        alloc_counting = 0;
         if (n < 0) {
             dem_test_check(0, "advance: %s", err);
             break;
         }
         *nsub += n;
     }
-    return nalloc + nfree - before;
+    return alloc_nalloc + alloc_nfree - before;
 }
 
 /* Engine of case c on `threads` threads continuing from the state of engine e (restart). */
@@ -126,11 +96,11 @@ int main(void)
 {
     /* the counters see this binary's calls: check that the wrapping is really in place */
     volatile size_t sz = 16; /* volatile: keep the compiler from eliding the pair */
-    counting = 1;
+    alloc_counting = 1;
     void *volatile p = malloc(sz);
     free(p);
-    counting = 0;
-    dem_test_check(nalloc == 1 && nfree == 1, "malloc/free are counted (--wrap works): %ld, %ld", nalloc, nfree);
+    alloc_counting = 0;
+    dem_test_check(alloc_nalloc == 1 && alloc_nfree == 1, "malloc/free are counted (--wrap works): %ld, %ld", alloc_nalloc, alloc_nfree);
     pile_check(120, 2, 1, 0.3, 0.1);
     pile_check(560, 1, 2, 0.15, 0.02);
     return dem_test_failures ? 1 : 0;

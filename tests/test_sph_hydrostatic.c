@@ -25,21 +25,8 @@
 #include "sph_fluid.h"
 #include "sph_probes.h"
 
+#include "test_bodies.h"
 #include "test_util.h"
-
-/* A fixed wall: 2D box with world-frame vertices, swept radius R. */
-static void wall(lahar_body *b, double cx, double cy, double hx, double hy)
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.005;
-    double half[2] = {hx - R, hy - R}, t[3] = {cx, cy, 0};
-    if (lahar_shape_make_box2d(&b->shape, half, R) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, t, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
 
 int main(int argc, char **argv)
 {
@@ -77,9 +64,9 @@ int main(int argc, char **argv)
         f.p.m[i] = f.p.rho[i] * dx * dx;
     }
     lahar_body walls[3];
-    wall(&walls[0], W / 2, -0.05, W / 2 + 0.2, 0.05);  /* floor, surface y = 0 */
-    wall(&walls[1], -0.05, H, 0.05, H + 0.1);         /* left, surface x = 0 */
-    wall(&walls[2], W + 0.05, H, 0.05, H + 0.1);      /* right, surface x = W */
+    test_fixed_box2d(&walls[0], W / 2, -0.05, W / 2 + 0.2, 0.05, 0.005);  /* floor, surface y = 0 */
+    test_fixed_box2d(&walls[1], -0.05, H, 0.05, H + 0.1, 0.005);         /* left, surface x = 0 */
+    test_fixed_box2d(&walls[2], W + 0.05, H, 0.05, H + 0.1, 0.005);      /* right, surface x = W */
     if (sph_fluid_attach_bodies(&f, 3, walls) != 0)
         return 1;
     int64_t crossings = 0;

@@ -20,20 +20,8 @@
 #include "shape_build.h"
 #include "sph_fluid.h"
 
+#include "test_bodies.h"
 #include "test_util.h"
-
-static void wall(lahar_body *b, const double c[3], const double outer_half[3])
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.005;
-    double half[3] = {outer_half[0] - R, outer_half[1] - R, outer_half[2] - R};
-    if (lahar_shape_make_box(&b->shape, half, R) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, c, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
 
 int main(int argc, char **argv)
 {
@@ -76,11 +64,11 @@ int main(int argc, char **argv)
     double c2[3] = {W + t, W / 2, H}, h2[3] = {t, W / 2 + e, H + e};
     double c3[3] = {W / 2, -t, H}, h3[3] = {W / 2 + e, t, H + e};
     double c4[3] = {W / 2, W + t, H}, h4[3] = {W / 2 + e, t, H + e};
-    wall(&walls[0], c0, h0); /* floor, surface z = 0 */
-    wall(&walls[1], c1, h1); /* x = 0 */
-    wall(&walls[2], c2, h2); /* x = W */
-    wall(&walls[3], c3, h3); /* y = 0 */
-    wall(&walls[4], c4, h4); /* y = W */
+    test_fixed_box(&walls[0], 3, c0, h0, 0.005); /* floor, surface z = 0 */
+    test_fixed_box(&walls[1], 3, c1, h1, 0.005); /* x = 0 */
+    test_fixed_box(&walls[2], 3, c2, h2, 0.005); /* x = W */
+    test_fixed_box(&walls[3], 3, c3, h3, 0.005); /* y = 0 */
+    test_fixed_box(&walls[4], 3, c4, h4, 0.005); /* y = W */
     if (sph_fluid_attach_bodies(&f, 5, walls) != 0)
         return 1;
     int64_t crossings = 0;

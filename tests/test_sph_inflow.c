@@ -47,27 +47,10 @@
 #include "shape_build.h"
 #include "sph_inflow.h"
 
+#include "test_bodies.h"
 #include "test_util.h"
 
 static const double G = 9.81;
-
-static void wall(lahar_body *b, const double lo[3], const double hi[3])
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.002;
-    double half[3], t[3];
-    for (int a = 0; a < 3; a++) {
-        half[a] = 0.5 * (hi[a] - lo[a]) - R;
-        t[a] = 0.5 * (hi[a] + lo[a]);
-    }
-    t[2] = 0.0;
-    if (lahar_shape_make_box2d(&b->shape, half, R) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, t, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
 
 /* The water of every test here: 2D, Wendland C2 with h = 1.41 dx, rho0 = 1000, mu = 1e-3,
  * Monaghan alpha 0.02, delta-SPH 0.1. */
@@ -113,7 +96,7 @@ static int channel_open(channel *ch, double dx, double h, double L, double c0, l
     if (sph_fluid_init(&ch->f, &prm, cap, err, errlen) != 0)
         return -1;
     const double wlo[3] = {-0.2, -0.05, 0.0}, whi[3] = {L, 0.0, 0.0};
-    wall(&ch->floor, wlo, whi);
+    test_fixed_box_lohi(&ch->floor, 2, wlo, whi, 0.002);
     if (sph_fluid_attach_bodies(&ch->f, 1, &ch->floor) != 0 || sph_inflow_start(&ch->fl, &ch->f, 0.0, err, errlen) != 0 ||
         sph_cells_sort(&ch->f.cells, &ch->f.p) != 0 || sph_fluid_rates(&ch->f, NULL, 0.25 * ch->f.k.h / c0) < 0)
         return -1;

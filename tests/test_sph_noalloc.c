@@ -23,80 +23,31 @@
 #include "shape_build.h"
 #include "sph_fluid.h"
 
+#include "alloc_count.h"
+#include "test_bodies.h"
 #include "test_util.h"
-
-void *__real_malloc(size_t n);
-void *__real_calloc(size_t n, size_t size);
-void *__real_realloc(void *p, size_t n);
-void __real_free(void *p);
-
-/* volatile: the compiler knows malloc/free touch no program variable and would otherwise drop
- * the stores around them */
-static volatile int counting;
-static volatile long nalloc, nfree;
-
-void *__wrap_malloc(size_t n)
-{
-    if (counting) nalloc++;
-    return __real_malloc(n);
-}
-void *__wrap_calloc(size_t n, size_t size)
-{
-    if (counting) nalloc++;
-    return __real_calloc(n, size);
-}
-void *__wrap_realloc(void *p, size_t n)
-{
-    if (counting) nalloc++;
-    return __real_realloc(p, n);
-}
-void __wrap_free(void *p)
-{
-    if (counting && p) nfree++;
-    __real_free(p);
-}
-
-/* A fixed wall: box [lo, hi) in world coordinates, swept radius R. */
-static void wall(lahar_body *b, int dim, const double lo[3], const double hi[3])
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.002;
-    double half[3], t[3];
-    for (int a = 0; a < 3; a++) {
-        half[a] = 0.5 * (hi[a] - lo[a]) - R;
-        t[a] = 0.5 * (hi[a] + lo[a]);
-    }
-    if (dim == 2)
-        t[2] = 0.0;
-    if ((dim == 2 ? lahar_shape_make_box2d(&b->shape, half, R) : lahar_shape_make_box(&b->shape, half, R)) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, t, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
 
 /* nsteps steps of the solver's own dt, the disc (body `moving`, or -1) moved down at 0.5 m/s;
  * returns the allocation calls made inside them. */
 static long steps(sph_fluid *f, int nsteps, lahar_body_state *states, int moving, int count)
 {
-    long before = nalloc + nfree;
+    long before = alloc_nalloc + alloc_nfree;
     for (int k = 0; k < nsteps; k++) {
         double dt = sph_fluid_dt(f);
         if (moving >= 0) {
             states[moving].v[1] = -0.5;
             states[moving].x[1] -= 0.5 * dt;
         }
-        counting = count;
+        alloc_counting = count;
         int64_t c;
         if (k % 2)
             c = sph_fluid_step(f, dt, states);
         else
             c = sph_fluid_step_begin(f, dt) == 0 ? sph_fluid_step_end(f, dt, states) : -1;
-        counting = 0;
+        alloc_counting = 0;
         CHECK(c == 0, "step %d: %lld (crossings, or -1 for an error)", k, (long long)c);
     }
-    return nalloc + nfree - before;
+    return alloc_nalloc + alloc_nfree - before;
 }
 
 /* Scene: water block [0, wlo..whi) of spacing dx in a tank [0, tank) of fixed walls (+ a disc in
@@ -141,7 +92,7 @@ static void scene(const char *name, int dim, double dx, const double water[3], c
         double l[3][3] = {{-T, -T, 0}, {-T, 0, 0}, {tank[0], 0, 0}};
         double u[3][3] = {{tank[0] + T, 0, 0}, {0, top, 0}, {tank[0] + T, top, 0}};
         for (; nb < 3; nb++)
-            wall(&bodies[nb], 2, l[nb], u[nb]);
+            test_fixed_box_lohi(&bodies[nb], 2, l[nb], u[nb], 0.002);
     } else {
         double l[5][3] = {{-T, -T, -T}, {-T, -T, 0}, {tank[0], -T, 0}, {-T, -T, 0}, {-T, tank[1], 0}};
         double u[5][3] = {{tank[0] + T, tank[1] + T, 0},
@@ -150,7 +101,7 @@ static void scene(const char *name, int dim, double dx, const double water[3], c
                           {tank[0] + T, 0, top},
                           {tank[0] + T, tank[1] + T, top}};
         for (; nb < 5; nb++)
-            wall(&bodies[nb], 3, l[nb], u[nb]);
+            test_fixed_box_lohi(&bodies[nb], 3, l[nb], u[nb], 0.002);
     }
     int moving = -1;
     if (disc) {
@@ -197,11 +148,11 @@ int main(void)
 {
     /* the counters see this binary's calls: check that the wrapping is really in place */
     volatile size_t sz = 16; /* volatile: keep the compiler from eliding the pair */
-    counting = 1;
+    alloc_counting = 1;
     void *volatile p = malloc(sz);
     free(p);
-    counting = 0;
-    CHECK(nalloc == 1 && nfree == 1, "malloc/free are counted (--wrap works): %ld, %ld", nalloc, nfree);
+    alloc_counting = 0;
+    CHECK(alloc_nalloc == 1 && alloc_nfree == 1, "malloc/free are counted (--wrap works): %ld, %ld", alloc_nalloc, alloc_nfree);
     const double wa[3] = {0.3, 0.2, 0}, ta[3] = {0.3, 0.4, 0};
     scene("A 2D disc SPS", 2, 0.005, wa, ta, 1, 1, LAHAR_SPH_EOS_LINEAR, 10, 30);
     const double wb[3] = {0.46, 0.46, 0}, tb[3] = {0.46, 0.6, 0};

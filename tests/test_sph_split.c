@@ -16,20 +16,8 @@
 #include "shape_build.h"
 #include "sph_fluid.h"
 
+#include "test_bodies.h"
 #include "test_util.h"
-
-static void wall(lahar_body *b, double cx, double cy, double hx, double hy)
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.005;
-    double half[2] = {hx - R, hy - R}, t[3] = {cx, cy, 0};
-    if (lahar_shape_make_box2d(&b->shape, half, R) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, t, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
 
 #define NP 2400
 
@@ -66,9 +54,9 @@ static int setup(sph_fluid *f, int sps, lahar_body *bodies)
 static int run_to(int sps, int nstep, double T, double *xy, double *fy, int64_t *crossed, int *refused)
 {
     lahar_body bodies[4];
-    wall(&bodies[0], 0.15, -0.05, 0.35, 0.05);
-    wall(&bodies[1], -0.05, 0.2, 0.05, 0.3);
-    wall(&bodies[2], 0.35, 0.2, 0.05, 0.3);
+    test_fixed_box2d(&bodies[0], 0.15, -0.05, 0.35, 0.05, 0.005);
+    test_fixed_box2d(&bodies[1], -0.05, 0.2, 0.05, 0.3, 0.005);
+    test_fixed_box2d(&bodies[2], 0.35, 0.2, 0.05, 0.3, 0.005);
     memset(&bodies[3], 0, sizeof bodies[3]);
     if (lahar_shape_make_sphere(&bodies[3].shape, 0.03) != 0)
         abort();

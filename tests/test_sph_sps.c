@@ -21,6 +21,7 @@
 #include "shape_build.h"
 #include "sph_fluid.h"
 
+#include "test_bodies.h"
 #include "test_util.h"
 
 static const double DX = 0.01, RHO0 = 1000.0, CS = 0.12;
@@ -156,19 +157,6 @@ static void check_shear_wave(void)
     sph_fluid_free(&f);
 }
 
-static void wall(lahar_body *b, double cx, double cy, double hx, double hy)
-{
-    memset(b, 0, sizeof *b);
-    const double R = 0.005;
-    double half[2] = {hx - R, hy - R}, t[3] = {cx, cy, 0};
-    if (lahar_shape_make_box2d(&b->shape, half, R) != 0)
-        abort();
-    lahar_shape_transform(&b->shape, NULL, t, 1.0);
-    b->motion = LAHAR_MOTION_FIXED;
-    b->convex = 1;
-    b->q[0] = 1.0;
-}
-
 /* 3. dam break with SPS on */
 static void check_dam_break(void)
 {
@@ -194,9 +182,9 @@ static void check_dam_break(void)
     double lo[3] = {0, 0, 0}, hi[3] = {W, H, 0}, v0[3] = {0, 0, 0};
     sph_particles_add_box(&f.p, 2, DX, RHO0, lo, hi, v0);
     lahar_body walls[3];
-    wall(&walls[0], TANK / 2, -0.05, TANK / 2 + 0.2, 0.05);
-    wall(&walls[1], -0.05, H, 0.05, H + 0.1);
-    wall(&walls[2], TANK + 0.05, H, 0.05, H + 0.1);
+    test_fixed_box2d(&walls[0], TANK / 2, -0.05, TANK / 2 + 0.2, 0.05, 0.005);
+    test_fixed_box2d(&walls[1], -0.05, H, 0.05, H + 0.1, 0.005);
+    test_fixed_box2d(&walls[2], TANK + 0.05, H, 0.05, H + 0.1, 0.005);
     if (sph_fluid_attach_bodies(&f, 3, walls) != 0) {
         CHECK(0, "attach failed");
         sph_fluid_free(&f);
