@@ -11,6 +11,7 @@
 #         busy_machine
 set -u
 test_name=$1 bin=$2 tools=$3 work=$4
+here=$(cd "$(dirname "$0")" && pwd) # tests/: two_hosts.sh
 python=/usr/bin/python3
 [ -x "$python" ] || python=python3
 rm -rf "$work"
@@ -284,20 +285,8 @@ cross_host)
     reference
     unshare --user --map-root-user --net bash -c "
         set -e
-        ip link set lo up
-        unshare --net sleep 600 & host_b=\$!
-        trap 'kill \$host_b 2>/dev/null' EXIT
-        for _ in \$(seq 50); do [ \"\$(readlink /proc/\$host_b/ns/net)\" != \"\$(readlink /proc/self/ns/net)\" ] && break; sleep 0.02; done
-        ip link add lahar_a type veth peer name lahar_b netns \$host_b
-        ip addr add 10.231.7.1/24 dev lahar_a
-        ip link set lahar_a up multicast on
-        ip route add 224.0.0.0/4 dev lahar_a
-        nsenter --net=/proc/\$host_b/ns/net sh -c '
-            ip link set lo up
-            ip addr add 10.231.7.2/24 dev lahar_b
-            ip link set lahar_b up multicast on
-            ip route add 224.0.0.0/4 dev lahar_b'
-        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' & dem=\$!
+        . '$here/two_hosts.sh'
+        nsenter --net=\$host_b_ns '$bin/lahar-dem' --lcm-url '$URL_LINK' & dem=\$!
         '$bin/lahar' run case.yaml -o xhost -q --no-spawn --lcm-url '$URL_LINK'
         wait \$dem" || fail "cross-host run failed"
     same_as_reference xhost
@@ -313,24 +302,11 @@ cross_host_auth)
     "$bin/lahar" run case.yaml -o ref --in-process -q || fail "in-process reference run failed"
     "$bin/lahar" keygen run.key > /dev/null || fail "lahar keygen failed"
     [ "$(stat -c %a run.key)" = 600 ] || fail "the key file is not mode 0600"
-    hosts="
-        ip link set lo up
-        unshare --net sleep 600 & host_b=\$!
-        trap 'kill \$host_b 2>/dev/null' EXIT
-        for _ in \$(seq 50); do [ \"\$(readlink /proc/\$host_b/ns/net)\" != \"\$(readlink /proc/self/ns/net)\" ] && break; sleep 0.02; done
-        ip link add lahar_a type veth peer name lahar_b netns \$host_b
-        ip addr add 10.231.7.1/24 dev lahar_a
-        ip link set lahar_a up multicast on
-        ip route add 224.0.0.0/4 dev lahar_a
-        nsenter --net=/proc/\$host_b/ns/net sh -c '
-            ip link set lo up
-            ip addr add 10.231.7.2/24 dev lahar_b
-            ip link set lahar_b up multicast on
-            ip route add 224.0.0.0/4 dev lahar_b'"
+    hosts=". '$here/two_hosts.sh'"
     unshare --user --map-root-user --net bash -c "
         set -e
         $hosts
-        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --auth-key run.key & dem=\$!
+        nsenter --net=\$host_b_ns '$bin/lahar-dem' --lcm-url '$URL_LINK' --auth-key run.key & dem=\$!
         '$LAHAR_ATTACK' '$URL_LINK' 3 > attack.txt & attacker=\$!
         '$bin/lahar' run case.yaml -o auth -q --no-spawn --lcm-url '$URL_LINK' --auth-key run.key
         wait \$dem
@@ -344,7 +320,7 @@ cross_host_auth)
     [ "$rejected" -gt 0 ] && [ "$replayed" -gt 0 ] || fail "the hostile frames were not counted (rejected $rejected, replayed $replayed)"
     unshare --user --map-root-user --net bash -c "
         $hosts
-        nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --wait 5 > /dev/null 2>&1 & dem=\$!
+        nsenter --net=\$host_b_ns '$bin/lahar-dem' --lcm-url '$URL_LINK' --wait 5 > /dev/null 2>&1 & dem=\$!
         set +e
         '$bin/lahar' run case.yaml -o keyless -q --no-spawn --lcm-url '$URL_LINK' --auth-key run.key --wait 3 2> keyless.txt
         echo \$? > keyless_rc.txt

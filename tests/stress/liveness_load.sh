@@ -213,20 +213,8 @@ if has_phase xhost; then
         out="xhost_$i"
         unshare --user --map-root-user --net bash -c "
             set -e
-            ip link set lo up
-            unshare --net sleep 600 & host_b=\$!
-            trap 'kill \$host_b 2>/dev/null' EXIT
-            for _ in \$(seq 50); do [ \"\$(readlink /proc/\$host_b/ns/net)\" != \"\$(readlink /proc/self/ns/net)\" ] && break; sleep 0.02; done
-            ip link add lahar_a type veth peer name lahar_b netns \$host_b
-            ip addr add 10.231.7.1/24 dev lahar_a
-            ip link set lahar_a up multicast on
-            ip route add 224.0.0.0/4 dev lahar_a
-            nsenter --net=/proc/\$host_b/ns/net sh -c '
-                ip link set lo up
-                ip addr add 10.231.7.2/24 dev lahar_b
-                ip link set lahar_b up multicast on
-                ip route add 224.0.0.0/4 dev lahar_b'
-            nsenter --net=/proc/\$host_b/ns/net '$bin/lahar-dem' --lcm-url '$URL_LINK' --threads 2 2> $out.dem.stderr & dem=\$!
+            . '$here/../two_hosts.sh'
+            nsenter --net=\$host_b_ns '$bin/lahar-dem' --lcm-url '$URL_LINK' --threads 2 2> $out.dem.stderr & dem=\$!
             '$bin/lahar-sph' --lcm-url '$URL_LINK' --threads 2 2> $out.sph.stderr & sph=\$!
             '$bin/lahar' run debris_long.yaml -o $out --overwrite -q --no-spawn --lcm-url '$URL_LINK' 2> $out.stderr & coord=\$!
             for _ in \$(seq 600); do [ -e $out/bodies.h5 ] && break; sleep 0.05; done
