@@ -172,7 +172,7 @@ static const lahar_key sph_keys[] = {
     {"transport_velocity", LAHAR_KEY_BOOL, 0, "false", 0, 0, 0, bools, "", "transport-velocity formulation (Adami et al. 2013): fully periodic water-only flows", NULL},
     {"body_layers", LAHAR_KEY_WHOLE, 0, "0", LO | HI, 0, 8, NULL, "", "particles within N dx of sphere/disc bodies start on N concentric layers; 0 = the plain lattice, 2-3 usual", NULL},
     {"scheme", LAHAR_KEY_CHOICE, 0, "delta", 0, 0, 0, scheme_names, "", "delta: delta-SPH + artificial viscosity; riemann: the low-dissipation Riemann solver of Zhang, Hu & Adams 2017 (alpha and delta then 0)", NULL},
-    {"riemann_limiter", LAHAR_KEY_NUMBER, 0, "3", LO | HI, 0, 100, NULL, "", "eta of the Riemann scheme's dissipation limiter beta = min(eta max(dU, 0), c0); 3 as in Zhang et al. 2017 (low dissipation: still water keeps sloshing), 0 = no limiter (the full acoustic dissipation: a tank at rest settles)", NULL},
+    {"riemann_limiter", LAHAR_KEY_NUMBER, 0, "3", LO | HI, 0, 100, NULL, "", "eta of the Riemann scheme's dissipation limiter beta = min(eta max(dU, 0), c0); 3 as in Zhang et al. 2017 (low dissipation: the start-up waves of water at rest take about three times as long to settle), 0 = no limiter (the full acoustic dissipation: a tank at rest settles as fast as with delta-SPH, impacts are braked)", NULL},
     {"blocks", LAHAR_KEY_LIST, 1, NULL, 0, 0, 0, NULL, "", "regions filled with particles (non-empty)", NULL},
     END};
 
