@@ -99,7 +99,7 @@ int main(int argc, char **argv)
      * h below the surface (as DualSPHysics' MeasureTool): Shepard-normalised kernel interpolation
      * sum p_j V_j W / sum V_j W. Closer to the floor the particles pressed against the penalty
      * wall read high (+13 % of rho g H at 1.5 dx): no wall particles complete their kernel. */
-    double rms = 0.0, worst = 0.0, vmax = 0.0, ytop_min = 1e9, ytop_max = -1e9;
+    double rms = 0.0, worst = 0.0, vmax = 0.0, level_min = 1e9, level_max = -1e9;
     int rows = 0;
     for (double gy = ghost ? 0.5 * dx : f.k.support; gy <= H - f.k.h; gy += dx) {
         double num = 0.0, den = 0.0, ref = 0.0;
@@ -128,19 +128,20 @@ int main(int argc, char **argv)
      * middle of the tank, a kernel support away from the side walls (whose ghosts it does not
      * count). Not the top particle per dx-wide bin: when the surface row shifts sideways a bin
      * loses its top particle and reads a dip of a whole dx on a level surface. */
-    double phi[400];
     const double lstep = dx / 8.0;
     const int lnpt = (int)(1.5 * H / lstep) + 1;
-    if (lnpt > (int)(sizeof phi / sizeof phi[0]))
+    double *phi = malloc((size_t)lnpt * sizeof *phi);
+    if (!phi)
         abort();
     for (double gx = f.k.support; gx <= W - f.k.support + 1e-12; gx += dx) {
         const double foot[3] = {gx, 0.0, 0.0};
         const double level = sph_probes_level(&f, foot, lnpt, lstep, phi);
         if (getenv("SPH_LEVELS"))
             printf("level at x %.4f: %.5f m (%+.3f dx from H)\n", gx, level, (level - H) / dx);
-        ytop_min = fmin(ytop_min, level);
-        ytop_max = fmax(ytop_max, level);
+        level_min = fmin(level_min, level);
+        level_max = fmax(level_max, level);
     }
+    free(phi);
     for (int64_t i = 0; i < f.p.n; i++)
         vmax = fmax(vmax, hypot(f.p.vx[i], f.p.vy[i]));
     printf("hydrostatic 2D, %d x %d particles, %d steps to t = %.2f s (dt %.3g s):\n", NX, NY, steps, f.t,
@@ -150,16 +151,16 @@ int main(int argc, char **argv)
     printf("  floor%s %.5g N/m vs weight %.5g (%+.3f %%; side walls %.3g N/m); pressure gauges from %.2g dx: RMS %.3f %%, "
            "max %.3f %% of rho g H\n", ghost ? " + side walls" : "", ff, weight, 100 * (ff / weight - 1), fside,
            ghost ? 0.5 : f.k.support / dx, 100 * rms, 100 * worst);
-    printf("  |v|max %.3g m/s, free surface spread %.3g m (level gauges), crossings %lld\n", vmax, ytop_max - ytop_min,
+    printf("  |v|max %.3g m/s, free surface spread %.3g m (level gauges), crossings %lld\n", vmax, level_max - level_min,
            (long long)crossings);
     CHECK(fabs(fl / f_wall - 1) <= 0.01 && fabs(fr / f_wall - 1) <= 0.01, "side wall force off rho g H^2/2 by > 1 %%");
     CHECK(fabs(ff / weight - 1) <= 0.005, "floor force off the weight by > 0.5 %%");
     CHECK(rms <= 0.01 && worst <= 0.015, "pressure profile off hydrostatic (RMS %.3f %%, max %.3f %%)", 100 * rms,
           100 * worst);
     CHECK(crossings == 0, "%lld wall crossings", (long long)crossings);
-    CHECK(ytop_max - ytop_min < 0.5 * dx, "free surface not level (spread %g m)", ytop_max - ytop_min);
-    CHECK(fabs(ytop_min - H) < 0.25 * dx && fabs(ytop_max - H) < 0.25 * dx,
-          "free surface moved off the water's depth H = %g m (levels %g to %g m; bound dx/4)", H, ytop_min, ytop_max);
+    CHECK(level_max - level_min < 0.5 * dx, "free surface not level (spread %g m)", level_max - level_min);
+    CHECK(fabs(level_min - H) < 0.25 * dx && fabs(level_max - H) < 0.25 * dx,
+          "free surface moved off the water's depth H = %g m (levels %g to %g m; bound dx/4)", H, level_min, level_max);
     CHECK(vmax < 0.01 * sqrt(g * H), "not settled: |v|max %g m/s", vmax);
     sph_fluid_free(&f);
     for (int b = 0; b < 3; b++)
