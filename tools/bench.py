@@ -110,7 +110,7 @@ BENCH = {
         # the column made 0.1 wide (height 2 x width, the tank's full 0.25 m across) so that the
         # Martin & Moyce front applies; the case's 0.3 m column has no published front to compare
         file="dam_break_3d.yaml", overrides={"time.end": 0.35, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]},
-        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10], vary_at=[0, 1],
+        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14], vary_at=[0, 1],
         error=["front_rel_error"], converged=FRONT_SERIES, target=0.05,
         error_note="surge front against the converged front of the dx sweep (Richardson; column 0.1 x 0.25 x 0.2 m "
                    "instead of the case's 0.3 m wide one); deviation from Martin & Moyce 1952 (n^2 = 2) beside it"),
