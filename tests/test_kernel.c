@@ -65,8 +65,38 @@ static void check_kernel(const char *name, int dim)
     CHECK(fabs(kernel_w(&k, k.support * (1 - 1e-6))) < 1e-12 * k.norm, "%s: W discontinuous at the support", name);
 }
 
+/* The level gauge's line: one particle's contribution is W at every point within the support and
+ * nothing beyond; the crossings of a phi falling linearly from 1 at z = 0 to 0 at z = 1 lie at
+ * 1 - frac either way, and the dry and flooded ends give the documented answers. */
+static void check_line(void)
+{
+    kernel k;
+    kernel_init(&k, "cubic", 2, 0.013);
+    enum { N = 101 };
+    double phi[N] = {0}, step = 0.001, z0 = 0.0, zj = 0.05, rh2 = 0.01 * 0.01;
+    kernel_line_add(&k, rh2, zj, 2.0, z0, step, N, phi);
+    int wrong = 0;
+    for (int i = 0; i < N; i++) {
+        double dz = z0 + i * step - zj, w = 2.0 * kernel_w(&k, sqrt(rh2 + dz * dz));
+        wrong += fabs(phi[i] - w) > 1e-12 * k.norm;
+    }
+    CHECK(wrong == 0, "kernel_line_add: %d of %d points differ from v W(r)", wrong, N);
+    for (int i = 0; i < N; i++)
+        phi[i] = 1.0 - (double)i / (N - 1);
+    double up = kernel_line_crossing(phi, N, 0.01, 0.5, 0), down = kernel_line_crossing(phi, N, 0.01, 0.5, 1);
+    CHECK(fabs(up - 0.5) < 1e-12 && fabs(down - 0.5) < 1e-12, "crossing of a linear phi: up %g, down %g (0.5)", up,
+          down);
+    up = kernel_line_crossing(phi, N, 0.01, 0.25, 0), down = kernel_line_crossing(phi, N, 0.01, 0.25, 1);
+    CHECK(fabs(up - 0.75) < 1e-12 && fabs(down - 0.75) < 1e-12, "crossing at 1/4: up %g, down %g (0.75)", up, down);
+    CHECK(kernel_line_crossing(phi, N, 0.01, 1.5, 0) == 0.0 && isnan(kernel_line_crossing(phi, N, 0.01, 1.5, 1)),
+          "never wet: 0 going up, NAN coming down");
+    CHECK(kernel_line_crossing(phi, N, 0.01, -1.0, 0) == 1.0 && isnan(kernel_line_crossing(phi, N, 0.01, -1.0, 1)),
+          "wet to the top: the line's top going up, NAN coming down");
+}
+
 int main(void)
 {
+    check_line();
     const char *names[] = {"cubic", "quintic", "wendland2"};
     for (int i = 0; i < 3; i++)
         for (int dim = 2; dim <= 3; dim++)

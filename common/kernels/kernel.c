@@ -45,3 +45,42 @@ int kernel_init(kernel *k, const char *name, int dim, double h)
     k->dnorm = k->norm / h;
     return 0;
 }
+
+void kernel_line_add(const kernel *k, double rh2, double zj, double v, double z0, double step, int npt,
+                     double *phi)
+{
+    const double S2 = k->support * k->support;
+    if (!(rh2 < S2))
+        return;
+    const double half = sqrt(S2 - rh2);
+    int i0 = (int)ceil((zj - half - z0) / step), i1 = (int)floor((zj + half - z0) / step);
+    if (i0 < 0)
+        i0 = 0;
+    if (i1 > npt - 1)
+        i1 = npt - 1;
+    for (int i = i0; i <= i1; i++) {
+        const double dz = z0 + i * step - zj, r2 = rh2 + dz * dz;
+        if (r2 < S2)
+            phi[i] += v * kernel_w(k, sqrt(r2));
+    }
+}
+
+double kernel_line_crossing(const double *phi, int npt, double step, double frac, int from_top)
+{
+    if (npt < 1)
+        return from_top ? NAN : 0.0;
+    if (!from_top) {
+        if (phi[0] < frac)
+            return 0.0;
+        for (int i = 1; i < npt; i++)
+            if (phi[i] < frac)
+                return (i - 1 + (phi[i - 1] - frac) / (phi[i - 1] - phi[i])) * step;
+        return (npt - 1) * step;
+    }
+    if (phi[npt - 1] >= frac)
+        return NAN;
+    for (int i = npt - 2; i >= 0; i--)
+        if (phi[i] >= frac)
+            return (i + (phi[i] - frac) / (phi[i] - phi[i + 1])) * step;
+    return NAN;
+}

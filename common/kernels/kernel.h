@@ -114,4 +114,25 @@ static inline double kernel_w(const kernel *k, double r) { return k->norm * kern
 /* dW/dr (<= 0); grad_i W(x_i - x_j) = dW/dr * (x_i - x_j) / r. */
 static inline double kernel_dwdr(const kernel *k, double r) { return k->dnorm * kernel_dshape(k->kind, r * k->inv_h); }
 
+/* ---- the free-surface level along a vertical line (level gauges, `lahar check`'s still-water
+ * level): the height where the kernel-summed fluid volume fraction sum_j V_j W(x - x_j) falls to
+ * KERNEL_SURFACE_FRACTION. Full support gives 1, a flat free surface cuts the support in half:
+ * on a particle lattice the 1/2 crossing lies within 1e-3 dx of the top row + dx/2 (cubic,
+ * h = 1.3 dx, 2D and 3D), and it averages over the support: where one surface particle is
+ * missing it drops 0.5 dx (a column's top particle: 1 dx), where one is raised dx/2 it rises
+ * 0.12 dx (tests/test_check_fluid.c). The rule of the DualSPHysics MeasureTool (kclimit 0.5). */
+#define KERNEL_SURFACE_FRACTION 0.5
+
+/* Add v W(r) to phi[i] at the npt points z0 + i step of a vertical line, r the distance from a
+ * particle at height zj whose horizontal distance to the line squared is rh2 (only the points
+ * within the support are visited). */
+void kernel_line_add(const kernel *k, double rh2, double zj, double v, double z0, double step, int npt,
+                     double *phi);
+/* Where phi (the npt line points z0 + i step) crosses frac, in m above z0, linearly interpolated
+ * between points. from_top = 0: the first crossing going up from i = 0 (the top of the water
+ * column standing on the line's foot; 0 when phi[0] < frac, the top of the line when phi never
+ * falls below frac). from_top = 1: the first point with phi >= frac coming down from the top
+ * (the uppermost surface; NAN when phi never reaches frac or the top point is already wet). */
+double kernel_line_crossing(const double *phi, int npt, double step, double frac, int from_top);
+
 #endif

@@ -8,9 +8,17 @@
  *  - "Late window": force-stream rows (or snapshots) with t >= t_last - 0.1 (t_last - t_first),
  *    at least the last one. Force averages over it smooth the step-to-step noise of SPH
  *    pressure; the reference is averaged over the same rows.
- *  - Free-surface level: particles are binned in columns of width dx across the horizontal
- *    directions; the level is the mean of the column tops plus dx/2 (a particle stands for a
- *    cell of size dx; the lattice of a block puts its top row dx/2 below the block's top).
+ *  - Free-surface level: level gauges on vertical lines at the centres of dx-wide columns, a
+ *    kernel support clear of the side walls (the middle column(s) where the water is narrower
+ *    than two supports): where the kernel-summed volume fraction sum_j dx^D W(x - x_j) (the
+ *    case's kernel and h) falls to 1/2 coming down from above (KERNEL_SURFACE_FRACTION,
+ *    common/kernels/kernel.h; the rule of the SPH node's level probes).
+ *    On a lattice it reads the top row + dx/2 (a particle stands for a cell of size dx) within
+ *    1e-3 dx; where a column lacks its top particle it drops dx/2, not dx as the column's top
+ *    particle would, and it reads no column against a wall, where the support is cut (the
+ *    surface rows there sit lower by up to dx/4). dx^D for m/rho: the particles near the
+ *    surface are at the rest density within (c0 / sqrt(g h))^-2. The level is the gauges' mean,
+ *    the spread their range.
  *
  * This file holds what the evaluators share (check_fluid.h); the evaluators live by family:
  * check_fluid_internal.c (poiseuille, lid_driven_cavity, taylor_green), check_fluid_arrays.c
@@ -23,8 +31,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include "geometry.h"
+#include "kernel.h"
 
 /* ---------------------------------------------------------------- helpers --------------- */
+
+static int64_t fluid_clamp(int64_t b, int64_t n) { return b < 0 ? 0 : (b >= n ? n - 1 : b); }
 
 /* Acceleration driving the fluid: gravity plus the fluid-only body force. */
 vec3 fluid_accel(const lahar_case *c) { return v3_add(v3_load(c->gravity), v3_load(c->sph.body_force)); }
@@ -133,61 +144,127 @@ int fluid_frame(const lahar_case *c, vec3 *up, vec3 *e1, vec3 *e2)
     return 0;
 }
 
-/* Free-surface level of the particles in the buffers (see the top of the file), skipping those
- * whose e1 coordinate lies in [skip_lo, skip_hi] (e.g. under a floating body). Returns the
- * number of columns (0: no particles or out of memory), the level, and min/max of the column
- * tops. */
-int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 e1, vec3 e2, double dx,
-                  double skip_lo, double skip_hi, fluid_columns *col, double *level, double *top_min,
-                  double *top_max)
+void fluid_columns_free(fluid_columns *col)
 {
+    free(col->top), free(col->bot), free(col->start), free(col->order), free(col->phi);
+    *col = (fluid_columns){0};
+}
+
+/* Grow *buf (elements of size sz, capacity *cap) to hold n: 0, or -1 out of memory. */
+static int fluid_grow(void **buf, size_t *cap, size_t n, size_t sz)
+{
+    if (n <= *cap)
+        return 0;
+    size_t c = *cap ? 2 * *cap : 1024;
+    while (c < n)
+        c *= 2;
+    void *t = realloc(*buf, c * sz);
+    if (!t)
+        return -1;
+    *buf = t, *cap = c;
+    return 0;
+}
+
+/* Free-surface level of the particles in the buffers (see the top of the file). Gauges stand at
+ * the centres of the dx-wide columns, skipping those within a kernel support of the fluid's
+ * horizontal extent (the side walls, where the support is cut; the middle column(s) where the
+ * fluid is narrower than two supports) or of [skip_lo, skip_hi] along e1
+ * (e.g. a floating body). Returns the number of gauges that found a surface (0: none, out of
+ * memory, or no valid sph.kernel), their mean level and its extremes. */
+int fluid_surface(const lahar_case *c, const lahar_check_particles *p, vec3 up, vec3 e1, vec3 e2, double dx,
+                  double skip_lo, double skip_hi, fluid_columns *col, double *level, double *lmin, double *lmax)
+{
+    const int dim = c->dim;
+    kernel k;
+    if (p->cur_n == 0 || !(dx > 0.0) || kernel_init(&k, c->sph.kernel, dim, c->sph.h_over_dx * dx))
+        return 0;
+    const double S = k.support, vol = pow(dx, dim), step = 0.1 * dx;
     double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
         vec3 x = fluid_pos(p, i);
         double s1 = v3_dot(x, e1), s2 = dim == 3 ? v3_dot(x, e2) : 0.0;
         lo1 = fmin(lo1, s1), hi1 = fmax(hi1, s1), lo2 = fmin(lo2, s2), hi2 = fmax(hi2, s2);
     }
-    if (p->cur_n == 0 || dx <= 0.0)
+    /* columns centred on the lowest particle's coordinate: on a lattice the particles sit on the
+     * column centres, under the gauges */
+    const int64_t n1 = (int64_t)floor((hi1 - lo1) / dx + 0.5) + 1,
+                  n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx + 0.5) + 1 : 1, ncol = n1 * n2;
+    if (fluid_grow((void **)&col->top, &col->cap_col, (size_t)ncol, sizeof *col->top) ||
+        fluid_grow((void **)&col->bot, &col->cap_bot, (size_t)ncol, sizeof *col->bot) ||
+        fluid_grow((void **)&col->start, &col->cap_start, (size_t)ncol + 1, sizeof *col->start) ||
+        fluid_grow((void **)&col->order, &col->cap_n, (size_t)p->cur_n, sizeof *col->order))
         return 0;
-    /* columns centred on the lowest particle's coordinate: on a lattice the particles sit at the
-     * column centres, not on the column edges where rounding would put part of a lattice column
-     * into its neighbour and leave a column without its top particle */
-    int64_t n1 = (int64_t)floor((hi1 - lo1) / dx + 0.5) + 1, n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx + 0.5) + 1 : 1;
-    if ((size_t)(n1 * n2) > col->cap) {
-        size_t cap = col->cap ? 2 * col->cap : 1024;
-        while (cap < (size_t)(n1 * n2))
-            cap *= 2;
-        double *t = realloc(col->top, cap * sizeof *t);
-        if (!t)
-            return 0;
-        col->top = t, col->cap = cap;
-    }
-    double *top = col->top;
-    for (int64_t b = 0; b < n1 * n2; b++)
-        top[b] = -INFINITY;
+    double *top = col->top, *bot = col->bot;
+    int64_t *start = col->start, *order = col->order;
+    /* the particles sorted by column (counting sort), each column's highest and lowest */
+    for (int64_t b = 0; b <= ncol; b++)
+        start[b] = 0;
+    for (int64_t b = 0; b < ncol; b++)
+        top[b] = -INFINITY, bot[b] = INFINITY;
+#define FLUID_COLUMN(x)                                                                                      \
+    (fluid_clamp((int64_t)floor((v3_dot(x, e1) - lo1) / dx + 0.5), n1) +                                   \
+     n1 * (dim == 3 ? fluid_clamp((int64_t)floor((v3_dot(x, e2) - lo2) / dx + 0.5), n2) : 0))
     for (int64_t i = 0; i < p->cur_n; i++) {
         vec3 x = fluid_pos(p, i);
-        double s1 = v3_dot(x, e1);
-        if (s1 >= skip_lo && s1 <= skip_hi)
-            continue;
-        int64_t b1 = (int64_t)floor((s1 - lo1) / dx + 0.5),
-                b2 = dim == 3 ? (int64_t)floor((v3_dot(x, e2) - lo2) / dx + 0.5) : 0;
-        b1 = b1 < 0 ? 0 : (b1 >= n1 ? n1 - 1 : b1);
-        b2 = b2 < 0 ? 0 : (b2 >= n2 ? n2 - 1 : b2);
-        top[b2 * n1 + b1] = fmax(top[b2 * n1 + b1], v3_dot(x, up));
+        int64_t b = FLUID_COLUMN(x);
+        start[b + 1]++;
+        top[b] = fmax(top[b], v3_dot(x, up)), bot[b] = fmin(bot[b], v3_dot(x, up));
     }
-    int nc = 0;
+    for (int64_t b = 0; b < ncol; b++)
+        start[b + 1] += start[b];
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        vec3 x = fluid_pos(p, i);
+        order[start[FLUID_COLUMN(x)]++] = i;
+    }
+#undef FLUID_COLUMN
+    for (int64_t b = ncol; b > 0; b--) /* back to the first index of each column */
+        start[b] = start[b - 1];
+    start[0] = 0;
+    /* a gauge per column: the kernel-summed volume fraction on its vertical line, from the
+     * lowest particle of the columns around to a support above the highest, read from the top */
+    const int64_t reach = (int64_t)ceil(S / dx);
+    /* the gauges' clearance from the fluid's sides: a support, or where the fluid is narrower
+     * than two supports its middle column(s) (a lattice 5 dx wide reads the same there as a wide
+     * one within 2e-5 dx: quintic, h = dx, 3D) */
+    const double m1 = fmin(S, 0.5 * (hi1 - lo1) - 1e-6 * dx), m2 = fmin(S, 0.5 * (hi2 - lo2) - 1e-6 * dx);
+    int ng = 0;
     double sum = 0.0;
-    *top_min = INFINITY, *top_max = -INFINITY;
-    for (int64_t b = 0; b < n1 * n2; b++) {
-        if (top[b] == -INFINITY)
-            continue;
-        nc++, sum += top[b];
-        *top_min = fmin(*top_min, top[b]), *top_max = fmax(*top_max, top[b]);
-    }
-    if (nc)
-        *level = sum / nc + 0.5 * dx;
-    return nc;
+    *lmin = INFINITY, *lmax = -INFINITY;
+    for (int64_t b2 = 0; b2 < n2; b2++)
+        for (int64_t b1 = 0; b1 < n1; b1++) {
+            const double g1 = lo1 + (double)b1 * dx, g2 = lo2 + (double)b2 * dx;
+            if (top[b2 * n1 + b1] == -INFINITY || g1 - lo1 + 0.5 * dx < m1 || hi1 - g1 + 0.5 * dx < m1 ||
+                (g1 > skip_lo - S && g1 < skip_hi + S) ||
+                (dim == 3 && (g2 - lo2 + 0.5 * dx < m2 || hi2 - g2 + 0.5 * dx < m2)))
+                continue;
+            const int64_t a1 = b1 - reach < 0 ? 0 : b1 - reach, z1 = b1 + reach >= n1 ? n1 - 1 : b1 + reach;
+            const int64_t a2 = b2 - reach < 0 ? 0 : b2 - reach, z2 = b2 + reach >= n2 ? n2 - 1 : b2 + reach;
+            double zt = -INFINITY, zb = INFINITY;
+            for (int64_t m2 = a2; m2 <= z2; m2++)
+                for (int64_t m1 = a1; m1 <= z1; m1++)
+                    zt = fmax(zt, top[m2 * n1 + m1]), zb = fmin(zb, bot[m2 * n1 + m1]);
+            const int npt = (int)ceil((zt + S - zb) / step) + 1;
+            if (fluid_grow((void **)&col->phi, &col->cap_phi, (size_t)npt, sizeof *col->phi))
+                return 0;
+            double *phi = col->phi;
+            for (int i = 0; i < npt; i++)
+                phi[i] = 0.0;
+            for (int64_t m2 = a2; m2 <= z2; m2++)
+                for (int64_t m1 = a1; m1 <= z1; m1++)
+                    for (int64_t q = start[m2 * n1 + m1]; q < start[m2 * n1 + m1 + 1]; q++) {
+                        vec3 x = fluid_pos(p, order[q]);
+                        const double d1 = v3_dot(x, e1) - g1, d2 = dim == 3 ? v3_dot(x, e2) - g2 : 0.0;
+                        kernel_line_add(&k, d1 * d1 + d2 * d2, v3_dot(x, up), vol, zb, step, npt, phi);
+                    }
+            const double z = kernel_line_crossing(phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
+            if (isnan(z))
+                continue;
+            ng++, sum += zb + z;
+            *lmin = fmin(*lmin, zb + z), *lmax = fmax(*lmax, zb + z);
+        }
+    if (ng)
+        *level = sum / ng;
+    return ng;
 }
 
 /* Where the late window of the times t[0, n) starts (see the top of the file; n > 0). */

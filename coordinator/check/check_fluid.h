@@ -31,13 +31,16 @@ int fluid_first_free(const lahar_case *c);
 
 /* gravity's frame and the free-surface level */
 int fluid_frame(const lahar_case *c, vec3 *up, vec3 *e1, vec3 *e2);
-/* Column tops of fluid_surface, kept across snapshots (grown by doubling, freed by the caller). */
+/* fluid_surface's work space, kept across snapshots (grown by doubling; fluid_columns_free). */
 typedef struct {
-    double *top;
-    size_t cap;
+    double *top, *bot;     /* [column] highest and lowest particle along up */
+    int64_t *start, *order; /* [column + 1], [particle]: the particles sorted by column */
+    double *phi;           /* a gauge's line */
+    size_t cap_col, cap_bot, cap_start, cap_n, cap_phi;
 } fluid_columns;
-int fluid_surface(const lahar_check_particles *p, int dim, vec3 up, vec3 e1, vec3 e2, double dx, double skip_lo,
-                  double skip_hi, fluid_columns *col, double *level, double *top_min, double *top_max);
+void fluid_columns_free(fluid_columns *col);
+int fluid_surface(const lahar_case *c, const lahar_check_particles *p, vec3 up, vec3 e1, vec3 e2, double dx,
+                  double skip_lo, double skip_hi, fluid_columns *col, double *level, double *lmin, double *lmax);
 
 /* the late window and the force stream */
 double fluid_late_from(const double *t, int64_t n);

@@ -9,7 +9,7 @@
 #include "sph_gauges.h"
 #include "vec.h"
 
-#define SPH_PROBE_DRY_FLUID 0.5 /* DualSPHysics MeasureTool kclimit */
+#define SPH_PROBE_DRY_FLUID KERNEL_SURFACE_FRACTION /* kernel.h */
 #define SPH_PROBE_LEVEL_POINTS 8 /* line points per dx */
 #define SPH_PROBE_DRY_WALL 0.1  /* wetted: ~1/2 on a flat wall, ~1/4 in a 90 degree corner */
 
@@ -245,40 +245,15 @@ double sph_probes_level(const sph_fluid *f, const double foot[3], int npt, doubl
                 }
                 if (rh2 >= S2)
                     continue;
-                const double half = sqrt(S2 - rh2), vj = p->m[j] / p->rho[j];
-                if (!(xj[v] + half >= z0 && xj[v] - half <= ztop)) /* beyond the line (an edge cell) */
-                    continue;
-                int i0 = (int)ceil((xj[v] - half - z0) / step), i1 = (int)floor((xj[v] + half - z0) / step);
-                if (i0 < 0)
-                    i0 = 0;
-                if (i1 > npt - 1)
-                    i1 = npt - 1;
-                for (int i = i0; i <= i1; i++) {
-                    double dz = z0 + i * step - xj[v], r2 = rh2 + dz * dz;
-                    if (r2 < S2)
-                        phi[i] += vj * kernel_w(k, sqrt(r2));
-                }
+                const double vj = p->m[j] / p->rho[j];
+                kernel_line_add(k, rh2, xj[v], vj, z0, step, npt, phi);
                 /* its mirror image below the floor (z0 - (zj - z0)): the half space the floor cuts off */
-                if (xj[v] < z0) /* a particle below the floor has no image */
-                    continue;
-                const double zm = 2.0 * z0 - xj[v];
-                int m1 = (int)floor((zm + half - z0) / step);
-                if (m1 > npt - 1)
-                    m1 = npt - 1;
-                for (int i = 0; i <= m1; i++) {
-                    double dz = z0 + i * step - zm, r2 = rh2 + dz * dz;
-                    if (r2 < S2)
-                        phi[i] += vj * kernel_w(k, sqrt(r2));
-                }
+                if (xj[v] >= z0) /* a particle below the floor has no image */
+                    kernel_line_add(k, rh2, 2.0 * z0 - xj[v], vj, z0, step, npt, phi);
             }
         }
-    /* the first crossing of 1/2 going up from the floor: the top of the water column standing on it */
-    if (phi[0] < SPH_PROBE_DRY_FLUID)
-        return 0.0;
-    for (int i = 1; i < npt; i++)
-        if (phi[i] < SPH_PROBE_DRY_FLUID)
-            return (i - 1 + (phi[i - 1] - SPH_PROBE_DRY_FLUID) / (phi[i - 1] - phi[i])) * step;
-    return (npt - 1) * step;
+    /* the first crossing going up from the floor: the top of the water column standing on it */
+    return kernel_line_crossing(phi, npt, step, SPH_PROBE_DRY_FLUID, 0);
 }
 
 int sph_probes_sample(sph_probes *pr, const sph_fluid *f, const lahar_case *c, const lahar_body_state *states,
