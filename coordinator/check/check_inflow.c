@@ -14,8 +14,9 @@
  *     (a steady state passes its inflow on).
  *   depth_rel_error (one inlet and at least one outlet): over the last third of the snapshots, the
  *     mean depth at the station halfway between the inlet's centre and the first outlet's centre
- *     (the highest domain particle within dx of the vertical line there, + dx/2, above the inlet
- *     section's lowest point) against the inlet's level. */
+ *     (a level gauge there: where the domain particles' kernel-summed volume fraction falls to
+ *     1/2, common/kernels/kernel.h, above the inlet section's lowest point) against the inlet's
+ *     level. */
 #include <hdf5.h>
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +24,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "kernel.h"
 #include "output.h"
 
 static int flow_attrs(const lahar_check_particles *p, int64_t k, double v[LAHAR_FLOW_NVAL])
@@ -211,36 +213,66 @@ static void inflow_station(const lahar_inlet *in, const lahar_outlet *o, const i
     }
 }
 
-/* One inlet and an outlet: the mean depth at the station over the late window (the highest
- * domain particle within dx of the vertical line there, + dx/2, above the inlet section's lowest
- * point) against the inlet's level over the same window (a level table: its mean there).
+/* One inlet and an outlet: the mean depth at the station over the late window (a level gauge on
+ * the vertical line there: where the kernel-summed volume fraction of the domain's particles
+ * falls to 1/2 coming down, KERNEL_SURFACE_FRACTION, above the inlet section's lowest point)
+ * against the inlet's level over the same window (a level table: its mean there).
  * 0, or -1 with r->err. */
 static int inflow_depth(const lahar_case *c, lahar_check_particles *p, const inflow *fl, lahar_check_result *r)
 {
     const lahar_inlet *in = &c->inlets[0];
     const int dim = fl->dim;
-    const double dx = fl->dx, *up = fl->up;
+    const double dx = fl->dx, *up = fl->up, vol = pow(dx, dim), step = 0.1 * dx;
+    kernel k;
+    if (kernel_init(&k, c->sph.kernel, dim, c->sph.h_over_dx * dx)) {
+        snprintf(r->err, sizeof r->err, "inflow: sph.kernel '%s' with h = %g dx is no kernel", c->sph.kernel,
+                 c->sph.h_over_dx);
+        return -1;
+    }
+    const double S = k.support;
     double st[3], low;
     inflow_station(in, &c->outlets[0], fl, st, &low);
-    double sum = 0.0;
+    double sum = 0.0, *phi = NULL;
+    size_t cap = 0;
     int cnt = 0;
-    for (int64_t k = fl->k0; k <= fl->k1; k++) {
-        if (lahar_check_particles_read(p, k, r->err, sizeof r->err) != 0)
+    for (int64_t kk = fl->k0; kk <= fl->k1; kk++) {
+        if (lahar_check_particles_read(p, kk, r->err, sizeof r->err) != 0) {
+            free(phi);
             return -1;
+        }
         double top = -HUGE_VAL;
         for (int64_t i = 0; i < p->cur_n; i++) {
             const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
             const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
             const double s = dot3(rr, up);
-            const double hz2 = dot3(rr, rr) - s * s; /* squared horizontal distance */
-            if (hz2 < dx * dx)
+            if (dot3(rr, rr) - s * s < S * S) /* squared horizontal distance */
                 top = fmax(top, dot3(x, up));
         }
-        if (top > -HUGE_VAL) {
-            sum += top + 0.5 * dx - low;
-            cnt++;
+        if (!(top > low))
+            continue;
+        const int npt = (int)ceil((top + S - low) / step) + 1;
+        if ((size_t)npt > cap) {
+            double *t = realloc(phi, (size_t)npt * sizeof *phi);
+            if (!t) {
+                free(phi);
+                snprintf(r->err, sizeof r->err, "inflow: out of memory for the depth gauge");
+                return -1;
+            }
+            phi = t, cap = (size_t)npt;
         }
+        for (int i = 0; i < npt; i++)
+            phi[i] = 0.0;
+        for (int64_t i = 0; i < p->cur_n; i++) {
+            const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
+            const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
+            const double s = dot3(rr, up);
+            kernel_line_add(&k, dot3(rr, rr) - s * s, dot3(x, up), vol, low, step, npt, phi);
+        }
+        const double z = kernel_line_crossing(phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
+        if (!isnan(z))
+            sum += z, cnt++;
     }
+    free(phi);
     const double depth = cnt ? sum / cnt : 0.0;
     double hl = 0.0;
     for (int64_t k = fl->k0; k <= fl->k1; k++)
