@@ -62,9 +62,10 @@ lahar_validation_test(sinking_disc_2d sinking_disc_2d dx=0.005
 # Hydrostatic tank (docs/bench/validation.md): side wall force within 1 % of
 # rho g h^2 / 2 (x width in 3D) and particle pressures within 1 % (L2) of rho g (h - y), at dx =
 # 10 mm (20 rows), 2 s in 2D and 1 s in 3D (the tanks start at rest on their lattice, so this is
-# settled: max speed < 1 % of sqrt(g h)); also the free surface level within 5 % of h.
-lahar_validation_test(hydrostatic_2d hydrostatic_2d dx=0.01 end=2 "free_surface_spread_rel<=0.05" "max_speed_rel<=0.01")
-lahar_validation_test(hydrostatic_3d hydrostatic_3d dx=0.01 end=1 "free_surface_spread_rel<=0.05" "max_speed_rel<=0.01")
+# settled: max speed < 1 % of sqrt(g h)); also a level surface: the level gauges (lahar check) agree
+# within 0.5 % of h, dx/10 (measured 0.071 % in 2D, 0.002 % in 3D).
+lahar_validation_test(hydrostatic_2d hydrostatic_2d dx=0.01 end=2 "free_surface_spread_rel<=0.005" "max_speed_rel<=0.01")
+lahar_validation_test(hydrostatic_3d hydrostatic_3d dx=0.01 end=1 "free_surface_spread_rel<=0.005" "max_speed_rel<=0.01")
 
 # Lid-driven cavity, Re = 100 (Ghia, Ghia & Shin 1982 Tables I and II, docs/reference/
 # ghia_1982_re100.txt) at 40 x 40 (dx = 0.025 m), 30 s, the case's particle shifting with
