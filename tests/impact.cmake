@@ -1,7 +1,7 @@
 # Granular flow impact on a wall (Trujillo-Vela et al. 2020 section 5.3): `lahar check` on
 # cases/granular_impact_3d.yaml at CI resolution, dx = 50 mm (360 particles; the paper's 12.5 mm is
 # 64 times the particles) over the full 1.8 m chute, in-process on 2 threads (~11 s each at load 3).
-# The case's metrics (reference granular_impact, coordinator/check/check_soil.c): no soil particle through the
+# The case's metrics (reference granular_impact, coordinator/check/check_soil_impact.c): no soil particle through the
 # wall, the bed or a side wall (followed by id; over the wall's top is overtopping, allowed); the
 # particle count; the impulse of every body's force against M g_t T - dP within 5 % (action and
 # reaction of the coupling); the 10 ms peak force within a factor 2 of rho u^2 A of the arriving

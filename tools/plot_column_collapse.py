@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 
 def band(a):
-    """[min, max] of the branches that apply at a (coordinator/check/check_soil.c, granular_collapse)."""
+    """[min, max] of the branches that apply at a (coordinator/check/check_soil_collapse.c, granular_collapse)."""
     br = []
     if a < 2.8:
         br.append(1.2 * a)

@@ -5,7 +5,7 @@ usage: plot_impact.py OUT.png RUN_DIR [RUN_DIR ...] [--peaks "LABEL=SLOPE:N,SLOP
 
 Each RUN_DIR is the output of `lahar check` on cases/granular_impact_3d.yaml (any slope, any dx):
 the script reads only its check.json (reference granular_impact), so the force history it draws is
-the check's own (the wall's force along the chute, 10 ms moving average; coordinator/check/check_soil.c),
+the check's own (the wall's force along the chute, 10 ms moving average; coordinator/check/check_soil_impact.c),
 and prints a Markdown table: slope, dx, first impact, peak force and its time, the momentum flux
 estimate rho u^2 A, and the run's metrics. Left panel: F(t) per slope; right panel: peak force
 against the slope. Trujillo-Vela et al. 2020, Fig. 14-15, are images whose numbers are not in the paper's text

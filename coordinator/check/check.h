@@ -142,7 +142,7 @@ int lahar_check_sinking_disc(const lahar_case *c, const lahar_check_data *d, lah
 int lahar_check_dam_break(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_lid_driven_cavity(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_taylor_green(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
-/* The soil references (coordinator/check/check_soil.c; documented there and in cases/README.md). */
+/* The soil references (coordinator/check/check_soil*.c; documented there and in cases/README.md). */
 int lahar_check_soil_geostatic(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_soil_slide(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
 int lahar_check_granular_collapse(const lahar_case *c, const lahar_check_data *d, lahar_check_result *r);
