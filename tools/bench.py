@@ -50,6 +50,7 @@ lahar_py.require("yaml", "numpy", "matplotlib", "h5py")
 import case_override  # noqa: E402
 
 CASES_DIR = os.path.join(ROOT, "cases")
+DEFAULT_TIMEOUT = 900.0  # seconds after which one run is stopped (--timeout)
 BENCH_CASES_DIR = os.path.join(ROOT, "docs", "bench", "cases")
 
 # --------------------------------------------------------------------------------------------
@@ -109,8 +110,10 @@ BENCH = {
     "dam_break_3d": dict(
         # the column made 0.1 wide (height 2 x width, the tank's full 0.25 m across) so that the
         # Martin & Moyce front applies; the case's 0.3 m column has no published front to compare
+        # dx down to 0.1/28 (109,760 particles, 16 CPU minutes): the three finest runs show the
+        # front's order (0.8, as in 2D); three runs ending at 0.1/20 gave a spurious 2.05
         file="dam_break_3d.yaml", overrides={"time.end": 0.35, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]},
-        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14], vary_at=[0, 1],
+        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14, 0.1 / 20, 0.1 / 28], vary_at=[0, 1], timeout=2400.0,
         error=["front_rel_error"], converged=FRONT_SERIES, target=0.05,
         error_note="surge front against the converged front of the dx sweep (Richardson; column 0.1 x 0.25 x 0.2 m "
                    "instead of the case's 0.3 m wide one); deviation from Martin & Moyce 1952 (n^2 = 2) beside it"),
@@ -409,7 +412,8 @@ def bench_case(args, name, spec, outdir):
         case_path = os.path.join(rundir, label + ".yaml")
         out = os.path.join(rundir, label)
         case_override.override_case(os.path.join(CASES_DIR, spec["file"]), case_path, overrides)
-        r = run_lahar(args.lahar, "check", case_path, out, args.threads, timeout=args.timeout)
+        r = run_lahar(args.lahar, "check", case_path, out, args.threads,
+                      timeout=args.timeout if args.timeout is not None else spec.get("timeout", DEFAULT_TIMEOUT))
         s = summary_numbers(out)
         # exit 1 = a check metric out of its bound: the run itself is fine, its error is recorded
         ok = r["exit_status"] in (0, 1) and s["steps"] > 0 and s["sim_time"] > 0
@@ -571,7 +575,7 @@ def per_step(s, node, key):
 
 def overhead_row(args, case_path, out, mode, rep, size):
     r = run_lahar(args.lahar, "run", case_path, out, args.threads, in_process=(mode == "in-process"),
-                  timeout=args.timeout)
+                  timeout=args.timeout if args.timeout is not None else DEFAULT_TIMEOUT)
     s = summary_numbers(out)
     sj = s["summary"]
     row = dict(size=size, mode=mode, repeat=rep, particles=s["particles"], steps=s["steps"], wall_s=s["wall_s"],
@@ -712,7 +716,8 @@ def bench_subcycle(args, outdir):
         case_path = os.path.join(d, f"{tag}.yaml")
         case_override.override_case(src, case_path, ov)
         out = os.path.join(d, tag)
-        r = run_lahar(args.lahar, "run", case_path, out, args.threads, timeout=args.timeout)
+        r = run_lahar(args.lahar, "run", case_path, out, args.threads,
+                      timeout=args.timeout if args.timeout is not None else DEFAULT_TIMEOUT)
         s = summary_numbers(out)
         sj = s["summary"]
         dem = sj.get("nodes", {}).get("dem", {})
@@ -778,7 +783,9 @@ def main(argv):
     ap.add_argument("--sections", default="pareto,overhead,subcycle", help="comma list of pareto, overhead, subcycle")
     ap.add_argument("--cases", default=",".join(BENCH), help="comma list of the cases of the pareto section")
     ap.add_argument("--threads", type=int, default=2, help="OpenMP threads per node (default 2)")
-    ap.add_argument("--timeout", type=float, default=900.0, help="seconds after which one run is stopped")
+    ap.add_argument("--timeout", type=float, default=None,
+                    help=f"seconds after which one run is stopped (default {DEFAULT_TIMEOUT:g}; the pareto sweeps of "
+                         "cases with longer runs set their own, dam_break_3d 2400)")
     ap.add_argument("--repeat", type=int, default=9,
                     help="pairs of runs of the overhead section (median is used; on a 2-core VM one pair varies by "
                          "+-20 %% and a median of 9 by about +-5 %%, docs/bench/cosim_overhead.md)")
