@@ -165,102 +165,134 @@ static int fluid_grow(void **buf, size_t *cap, size_t n, size_t sz)
     return 0;
 }
 
-/* Free-surface level of the particles in the buffers (see the top of the file). Gauges stand at
- * the centres of the dx-wide columns, skipping those within a kernel support of the fluid's
- * horizontal extent (the side walls, where the support is cut; the middle column(s) where the
- * fluid is narrower than two supports) or of [skip_lo, skip_hi] along e1
- * (e.g. a floating body). Returns the number of gauges that found a surface (0: none, out of
- * memory, or no valid sph.kernel), their mean level and its extremes. */
-int fluid_surface(const lahar_case *c, const lahar_check_particles *p, vec3 up, vec3 e1, vec3 e2, double dx,
-                  double skip_lo, double skip_hi, fluid_columns *col, double *level, double *lmin, double *lmax)
+/* The columns of fluid_surface: dx wide along e1 (and e2 in 3D), centred on the lowest particle's
+ * coordinate so that on a lattice the particles sit on the column centres, under the gauges. */
+typedef struct {
+    int dim;
+    vec3 up, e1, e2;
+    double dx, lo[2], hi[2]; /* the particles' extent along e1, e2 */
+    int64_t n[2];            /* columns along e1, e2 (1 in 2D) */
+} fluid_grid;
+
+static int64_t fluid_column(const fluid_grid *g, vec3 x)
 {
-    const int dim = c->dim;
-    kernel k;
-    if (p->cur_n == 0 || !(dx > 0.0) || kernel_init(&k, c->sph.kernel, dim, c->sph.h_over_dx * dx))
-        return 0;
-    const double S = k.support, vol = pow(dx, dim), step = 0.1 * dx;
-    double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY;
+    int64_t b1 = fluid_clamp((int64_t)floor((v3_dot(x, g->e1) - g->lo[0]) / g->dx + 0.5), g->n[0]);
+    int64_t b2 = g->dim == 3 ? fluid_clamp((int64_t)floor((v3_dot(x, g->e2) - g->lo[1]) / g->dx + 0.5), g->n[1]) : 0;
+    return b2 * g->n[0] + b1;
+}
+
+/* The particles of the buffers sorted by column (counting sort into col->start, col->order) with
+ * each column's highest and lowest particle along up (col->top, col->bot; -inf/+inf when empty).
+ * 0, or -1 out of memory. */
+static int fluid_sort_columns(const lahar_check_particles *p, fluid_grid *g, fluid_columns *col)
+{
+    g->lo[0] = g->lo[1] = INFINITY, g->hi[0] = g->hi[1] = -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
         vec3 x = fluid_pos(p, i);
-        double s1 = v3_dot(x, e1), s2 = dim == 3 ? v3_dot(x, e2) : 0.0;
-        lo1 = fmin(lo1, s1), hi1 = fmax(hi1, s1), lo2 = fmin(lo2, s2), hi2 = fmax(hi2, s2);
+        double s1 = v3_dot(x, g->e1), s2 = g->dim == 3 ? v3_dot(x, g->e2) : 0.0;
+        g->lo[0] = fmin(g->lo[0], s1), g->hi[0] = fmax(g->hi[0], s1);
+        g->lo[1] = fmin(g->lo[1], s2), g->hi[1] = fmax(g->hi[1], s2);
     }
-    /* columns centred on the lowest particle's coordinate: on a lattice the particles sit on the
-     * column centres, under the gauges */
-    const int64_t n1 = (int64_t)floor((hi1 - lo1) / dx + 0.5) + 1,
-                  n2 = dim == 3 ? (int64_t)floor((hi2 - lo2) / dx + 0.5) + 1 : 1, ncol = n1 * n2;
+    g->n[0] = (int64_t)floor((g->hi[0] - g->lo[0]) / g->dx + 0.5) + 1;
+    g->n[1] = g->dim == 3 ? (int64_t)floor((g->hi[1] - g->lo[1]) / g->dx + 0.5) + 1 : 1;
+    const int64_t ncol = g->n[0] * g->n[1];
     if (fluid_grow((void **)&col->top, &col->cap_col, (size_t)ncol, sizeof *col->top) ||
         fluid_grow((void **)&col->bot, &col->cap_bot, (size_t)ncol, sizeof *col->bot) ||
         fluid_grow((void **)&col->start, &col->cap_start, (size_t)ncol + 1, sizeof *col->start) ||
         fluid_grow((void **)&col->order, &col->cap_n, (size_t)p->cur_n, sizeof *col->order))
-        return 0;
+        return -1;
     double *top = col->top, *bot = col->bot;
-    int64_t *start = col->start, *order = col->order;
-    /* the particles sorted by column (counting sort), each column's highest and lowest */
+    int64_t *start = col->start;
     for (int64_t b = 0; b <= ncol; b++)
         start[b] = 0;
     for (int64_t b = 0; b < ncol; b++)
         top[b] = -INFINITY, bot[b] = INFINITY;
-#define FLUID_COLUMN(x)                                                                                      \
-    (fluid_clamp((int64_t)floor((v3_dot(x, e1) - lo1) / dx + 0.5), n1) +                                   \
-     n1 * (dim == 3 ? fluid_clamp((int64_t)floor((v3_dot(x, e2) - lo2) / dx + 0.5), n2) : 0))
     for (int64_t i = 0; i < p->cur_n; i++) {
         vec3 x = fluid_pos(p, i);
-        int64_t b = FLUID_COLUMN(x);
+        int64_t b = fluid_column(g, x);
         start[b + 1]++;
-        top[b] = fmax(top[b], v3_dot(x, up)), bot[b] = fmin(bot[b], v3_dot(x, up));
+        top[b] = fmax(top[b], v3_dot(x, g->up)), bot[b] = fmin(bot[b], v3_dot(x, g->up));
     }
     for (int64_t b = 0; b < ncol; b++)
         start[b + 1] += start[b];
-    for (int64_t i = 0; i < p->cur_n; i++) {
-        vec3 x = fluid_pos(p, i);
-        order[start[FLUID_COLUMN(x)]++] = i;
-    }
-#undef FLUID_COLUMN
+    for (int64_t i = 0; i < p->cur_n; i++)
+        col->order[start[fluid_column(g, fluid_pos(p, i))]++] = i;
     for (int64_t b = ncol; b > 0; b--) /* back to the first index of each column */
         start[b] = start[b - 1];
     start[0] = 0;
-    /* a gauge per column: the kernel-summed volume fraction on its vertical line, from the
-     * lowest particle of the columns around to a support above the highest, read from the top */
-    const int64_t reach = (int64_t)ceil(S / dx);
+    return 0;
+}
+
+/* The level gauge at the centre of column (b1, b2): the kernel-summed volume fraction of the
+ * particles of the columns within a support, on the vertical line from their lowest particle to
+ * a support above their highest, read from the top. The level along up, NAN when the line finds
+ * no surface, -INFINITY out of memory. */
+static double fluid_gauge(const lahar_check_particles *p, const fluid_grid *g, const kernel *k, fluid_columns *col,
+                          int64_t b1, int64_t b2)
+{
+    const double S = k->support, dx = g->dx, vol = pow(dx, g->dim), step = 0.1 * dx;
+    const double g1 = g->lo[0] + (double)b1 * dx, g2 = g->lo[1] + (double)b2 * dx;
+    const int64_t reach = (int64_t)ceil(S / dx), n1 = g->n[0];
+    const int64_t a1 = b1 - reach < 0 ? 0 : b1 - reach, z1 = b1 + reach >= n1 ? n1 - 1 : b1 + reach;
+    const int64_t a2 = b2 - reach < 0 ? 0 : b2 - reach, z2 = b2 + reach >= g->n[1] ? g->n[1] - 1 : b2 + reach;
+    double zt = -INFINITY, zb = INFINITY;
+    for (int64_t m2 = a2; m2 <= z2; m2++)
+        for (int64_t m1 = a1; m1 <= z1; m1++)
+            zt = fmax(zt, col->top[m2 * n1 + m1]), zb = fmin(zb, col->bot[m2 * n1 + m1]);
+    const int npt = (int)ceil((zt + S - zb) / step) + 1;
+    if (fluid_grow((void **)&col->phi, &col->cap_phi, (size_t)npt, sizeof *col->phi))
+        return -INFINITY;
+    double *phi = col->phi;
+    for (int i = 0; i < npt; i++)
+        phi[i] = 0.0;
+    for (int64_t m2 = a2; m2 <= z2; m2++)
+        for (int64_t m1 = a1; m1 <= z1; m1++)
+            for (int64_t q = col->start[m2 * n1 + m1]; q < col->start[m2 * n1 + m1 + 1]; q++) {
+                vec3 x = fluid_pos(p, col->order[q]);
+                const double d1 = v3_dot(x, g->e1) - g1, d2 = g->dim == 3 ? v3_dot(x, g->e2) - g2 : 0.0;
+                kernel_line_add(k, d1 * d1 + d2 * d2, v3_dot(x, g->up), vol, zb, step, npt, phi);
+            }
+    return zb + kernel_line_crossing(phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
+}
+
+/* Free-surface level of the particles in the buffers (see the top of the file). Gauges stand at
+ * the centres of the dx-wide columns, skipping those within a kernel support of the fluid's
+ * horizontal extent (the side walls, where the support is cut; the middle column(s) where the
+ * fluid is narrower than two supports) or of [skip_lo, skip_hi] along e1 (e.g. a floating body).
+ * Returns the number of gauges that found a surface (0: none, out of memory, or no valid
+ * sph.kernel), their mean level and its extremes. */
+int fluid_surface(const lahar_case *c, const lahar_check_particles *p, vec3 up, vec3 e1, vec3 e2, double dx,
+                  double skip_lo, double skip_hi, fluid_columns *col, double *level, double *lmin, double *lmax)
+{
+    fluid_grid g = {.dim = c->dim, .up = up, .e1 = e1, .e2 = e2, .dx = dx};
+    kernel k;
+    if (p->cur_n == 0 || !(dx > 0.0) || kernel_init(&k, c->sph.kernel, c->dim, c->sph.h_over_dx * dx) ||
+        fluid_sort_columns(p, &g, col))
+        return 0;
+    const double S = k.support;
     /* the gauges' clearance from the fluid's sides: a support, or where the fluid is narrower
      * than two supports its middle column(s) (a lattice 5 dx wide reads the same there as a wide
      * one within 2e-5 dx: quintic, h = dx, 3D) */
-    const double m1 = fmin(S, 0.5 * (hi1 - lo1) - 1e-6 * dx), m2 = fmin(S, 0.5 * (hi2 - lo2) - 1e-6 * dx);
+    double m[2];
+    for (int a = 0; a < 2; a++)
+        m[a] = fmin(S, 0.5 * (g.hi[a] - g.lo[a]) - 1e-6 * dx);
     int ng = 0;
     double sum = 0.0;
     *lmin = INFINITY, *lmax = -INFINITY;
-    for (int64_t b2 = 0; b2 < n2; b2++)
-        for (int64_t b1 = 0; b1 < n1; b1++) {
-            const double g1 = lo1 + (double)b1 * dx, g2 = lo2 + (double)b2 * dx;
-            if (top[b2 * n1 + b1] == -INFINITY || g1 - lo1 + 0.5 * dx < m1 || hi1 - g1 + 0.5 * dx < m1 ||
-                (g1 > skip_lo - S && g1 < skip_hi + S) ||
-                (dim == 3 && (g2 - lo2 + 0.5 * dx < m2 || hi2 - g2 + 0.5 * dx < m2)))
+    for (int64_t b2 = 0; b2 < g.n[1]; b2++)
+        for (int64_t b1 = 0; b1 < g.n[0]; b1++) {
+            const double g1 = g.lo[0] + (double)b1 * dx, g2 = g.lo[1] + (double)b2 * dx;
+            if (col->top[b2 * g.n[0] + b1] == -INFINITY || g1 - g.lo[0] + 0.5 * dx < m[0] ||
+                g.hi[0] - g1 + 0.5 * dx < m[0] || (g1 > skip_lo - S && g1 < skip_hi + S) ||
+                (g.dim == 3 && (g2 - g.lo[1] + 0.5 * dx < m[1] || g.hi[1] - g2 + 0.5 * dx < m[1])))
                 continue;
-            const int64_t a1 = b1 - reach < 0 ? 0 : b1 - reach, z1 = b1 + reach >= n1 ? n1 - 1 : b1 + reach;
-            const int64_t a2 = b2 - reach < 0 ? 0 : b2 - reach, z2 = b2 + reach >= n2 ? n2 - 1 : b2 + reach;
-            double zt = -INFINITY, zb = INFINITY;
-            for (int64_t m2 = a2; m2 <= z2; m2++)
-                for (int64_t m1 = a1; m1 <= z1; m1++)
-                    zt = fmax(zt, top[m2 * n1 + m1]), zb = fmin(zb, bot[m2 * n1 + m1]);
-            const int npt = (int)ceil((zt + S - zb) / step) + 1;
-            if (fluid_grow((void **)&col->phi, &col->cap_phi, (size_t)npt, sizeof *col->phi))
+            const double z = fluid_gauge(p, &g, &k, col, b1, b2);
+            if (z == -INFINITY)
                 return 0;
-            double *phi = col->phi;
-            for (int i = 0; i < npt; i++)
-                phi[i] = 0.0;
-            for (int64_t m2 = a2; m2 <= z2; m2++)
-                for (int64_t m1 = a1; m1 <= z1; m1++)
-                    for (int64_t q = start[m2 * n1 + m1]; q < start[m2 * n1 + m1 + 1]; q++) {
-                        vec3 x = fluid_pos(p, order[q]);
-                        const double d1 = v3_dot(x, e1) - g1, d2 = dim == 3 ? v3_dot(x, e2) - g2 : 0.0;
-                        kernel_line_add(&k, d1 * d1 + d2 * d2, v3_dot(x, up), vol, zb, step, npt, phi);
-                    }
-            const double z = kernel_line_crossing(phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
             if (isnan(z))
                 continue;
-            ng++, sum += zb + z;
-            *lmin = fmin(*lmin, zb + z), *lmax = fmax(*lmax, zb + z);
+            ng++, sum += z;
+            *lmin = fmin(*lmin, z), *lmax = fmax(*lmax, z);
         }
     if (ng)
         *level = sum / ng;
