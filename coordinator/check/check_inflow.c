@@ -213,70 +213,85 @@ static void inflow_station(const lahar_inlet *in, const lahar_outlet *o, const i
     }
 }
 
-/* One inlet and an outlet: the mean depth at the station over the late window (a level gauge on
- * the vertical line there: where the kernel-summed volume fraction of the domain's particles
- * falls to 1/2 coming down, KERNEL_SURFACE_FRACTION, above the inlet section's lowest point)
- * against the inlet's level over the same window (a level table: its mean there).
- * 0, or -1 with r->err. */
+/* Particle i of the snapshot in p's buffers relative to the point st: its squared distance across
+ * up (horizontal) and its height along up. */
+static double inflow_across2(const lahar_check_particles *p, int dim, int64_t i, const double st[3],
+                             const double up[3], double *height)
+{
+    const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
+    const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
+    const double s = dot3(rr, up);
+    *height = dot3(x, up);
+    return dot3(rr, rr) - s * s;
+}
+
+/* The level gauge on the vertical line through st for the snapshot in p's buffers, from `low` to
+ * a kernel support above the highest particle within a support of the line: the depth above low
+ * where the particles' dx^D W sum falls to 1/2 coming down. NAN when no water stands there,
+ * -INFINITY out of memory (*phi, *cap: the line's buffer, grown here). */
+static double inflow_gauge(const lahar_check_particles *p, const kernel *k, int dim, double dx, const double st[3],
+                           const double up[3], double low, double **phi, size_t *cap)
+{
+    const double S = k->support, vol = pow(dx, dim), step = 0.1 * dx;
+    double top = -HUGE_VAL, hgt;
+    for (int64_t i = 0; i < p->cur_n; i++)
+        if (inflow_across2(p, dim, i, st, up, &hgt) < S * S)
+            top = fmax(top, hgt);
+    if (!(top > low))
+        return NAN;
+    const int npt = (int)ceil((top + S - low) / step) + 1;
+    if ((size_t)npt > *cap) {
+        double *t = realloc(*phi, (size_t)npt * sizeof *t);
+        if (!t)
+            return -INFINITY;
+        *phi = t, *cap = (size_t)npt;
+    }
+    for (int i = 0; i < npt; i++)
+        (*phi)[i] = 0.0;
+    for (int64_t i = 0; i < p->cur_n; i++) {
+        const double d2 = inflow_across2(p, dim, i, st, up, &hgt);
+        kernel_line_add(k, d2, hgt, vol, low, step, npt, *phi);
+    }
+    return kernel_line_crossing(*phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
+}
+
+/* One inlet and an outlet: the mean depth at the station over the late window (inflow_gauge, the
+ * rule of the level gauges, above the inlet section's lowest point) against the inlet's level over
+ * the same window (a level table: its mean there). 0, or -1 with r->err. */
 static int inflow_depth(const lahar_case *c, lahar_check_particles *p, const inflow *fl, lahar_check_result *r)
 {
     const lahar_inlet *in = &c->inlets[0];
-    const int dim = fl->dim;
-    const double dx = fl->dx, *up = fl->up, vol = pow(dx, dim), step = 0.1 * dx;
     kernel k;
-    if (kernel_init(&k, c->sph.kernel, dim, c->sph.h_over_dx * dx)) {
+    if (kernel_init(&k, c->sph.kernel, fl->dim, c->sph.h_over_dx * fl->dx)) {
         snprintf(r->err, sizeof r->err, "inflow: sph.kernel '%s' with h = %g dx is no kernel", c->sph.kernel,
                  c->sph.h_over_dx);
         return -1;
     }
-    const double S = k.support;
     double st[3], low;
     inflow_station(in, &c->outlets[0], fl, st, &low);
     double sum = 0.0, *phi = NULL;
     size_t cap = 0;
-    int cnt = 0;
-    for (int64_t kk = fl->k0; kk <= fl->k1; kk++) {
+    int cnt = 0, rc = 0;
+    for (int64_t kk = fl->k0; kk <= fl->k1 && !rc; kk++) {
         if (lahar_check_particles_read(p, kk, r->err, sizeof r->err) != 0) {
-            free(phi);
-            return -1;
+            rc = -1;
+            break;
         }
-        double top = -HUGE_VAL;
-        for (int64_t i = 0; i < p->cur_n; i++) {
-            const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
-            const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
-            const double s = dot3(rr, up);
-            if (dot3(rr, rr) - s * s < S * S) /* squared horizontal distance */
-                top = fmax(top, dot3(x, up));
-        }
-        if (!(top > low))
-            continue;
-        const int npt = (int)ceil((top + S - low) / step) + 1;
-        if ((size_t)npt > cap) {
-            double *t = realloc(phi, (size_t)npt * sizeof *phi);
-            if (!t) {
-                free(phi);
-                snprintf(r->err, sizeof r->err, "inflow: out of memory for the depth gauge");
-                return -1;
-            }
-            phi = t, cap = (size_t)npt;
-        }
-        for (int i = 0; i < npt; i++)
-            phi[i] = 0.0;
-        for (int64_t i = 0; i < p->cur_n; i++) {
-            const double x[3] = {p->x[i], p->y[i], dim == 3 ? p->z[i] : 0.0};
-            const double rr[3] = {x[0] - st[0], x[1] - st[1], x[2] - st[2]};
-            const double s = dot3(rr, up);
-            kernel_line_add(&k, dot3(rr, rr) - s * s, dot3(x, up), vol, low, step, npt, phi);
-        }
-        const double z = kernel_line_crossing(phi, npt, step, KERNEL_SURFACE_FRACTION, 1);
-        if (!isnan(z))
+        const double z = inflow_gauge(p, &k, fl->dim, fl->dx, st, fl->up, low, &phi, &cap);
+        if (z == -INFINITY) {
+            snprintf(r->err, sizeof r->err, "inflow: out of memory for the depth gauge");
+            rc = -1;
+        } else if (!isnan(z)) {
             sum += z, cnt++;
+        }
     }
     free(phi);
+    if (rc)
+        return -1;
     const double depth = cnt ? sum / cnt : 0.0;
     double hl = 0.0;
-    for (int64_t k = fl->k0; k <= fl->k1; k++)
-        hl += lahar_inlet_level(in, p->t[k]);
+    for (int64_t kk = fl->k0; kk <= fl->k1; kk++)
+        hl += lahar_inlet_level(in, p->t[kk]);
     hl /= (double)(fl->k1 - fl->k0 + 1);
     lahar_check_value(r, "depth_rel_error", fabs(depth / hl - 1.0));
     lahar_check_value(r, "depth_m", depth);
