@@ -186,6 +186,13 @@ def _descendants(pid):
     return out
 
 
+def run_timeout(args, spec=None):
+    """Seconds after which one run is stopped: --timeout, else the pareto case's own, else DEFAULT_TIMEOUT."""
+    if args.timeout is not None:
+        return args.timeout
+    return (spec or {}).get("timeout", DEFAULT_TIMEOUT)
+
+
 def run_lahar(lahar, cmd, case_path, out, threads, in_process=True, timeout=600.0, check_plot=False):
     """Runs lahar as a child; returns its exit status, wall and CPU time (wait4) and peak memory:
     the sum over lahar and the nodes it starts of each process's VmHWM, sampled every 50 ms (wait4's
@@ -413,7 +420,7 @@ def bench_case(args, name, spec, outdir):
         out = os.path.join(rundir, label)
         case_override.override_case(os.path.join(CASES_DIR, spec["file"]), case_path, overrides)
         r = run_lahar(args.lahar, "check", case_path, out, args.threads,
-                      timeout=args.timeout if args.timeout is not None else spec.get("timeout", DEFAULT_TIMEOUT))
+                      timeout=run_timeout(args, spec))
         s = summary_numbers(out)
         # exit 1 = a check metric out of its bound: the run itself is fine, its error is recorded
         ok = r["exit_status"] in (0, 1) and s["steps"] > 0 and s["sim_time"] > 0
@@ -575,7 +582,7 @@ def per_step(s, node, key):
 
 def overhead_row(args, case_path, out, mode, rep, size):
     r = run_lahar(args.lahar, "run", case_path, out, args.threads, in_process=(mode == "in-process"),
-                  timeout=args.timeout if args.timeout is not None else DEFAULT_TIMEOUT)
+                  timeout=run_timeout(args))
     s = summary_numbers(out)
     sj = s["summary"]
     row = dict(size=size, mode=mode, repeat=rep, particles=s["particles"], steps=s["steps"], wall_s=s["wall_s"],
@@ -717,7 +724,7 @@ def bench_subcycle(args, outdir):
         case_override.override_case(src, case_path, ov)
         out = os.path.join(d, tag)
         r = run_lahar(args.lahar, "run", case_path, out, args.threads,
-                      timeout=args.timeout if args.timeout is not None else DEFAULT_TIMEOUT)
+                      timeout=run_timeout(args))
         s = summary_numbers(out)
         sj = s["summary"]
         dem = sj.get("nodes", {}).get("dem", {})

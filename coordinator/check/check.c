@@ -351,6 +351,23 @@ double lahar_check_late_from(const double *t, int64_t n, double fraction)
     return t1 - fraction * (t1 - t0);
 }
 
+int lahar_check_gauge_line(double **phi, size_t *cap, double low, double top, double support, double step)
+{
+    const int npt = (int)ceil((top + support - low) / step) + 1;
+    if ((size_t)npt > *cap) {
+        size_t c = *cap ? 2 * *cap : 1024;
+        while (c < (size_t)npt)
+            c *= 2;
+        double *t = realloc(*phi, c * sizeof *t);
+        if (!t)
+            return -1;
+        *phi = t, *cap = c;
+    }
+    for (int i = 0; i < npt; i++)
+        (*phi)[i] = 0.0;
+    return npt;
+}
+
 int lahar_check_panel(lahar_check_result *r, const char *title, const char *xlabel, const char *ylabel)
 {
     if (r->npanel >= LAHAR_CHECK_MAX_PANELS)

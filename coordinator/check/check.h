@@ -108,6 +108,10 @@ void lahar_check_value(lahar_check_result *r, const char *name, double v);
 /* Start of the late window of the times t[0, n) (n >= 1): the last `fraction` of the span
  * t[n-1] - t[0], where an evaluator averages a steady state (water: 0.1, soil: 0.25). */
 double lahar_check_late_from(const double *t, int64_t n, double fraction);
+/* A level gauge's line (common/kernels/kernel.h kernel_line_add, kernel_line_crossing): the
+ * points `step` apart from low up to a kernel support above top, zeroed in *phi (grown as needed,
+ * *cap its capacity). Returns their number, or -1 out of memory. */
+int lahar_check_gauge_line(double **phi, size_t *cap, double low, double top, double support, double step);
 /* Start a panel; returns its index (or -1 when there are LAHAR_CHECK_MAX_PANELS already). */
 int lahar_check_panel(lahar_check_result *r, const char *title, const char *xlabel, const char *ylabel);
 /* Start a curve in panel `panel`; following lahar_check_point calls add to it. Returns 0 or -1. */

@@ -239,12 +239,10 @@ static double fluid_gauge(const lahar_check_particles *p, const fluid_grid *g, c
     for (int64_t m2 = a2; m2 <= z2; m2++)
         for (int64_t m1 = a1; m1 <= z1; m1++)
             zt = fmax(zt, col->top[m2 * n1 + m1]), zb = fmin(zb, col->bot[m2 * n1 + m1]);
-    const int npt = (int)ceil((zt + S - zb) / step) + 1;
-    if (fluid_grow((void **)&col->phi, &col->cap_phi, (size_t)npt, sizeof *col->phi))
+    const int npt = lahar_check_gauge_line(&col->phi, &col->cap_phi, zb, zt, S, step);
+    if (npt < 0)
         return -INFINITY;
     double *phi = col->phi;
-    for (int i = 0; i < npt; i++)
-        phi[i] = 0.0;
     for (int64_t m2 = a2; m2 <= z2; m2++)
         for (int64_t m1 = a1; m1 <= z1; m1++)
             for (int64_t q = col->start[m2 * n1 + m1]; q < col->start[m2 * n1 + m1 + 1]; q++) {

@@ -36,7 +36,7 @@ typedef struct {
     int floor_j;               /* the fixed body under the lowest particle */
     double y_floor;            /* its surface's height */
     fluid_columns cols;
-    double tmax;               /* the highest gauge level at the last snapshot */
+    double tmax;               /* the highest particle at the last snapshot (sizes the rows) */
     /* the late window: pressures in rows of dx above the floor */
     int nb;
     double *bp, *by;           /* [nb] sums of the pressures and the heights of a row's samples */
@@ -71,8 +71,8 @@ static int hydrostatic_frame(const lahar_case *c, const lahar_check_data *d, hyd
 }
 
 /* At the last snapshot (left in the buffers): the fluid's centroid, the floor (the fixed body
- * whose surface faces up under the lowest particle) and the height of the free surface's highest
- * column, which sizes the rows. 0, or -1 with r->err. */
+ * whose surface faces up under the lowest particle) and the highest particle, which sizes the
+ * rows. 0, or -1 with r->err. */
 static int hydrostatic_floor(const lahar_case *c, const lahar_check_data *d, hydrostatic *hs, lahar_check_result *r)
 {
     const lahar_check_particles *p = d->particles;
@@ -86,9 +86,11 @@ static int hydrostatic_floor(const lahar_case *c, const lahar_check_data *d, hyd
     }
     int64_t ilow = 0;
     vec3 centre = v3(0, 0, 0);
+    hs->tmax = -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
         if (v3_dot(fluid_pos(p, i), up) < v3_dot(fluid_pos(p, ilow), up))
             ilow = i;
+        hs->tmax = fmax(hs->tmax, v3_dot(fluid_pos(p, i), up));
         centre = v3_add(centre, fluid_pos(p, i));
     }
     hs->centre = v3_scale(centre, 1.0 / (double)p->cur_n);
@@ -104,18 +106,8 @@ static int hydrostatic_floor(const lahar_case *c, const lahar_check_data *d, hyd
             best = gap, floor_j = j, y_floor = v3_dot(v3_axpy(c->bodies[j].shape.radius, n, cp), up);
     }
     hs->floor_j = floor_j, hs->y_floor = y_floor;
-    double level = 0.0, tmin = 0.0;
-    hs->tmax = 0.0;
     if (floor_j < 0) {
         snprintf(r->err, sizeof r->err, "hydrostatic: no fixed floor under the fluid");
-        return -1;
-    }
-    if (!fluid_surface(c, p, up, hs->e1, hs->e2, hs->dx, INFINITY, -INFINITY, &hs->cols, &level, &tmin,
-                       &hs->tmax)) {
-        snprintf(r->err, sizeof r->err,
-                 "hydrostatic: no free surface found: the water must reach a kernel support (%s, h = %g dx) beyond "
-                 "its sides, and sph.kernel must be valid",
-                 c->sph.kernel, c->sph.h_over_dx);
         return -1;
     }
     return 0;
@@ -160,6 +152,13 @@ static int hydrostatic_window(const lahar_case *c, const lahar_check_data *d, hy
             continue;
         hs->level_sum += level, hs->spread_sum += tmax - tmin, hs->nwin++;
         hydrostatic_bin_snapshot(p, k, hs);
+    }
+    if (hs->nwin == 0) {
+        snprintf(r->err, sizeof r->err,
+                 "hydrostatic: no free surface found: the water must reach a kernel support (%s, h = %g dx) beyond "
+                 "its sides, and sph.kernel must be valid",
+                 c->sph.kernel, c->sph.h_over_dx);
+        return -1;
     }
     hs->level = hs->level_sum / (hs->nwin ? hs->nwin : 1);
     hs->h = hs->level - hs->y_floor;
@@ -276,8 +275,8 @@ static void hydrostatic_report(const lahar_case *c, const lahar_check_particles 
     lahar_check_value(r, "side_walls", hs->nwall);
     lahar_check_value(r, "t_last", p->t[hs->kl]);
     snprintf(r->note, sizeof r->note,
-             "floor %s; h from the free-surface level (mean of the level gauges, kernel volume fraction 1/2); wall force: late-window mean, worst "
-             "side wall, reference rho g h^2/2 per unit width",
+             "floor %s; h from the free-surface level (mean of the level gauges, kernel volume fraction 1/2); "
+             "wall force: late-window mean, worst side wall, reference rho g h^2/2 per unit width",
              c->bodies[hs->floor_j].name);
     snprintf(r->title, sizeof r->title, "hydrostatic: h = %.4g m, worst wall force error %.3g %%", h,
              100.0 * hs->werr);

@@ -239,15 +239,9 @@ static double inflow_gauge(const lahar_check_particles *p, const kernel *k, int 
             top = fmax(top, hgt);
     if (!(top > low))
         return NAN;
-    const int npt = (int)ceil((top + S - low) / step) + 1;
-    if ((size_t)npt > *cap) {
-        double *t = realloc(*phi, (size_t)npt * sizeof *t);
-        if (!t)
-            return -INFINITY;
-        *phi = t, *cap = (size_t)npt;
-    }
-    for (int i = 0; i < npt; i++)
-        (*phi)[i] = 0.0;
+    const int npt = lahar_check_gauge_line(phi, cap, low, top, S, step);
+    if (npt < 0)
+        return -INFINITY;
     for (int64_t i = 0; i < p->cur_n; i++) {
         const double d2 = inflow_across2(p, dim, i, st, up, &hgt);
         kernel_line_add(k, d2, hgt, vol, low, step, npt, *phi);
