@@ -351,18 +351,25 @@ double lahar_check_late_from(const double *t, int64_t n, double fraction)
     return t1 - fraction * (t1 - t0);
 }
 
+int lahar_check_grow(void **buf, size_t *cap, size_t n, size_t sz)
+{
+    if (n <= *cap)
+        return 0;
+    size_t c = *cap ? 2 * *cap : 1024;
+    while (c < n)
+        c *= 2;
+    void *t = realloc(*buf, c * sz);
+    if (!t)
+        return -1;
+    *buf = t, *cap = c;
+    return 0;
+}
+
 int lahar_check_gauge_line(double **phi, size_t *cap, double low, double top, double support, double step)
 {
     const int npt = (int)ceil((top + support - low) / step) + 1;
-    if ((size_t)npt > *cap) {
-        size_t c = *cap ? 2 * *cap : 1024;
-        while (c < (size_t)npt)
-            c *= 2;
-        double *t = realloc(*phi, c * sizeof *t);
-        if (!t)
-            return -1;
-        *phi = t, *cap = c;
-    }
+    if (lahar_check_grow((void **)phi, cap, (size_t)npt, sizeof **phi))
+        return -1;
     for (int i = 0; i < npt; i++)
         (*phi)[i] = 0.0;
     return npt;

@@ -108,6 +108,9 @@ void lahar_check_value(lahar_check_result *r, const char *name, double v);
 /* Start of the late window of the times t[0, n) (n >= 1): the last `fraction` of the span
  * t[n-1] - t[0], where an evaluator averages a steady state (water: 0.1, soil: 0.25). */
 double lahar_check_late_from(const double *t, int64_t n, double fraction);
+/* Grow *buf (elements of size sz, capacity *cap) to hold n, doubling from 1024: 0, or -1 out of
+ * memory (buffers kept across snapshots). */
+int lahar_check_grow(void **buf, size_t *cap, size_t n, size_t sz);
 /* A level gauge's line (common/kernels/kernel.h kernel_line_add, kernel_line_crossing): the
  * points `step` apart from low up to a kernel support above top, zeroed in *phi (grown as needed,
  * *cap its capacity). Returns their number, or -1 out of memory. */

@@ -150,21 +150,6 @@ void fluid_columns_free(fluid_columns *col)
     *col = (fluid_columns){0};
 }
 
-/* Grow *buf (elements of size sz, capacity *cap) to hold n: 0, or -1 out of memory. */
-static int fluid_grow(void **buf, size_t *cap, size_t n, size_t sz)
-{
-    if (n <= *cap)
-        return 0;
-    size_t c = *cap ? 2 * *cap : 1024;
-    while (c < n)
-        c *= 2;
-    void *t = realloc(*buf, c * sz);
-    if (!t)
-        return -1;
-    *buf = t, *cap = c;
-    return 0;
-}
-
 /* The columns of fluid_surface: dx wide along e1 (and e2 in 3D), centred on the lowest particle's
  * coordinate so that on a lattice the particles sit on the column centres, under the gauges. */
 typedef struct {
@@ -196,10 +181,10 @@ static int fluid_sort_columns(const lahar_check_particles *p, fluid_grid *g, flu
     g->n[0] = (int64_t)floor((g->hi[0] - g->lo[0]) / g->dx + 0.5) + 1;
     g->n[1] = g->dim == 3 ? (int64_t)floor((g->hi[1] - g->lo[1]) / g->dx + 0.5) + 1 : 1;
     const int64_t ncol = g->n[0] * g->n[1];
-    if (fluid_grow((void **)&col->top, &col->cap_col, (size_t)ncol, sizeof *col->top) ||
-        fluid_grow((void **)&col->bot, &col->cap_bot, (size_t)ncol, sizeof *col->bot) ||
-        fluid_grow((void **)&col->start, &col->cap_start, (size_t)ncol + 1, sizeof *col->start) ||
-        fluid_grow((void **)&col->order, &col->cap_n, (size_t)p->cur_n, sizeof *col->order))
+    if (lahar_check_grow((void **)&col->top, &col->cap_col, (size_t)ncol, sizeof *col->top) ||
+        lahar_check_grow((void **)&col->bot, &col->cap_bot, (size_t)ncol, sizeof *col->bot) ||
+        lahar_check_grow((void **)&col->start, &col->cap_start, (size_t)ncol + 1, sizeof *col->start) ||
+        lahar_check_grow((void **)&col->order, &col->cap_n, (size_t)p->cur_n, sizeof *col->order))
         return -1;
     double *top = col->top, *bot = col->bot;
     int64_t *start = col->start;
