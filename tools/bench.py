@@ -110,10 +110,10 @@ BENCH = {
     "dam_break_3d": dict(
         # the column made 0.1 wide (height 2 x width, the tank's full 0.25 m across) so that the
         # Martin & Moyce front applies; the case's 0.3 m column has no published front to compare
-        # dx down to 0.1/28 (109,760 particles, 16 CPU minutes): the three finest runs show the
+        # dx down to 0.1/40 (320,000 particles, about 70 CPU minutes): the three finest runs show the
         # front's order (0.8, as in 2D); three runs ending at 0.1/20 gave a spurious 2.05
         file="dam_break_3d.yaml", overrides={"time.end": 0.35, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]},
-        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14, 0.1 / 20, 0.1 / 28], vary_at=[0, 1], timeout=2400.0,
+        dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14, 0.1 / 20, 0.1 / 28, 0.1 / 40], vary_at=[0, 1], timeout=7200.0,
         error=["front_rel_error"], converged=FRONT_SERIES, target=0.05,
         error_note="surge front against the converged front of the dx sweep (Richardson; column 0.1 x 0.25 x 0.2 m "
                    "instead of the case's 0.3 m wide one); deviation from Martin & Moyce 1952 (n^2 = 2) beside it"),
@@ -792,7 +792,7 @@ def main(argv):
     ap.add_argument("--threads", type=int, default=2, help="OpenMP threads per node (default 2)")
     ap.add_argument("--timeout", type=float, default=None,
                     help=f"seconds after which one run is stopped (default {DEFAULT_TIMEOUT:g}; the pareto sweeps of "
-                         "cases with longer runs set their own, dam_break_3d 2400)")
+                         "cases with longer runs set their own, dam_break_3d 7200)")
     ap.add_argument("--repeat", type=int, default=9,
                     help="pairs of runs of the overhead section (median is used; on a 2-core VM one pair varies by "
                          "+-20 %% and a median of 9 by about +-5 %%, docs/bench/cosim_overhead.md)")
