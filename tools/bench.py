@@ -110,8 +110,10 @@ BENCH = {
     "dam_break_3d": dict(
         # the column made 0.1 wide (height 2 x width, the tank's full 0.25 m across) so that the
         # Martin & Moyce front applies; the case's 0.3 m column has no published front to compare
-        # dx down to 0.1/40 (320,000 particles, about 70 CPU minutes): the three finest runs show the
-        # front's order (0.8, as in 2D); three runs ending at 0.1/20 gave a spurious 2.05
+        # dx down to 0.1/40 (320,000 particles, 72 CPU minutes): the three finest runs' order moved
+        # 2.05, 0.79, 2.26 as the sweep ended at 0.1/20, 0.1/28, 0.1/40 (the front moves in steps of
+        # dx); with 0.1/40 in, 0.1/20 is within 5 % against each converged front tried (the three-run
+        # Richardson, the finest run, a fit of the four finest: docs/bench/summary.md)
         file="dam_break_3d.yaml", overrides={"time.end": 0.35, "sph.blocks.0.box.hi": [0.1, 0.25, 0.2]},
         dx=[0.1 / 4, 0.1 / 5, 0.1 / 7, 0.1 / 10, 0.1 / 14, 0.1 / 20, 0.1 / 28, 0.1 / 40], vary_at=[0, 1], timeout=7200.0,
         error=["front_rel_error"], converged=FRONT_SERIES, target=0.05,
