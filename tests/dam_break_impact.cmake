@@ -30,12 +30,14 @@ lahar_test(tools_lobovsky_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_lobovsk
 # The centre plane in 2D (cases/dam_break_obstacle_plane_2d.yaml) as it is, dx 5 mm, 27000 particles,
 # 0.45 s (98 s of CPU): the first impact on P1 within the 5 % of the experiment's 0.394 s that
 # the timing target sets (measured +4.63 %; +5.04 % at dx 10 mm, the 3D case at dx 10 mm +4.86 %),
-# every level gauge within 15 mm (mean |dh|, measured 9 / 2 / 1 / 6 mm). The pressures after the
+# the front's travel time from the column (H4's first 20 mm drop) to that impact within 5 % of the
+# experiment's 0.260 s, which does not depend on the experiment's undocumented t = 0 (measured
+# +1.26 %; +2.65 % at dx 10 mm), every level gauge within 15 mm (mean |dh|, measured 9 / 2 / 1 / 6 mm). The pressures after the
 # impact are not checked in the plane (the water cannot go round the box there). --depths: the
 # H1/H2 depths against Ritter are printed and kept in the JSON.
 lahar_test(sph_dam_break_obstacle_plane_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/spheric2_plane_2d ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_plane_2d.yaml compare_spheric2.py
-  -- --impact-tol 0.05 --level-tol 0.015 --depths
+  -- --impact-tol 0.05 --travel-tol 0.05 --level-tol 0.015 --depths
   LABELS sph validation slow TIMEOUT 600)
 # The 3D case as it is (dx 40 mm, 9750 particles) to 0.5 s (26 s of CPU): it guards the 3D path
 # (plane walls, probes on a 3D box, level gauges) at the error of this coarse resolution, which is

@@ -6,8 +6,8 @@
 Writes CASE with the overrides (tools/case_override.py syntax, e.g. sph.dx=0.01 time.end=0.45) to
 OUT, runs it on one thread in one process, then tools/TOOL --check with the bounds after "--".
 TOOL is compare_lobovsky.py (Lobovsky et al. 2014; bounds --rise-tol, --peak-band, --level-tol, --spread-tol)
-or compare_spheric2.py (SPHERIC Test 2, Kleefsman et al. 2005; bounds --impact-tol, --level-tol,
---p1-mean-band); each tool's header says what it measures. The bounds used and the values they
+or compare_spheric2.py (SPHERIC Test 2, Kleefsman et al. 2005; bounds --impact-tol, --travel-tol,
+--level-tol, --p1-mean-band); each tool's header says what it measures. The bounds used and the values they
 guard: tests/dam_break_impact.cmake, cases/README.md. Writes OUT/NAME.json and OUT/NAME.png (NAME:
 the tool's name without compare_ and .py)."""
 import os

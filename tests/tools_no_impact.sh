@@ -4,7 +4,8 @@
 # first_impact_s = null), compare_spheric2.py exits 2 saying the water has not hit the box (it
 # raised a ValueError on an empty array), compare_lobovsky.py --check fails on the impact time
 # and reads "no value" against the spread (it printed nan), and plot_lobovsky_convergence.py's row
-# says there is no impact. check.json and summary.json name the case by its absolute path.
+# says there is no impact; on a run that has not ended both compare tools exit 2 and say so.
+# check.json and summary.json name the case by its absolute path.
 # usage: tools_no_impact.sh LAHAR SRC_DIR OUT_DIR PYTHON
 set -u
 lahar=$1 src=$2 out=$3 py=$4
@@ -30,6 +31,19 @@ rc=$?
 cat "$out/sp.err"
 [ $rc -eq 2 ] || fail "compare_spheric2.py: exit $rc on a run without impact, expected 2"
 grep -q "P1 never reaches" "$out/sp.err" || fail "compare_spheric2.py: no message saying why"
+
+# a run that has not ended (lahar writes this summary.json when it starts; a killed run keeps it):
+# both compare tools exit 2 saying so and how to go on (they raised a KeyError on "case")
+mkdir -p "$out/sp_running" && cp "$out/sp/gauges.h5" "$out/sp_running/"
+printf '{"status": "running", "message": "the run has not ended, or lahar was killed before it could write this summary"}\n' \
+  > "$out/sp_running/summary.json"
+for tool in compare_spheric2.py compare_lobovsky.py; do
+  "$py" "$src/tools/$tool" "$out/sp_running" --no-plot 2> "$out/running.err"
+  rc=$?
+  cat "$out/running.err"
+  [ $rc -eq 2 ] || fail "$tool: exit $rc on a run that has not ended, expected 2"
+  grep -q "status running: .*lahar resume $out/sp_running" "$out/running.err" || fail "$tool: no message saying the run has not ended"
+done
 
 # compare_lobovsky.py --check on a run that ends before the water reaches the wall: exit 1 with
 # the impact time among the failures and sensor 2 "no value" against the spread (NaN passed the

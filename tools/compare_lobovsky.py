@@ -38,7 +38,6 @@ sensor in --sensors (default sensor1 sensor2) peak_mean / experiment within --pe
 sensor 2's peak_mean within the experiment's spread widened by the fraction F:
 [p2.5 (1 - F), p97.5 (1 + F)]. The PNG shows pressure and levels against the experiment."""
 import argparse
-import json
 import os
 import sys
 
@@ -125,8 +124,7 @@ def main():
 
     dx = a.dx
     if dx is None:
-        with open(os.path.join(a.out, "summary.json")) as fh:
-            case = json.load(fh)["case"]
+        case = lahar_py.run_case(a.out)
         lahar_py.require("yaml")
         import yaml
         with open(case) as fh:

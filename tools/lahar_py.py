@@ -68,3 +68,23 @@ def null_as_nan(d):
     """json.load(..., object_hook=null_as_nan): the nulls dump_json wrote read back as nan, so
     that arithmetic and formatting on a quantity with no value give nan instead of a TypeError."""
     return {k: float("nan") if v is None else v for k, v in d.items()}
+
+
+def run_case(out):
+    """The case file a run in directory `out` was made from (OUT/summary.json "case"). Exit 2 with
+    what to do when there is no summary or the run has not ended (lahar writes the case's path
+    when it stops; a killed run leaves status "running")."""
+    import json
+    tool = os.path.basename(sys.argv[0])
+    path = os.path.join(out, "summary.json")
+    try:
+        with open(path) as fh:
+            summary = json.load(fh)
+    except (OSError, ValueError) as exc:
+        sys.stderr.write(f"{tool}: {path}: {exc}; give the output directory of a lahar run (lahar run CASE -o OUT)\n")
+        sys.exit(2)
+    if "case" not in summary:
+        sys.stderr.write(f"{tool}: {path}: status {summary.get('status', '?')}: {summary.get('message', '')}; "
+                         f"wait for the run to end, or continue it with `lahar resume {out}`\n")
+        sys.exit(2)
+    return summary["case"]
