@@ -53,6 +53,10 @@ lahar_test(check_poiseuille_2d COMMAND lahar check ${CMAKE_SOURCE_DIR}/cases/poi
 # `--help` exits 0
 lahar_test(tools_readme COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/tools_check.py ${CMAKE_SOURCE_DIR}/tools
   LABELS fast output)
+# tools/case_override.py's list paths: an element by name or index, a named element added by a map
+# (a body the case does not have), the refusals (tests/tools_case_override.py)
+lahar_test(tools_case_override COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/tools_case_override.py ${CMAKE_SOURCE_DIR}
+  ${CMAKE_CURRENT_BINARY_DIR}/tools_case_override LABELS fast output)
 # The impact tools on runs that end before the impact: plot_impact.py tabulates "none",
 # compare_spheric2.py exits 2 with a message (both crashed with a Python traceback)
 lahar_test(tools_no_impact COMMAND sh ${LAHAR_TEST_DIR}/tools_no_impact.sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/tools_no_impact ${LAHAR_OUTPUT_PYTHON}

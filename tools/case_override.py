@@ -7,6 +7,7 @@ usage: case_override.py CASE OUT.yaml [PATH=VALUE ...]
 PATH is a dotted key path into the case, VALUE is parsed as YAML:
     sph.dx=0.01   time.end=0.4   sph.kernel=wendland2   sph.blocks.0.box.hi=[0.1,0.2]
     bodies.cylinder.radius=0.03      (a list element by its `name:`, or by its index: bodies.0)
+    bodies.gate={shape: box, ...}    (a map for a name the list does not have adds that element)
     materials.rock.kn=1e8            (a missing map key is added)
     sph.delta=~                      (~ or null removes the key: the loader's default applies)
 Relative `file:` paths (STL blocks and bodies, terrain), `hydrograph:` and `level_hydrograph:` paths (inlets)
@@ -84,6 +85,18 @@ def _list_index(node, key, path):
     raise OverrideError(f"{path}: no element named '{key}' (names: {', '.join(map(str, names)) or 'none'})")
 
 
+def _is_new_named_element(node, key, value):
+    """`bodies.gate={...}` with no element named gate adds one: a map value, a key that is not an
+    index, in a list of named maps."""
+    try:
+        int(key)
+        return False
+    except ValueError:
+        pass
+    return (isinstance(value, dict) and value.get("name", key) == key and
+            all(isinstance(el, dict) and "name" in el for el in node))
+
+
 def set_path(doc, path, value):
     """Set (or with value None remove) the key at dotted `path` in the loaded case `doc`."""
     keys = path.split(".")
@@ -99,7 +112,13 @@ def set_path(doc, path, value):
         else:
             node[last] = value
     elif isinstance(node, list):
-        i = _list_index(node, last, path)
+        try:
+            i = _list_index(node, last, path)
+        except OverrideError:
+            if not _is_new_named_element(node, last, value):
+                raise
+            node.append({"name": last, **value})  # a body, block or probe the original does not have
+            return
         if value is None:
             del node[i]
         else:
