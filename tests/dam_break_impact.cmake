@@ -38,7 +38,7 @@ lahar_test(tools_lobovsky_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_lobovsk
 lahar_test(sph_dam_break_obstacle_plane_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/spheric2_plane_2d ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_plane_2d.yaml compare_spheric2.py
   -- --impact-tol 0.05 --travel-tol 0.05 --level-tol 0.015 --depths
-  LABELS sph validation slow TIMEOUT 600)
+  LABELS sph validation slow TIMEOUT 600 PROPERTIES FIXTURES_SETUP spheric2_runs)
 # The 3D case as it is (dx 40 mm, 9750 particles) to 0.5 s (26 s of CPU): it guards the 3D path
 # (plane walls, probes on a 3D box, level gauges) at the error of this coarse resolution, which is
 # what the bounds state: impact within 14 % (measured +12.72 %), levels within 30 mm (the lattice
@@ -47,4 +47,12 @@ lahar_test(sph_dam_break_obstacle_plane_2d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHA
 lahar_test(sph_dam_break_obstacle_3d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/experiment_check.py $<TARGET_FILE:lahar>
   ${CMAKE_CURRENT_BINARY_DIR}/impact/spheric2_3d ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_3d.yaml compare_spheric2.py time.end=0.5
   -- --impact-tol 0.14 --level-tol 0.03 --p1-mean-band 0.5 3
-  LABELS sph validation slow TIMEOUT 600)
+  LABELS sph validation slow TIMEOUT 600 PROPERTIES FIXTURES_SETUP spheric2_runs)
+# tools/plot_spheric2_convergence.py (timing and sustained loads against dx with their Richardson
+# extrapolation, docs/bench/impact_pressure.md "SPHERIC Test 2: P3 against resolution in the plane")
+# on the two runs above: each row's numbers those of the run's spheric2.json; on a synthetic
+# series of known limits and orders the converged values and orders recovered, "not monotone"
+# where the runs do not converge; a PNG; exit 2 on bad arguments
+lahar_test(tools_spheric2_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_spheric2_convergence.sh ${CMAKE_SOURCE_DIR}
+  ${CMAKE_CURRENT_BINARY_DIR}/impact ${CMAKE_CURRENT_BINARY_DIR}/tools_spheric2_convergence ${LAHAR_OUTPUT_PYTHON}
+  LABELS output TIMEOUT 60 PROPERTIES FIXTURES_REQUIRED spheric2_runs)

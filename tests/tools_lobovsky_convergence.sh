@@ -12,9 +12,7 @@ src=$1 runs=$2 out=$3 py=$4
 fail() { echo "tools_lobovsky_convergence: $*" >&2; exit 1; }
 mkdir -p "$out"
 tool="$src/tools/plot_lobovsky_convergence.py"
-# row LABEL FILE: the cells after the label of LABEL's row in the Markdown table FILE, '|'-separated
-row() { awk -F'|' -v l="$1" '{ for (i = 2; i < NF; i++) { gsub(/^ +| +$/, "", $i) } }
-  $2 == l { s = $3; for (i = 4; i < NF; i++) s = s "|" $i; print s }' "$2"; }
+. "$src/tests/tools_test_lib.sh"  # row, bad
 
 "$py" "$tool" "$out/conv.png" "delta=$runs/lobovsky_2d/lobovsky.json" "riemann=$runs/lobovsky_2d_riemann/lobovsky.json" > "$out/conv.md" ||
   fail "exit $? on the two runs"
@@ -49,12 +47,6 @@ new=$(row delta "$out/old.md" | cut -d'|' -f5,6) old=$(row old "$out/old.md" | c
 [ "$old" = "$new|-" ] || fail "older lobovsky.json: notes '$old', expected '$new|-'"
 
 # bad input: exit 2 and a message saying what is wrong
-bad() {  # bad NAME MESSAGE ARGS...: the tool on ARGS exits 2 with MESSAGE on stderr
-  name=$1 msg=$2; shift 2
-  "$py" "$tool" "$@" > /dev/null 2> "$out/$name.err"
-  rc=$?
-  [ $rc -eq 2 ] && grep -q "$msg" "$out/$name.err" || fail "$name: exit $rc, $(cat "$out/$name.err")"
-}
 bad no_json "no readable lobovsky.json" "$out/x.png" "a=$out/nothing"
 bad no_label "expected LABEL=RUN" "$out/x.png" "$runs/lobovsky_2d/lobovsky.json"
 bad no_run "expected LABEL=RUN" "$out/x.png" "a=,"

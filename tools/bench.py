@@ -288,27 +288,6 @@ def read_series(out, series):
     return None
 
 
-def richardson_order(dxs, r_obs, lo=0.25, hi=4.0):
-    """The order p of error ~ C dx^p that three resolutions dx1 > dx2 > dx3 with solution
-    differences |q1 - q2| / |q2 - q3| = r_obs imply: (dx1^p - dx2^p) / (dx2^p - dx3^p) = r_obs,
-    solved by bisection (the left side grows with p). None when r_obs lies outside what orders in
-    [lo, hi] give (the runs do not converge monotonically)."""
-    d1, d2, d3 = dxs
-
-    def g(p):
-        return (d1 ** p - d2 ** p) / (d2 ** p - d3 ** p)
-    if not (math.isfinite(r_obs) and g(lo) <= r_obs <= g(hi)):
-        return None
-    a, b = lo, hi
-    for _ in range(200):
-        m = 0.5 * (a + b)
-        if g(m) < r_obs:
-            a = m
-        else:
-            b = m
-    return 0.5 * (a + b)
-
-
 def converged_reference(curves):
     """The converged solution of a dx sweep. curves: {dx: y} on one time grid, >= 2 resolutions.
     With three or more: Richardson extrapolation from the three finest (y* = y3 + (y3 - y2) dx3^p /
@@ -323,7 +302,7 @@ def converged_reference(curves):
         d1, d2, d3 = dxs[-3:]
         y1, y2, y3 = curves[d1], curves[d2], curves[d3]
         e12, e23 = float(np.linalg.norm(y1 - y2)), float(np.linalg.norm(y2 - y3))
-        p = richardson_order((d1, d2, d3), e12 / e23 if e23 > 0 else float("inf"))
+        p = lahar_py.richardson_order((d1, d2, d3), e12 / e23 if e23 > 0 else float("inf"))
         if p is not None:
             return (y3 + (y3 - y2) * d3 ** p / (d2 ** p - d3 ** p),
                     f"Richardson from dx {d1:.4g}, {d2:.4g}, {d3:.4g} (observed order {p:.2f})", None)

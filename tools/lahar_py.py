@@ -1,4 +1,4 @@
-"""Shared start-up for lahar's python tools: make sure h5py/numpy (and matplotlib when asked)
+"""Code lahar's python tools share. Start-up: make sure h5py/numpy (and matplotlib when asked)
 import. Debian installs them for /usr/bin/python3 (python3-h5py, python3-matplotlib); when the
 `python3` first on PATH is another interpreter (pyenv, venv) without them, re-run the script under
 /usr/bin/python3 once instead of failing."""
@@ -68,6 +68,111 @@ def null_as_nan(d):
     """json.load(..., object_hook=null_as_nan): the nulls dump_json wrote read back as nan, so
     that arithmetic and formatting on a quantity with no value give nan instead of a TypeError."""
     return {k: float("nan") if v is None else v for k, v in d.items()}
+
+
+def richardson_order(dxs, r_obs, lo=0.25, hi=4.0):
+    """The order p of error ~ C dx^p that three resolutions dx1 > dx2 > dx3 with solution
+    differences |q1 - q2| / |q2 - q3| = r_obs imply: (dx1^p - dx2^p) / (dx2^p - dx3^p) = r_obs,
+    solved by bisection (the left side grows with p). None when r_obs lies outside what orders in
+    [lo, hi] give (the runs do not converge monotonically)."""
+    import math
+    d1, d2, d3 = dxs
+
+    def g(p):
+        return (d1 ** p - d2 ** p) / (d2 ** p - d3 ** p)
+    if not (math.isfinite(r_obs) and g(lo) <= r_obs <= g(hi)):
+        return None
+    a, b = lo, hi
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        if g(m) < r_obs:
+            a = m
+        else:
+            b = m
+    return 0.5 * (a + b)
+
+
+def richardson_extrapolate(dxs, qs):
+    """The converged value of a scalar q from runs at three resolutions dx1 > dx2 > dx3 (any
+    refinement ratios): q* = q3 + (q3 - q2) dx3^p / (dx2^p - dx3^p) with the observed order p of
+    richardson_order (Roache 1998; Celik et al. 2008). Returns (q*, p), or None when the three do
+    not converge monotonically: the differences change sign, one is zero, or no order in
+    [0.25, 4] fits their ratio. Then no converged value can be read off the runs."""
+    import math
+    (d1, d2, d3), (q1, q2, q3) = dxs, qs
+    if not all(math.isfinite(q) for q in qs) or not d1 > d2 > d3 > 0:
+        return None
+    e12, e23 = q1 - q2, q2 - q3
+    if e12 == 0 or e23 == 0 or (e12 > 0) != (e23 > 0):
+        return None
+    p = richardson_order((d1, d2, d3), e12 / e23)
+    if p is None:
+        return None
+    return q3 + (q3 - q2) * d3 ** p / (d2 ** p - d3 ** p), p
+
+
+def convergence_args(doc, load, fail):
+    """The command line of a convergence plot, `TOOL OUT.png "LABEL=RUN[,RUN...]" ...`: returns the
+    PNG's path and the series [(label, [m, ...])] with m = load(RUN) (a dict with the run's "dx"),
+    each series ordered coarse to fine. Prints `doc` and exits 0 on -h/--help, 2 on too few
+    arguments; fail(msg) on a PNG that is not one or whose directory is missing, and on an
+    argument that is not LABEL=RUN[,RUN...]."""
+    args = sys.argv[1:]
+    if len(args) < 2 or args[0] in ("-h", "--help"):
+        print(doc)
+        sys.exit(0 if args and args[0] in ("-h", "--help") else 2)
+    png = args[0]
+    if not png.endswith(".png"):
+        fail("the first argument is the PNG to write (got %r)" % png)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(png))):
+        fail("%s: its directory does not exist; create it or write the PNG elsewhere" % png)
+    series = []
+    for spec in args[1:]:
+        label, eq, runs = spec.partition("=")
+        paths = [r for r in runs.split(",") if r]
+        if not eq or not label or not paths:
+            fail("%r: expected LABEL=RUN[,RUN...]" % spec)
+        series.append((label, sorted((load(r) for r in paths), key=lambda m: -m["dx"])))
+    return png, series
+
+
+def read_compare_json(run, name, compare_tool, fail):
+    """(path, metrics) of the JSON `name` a compare tool wrote into run directory `run` (or `run`
+    itself when it is a .json file), nulls read as nan; fail(msg) saying to run `compare_tool` on
+    it when it cannot be read."""
+    import json
+    path = run if run.endswith(".json") else os.path.join(run, name)
+    try:
+        with open(path) as f:
+            return path, json.load(f, object_hook=null_as_nan)
+    except (OSError, ValueError) as e:
+        fail("%s: no readable %s (%s); run tools/%s on it first" % (run, name, e, compare_tool))
+
+
+def fail_usage(msg):
+    """A tool's error on bad usage or input: its name and msg on stderr, exit 2."""
+    sys.stderr.write("%s: %s\n" % (os.path.splitext(os.path.basename(sys.argv[0]))[0], msg))
+    sys.exit(2)
+
+
+def save_png(fig, png, fail):
+    """Write the figure (fail(msg) when it cannot be) and say where."""
+    try:
+        fig.savefig(png, dpi=90)
+    except OSError as e:
+        fail("%s: cannot write it (%s)" % (png, e))
+    print("wrote", png)
+
+
+def dx_axis(ax, dxs):
+    """A logarithmic dx axis (mm) for a convergence plot: finer to the right, ticks at the runs' dx
+    `dxs` instead of decades."""
+    from matplotlib.ticker import NullFormatter
+    ticks = sorted(set(dxs))
+    ax.set_xscale("log")
+    ax.set_xlim(max(ticks) * 1.3, min(ticks) / 1.3)
+    ax.set_xticks(ticks, ["%g" % d for d in ticks])
+    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def run_case(out):

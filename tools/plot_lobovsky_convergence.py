@@ -16,7 +16,6 @@ against that band (RMS distance from it, fraction of samples inside). Prints a M
 series, dx, impact t*, peaks and means of sensors 1-3, sensor 2 against the spread.
 Exit 0, 2 on bad usage, a RUN without a readable lobovsky.json, runs compared with different
 windows (--window of compare_lobovsky) or a PNG that cannot be written."""
-import json
 import math
 import os
 import sys
@@ -29,24 +28,16 @@ import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import NullFormatter  # noqa: E402
 from compare_lobovsky import rel_outside  # noqa: E402
 
 SENSORS = ("sensor1", "sensor2", "sensor3")
 
 
-def fail(msg):
-    print("plot_lobovsky_convergence: " + msg, file=sys.stderr)
-    sys.exit(2)
+fail = lahar_py.fail_usage
 
 
 def load(run):
-    path = run if run.endswith(".json") else os.path.join(run, "lobovsky.json")
-    try:
-        with open(path) as f:
-            m = json.load(f, object_hook=lahar_py.null_as_nan)
-    except (OSError, ValueError) as e:
-        fail("%s: no readable lobovsky.json (%s); run tools/compare_lobovsky.py on it first" % (run, e))
+    path, m = lahar_py.read_compare_json(run, "lobovsky.json", "compare_lobovsky.py", fail)
     if not isinstance(m, dict) or any(k not in m for k in ("dx", "rise", "sensors")) or \
             any(s not in m["sensors"] for s in SENSORS):
         fail("%s: not the JSON of tools/compare_lobovsky.py (no dx, rise or sensors 1-3)" % path)
@@ -74,23 +65,7 @@ def spread_note(s2):
 
 
 def main():
-    args = sys.argv[1:]
-    if len(args) < 2 or args[0] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if args and args[0] in ("-h", "--help") else 2
-    png = args[0]
-    if not png.endswith(".png"):
-        fail("the first argument is the PNG to write (got %r)" % png)
-    if not os.path.isdir(os.path.dirname(os.path.abspath(png))):
-        fail("%s: its directory does not exist; create it or write the PNG elsewhere" % png)
-    series = []
-    for spec in args[1:]:
-        label, eq, runs = spec.partition("=")
-        paths = [r for r in runs.split(",") if r]
-        if not eq or not label or not paths:
-            fail("%r: expected LABEL=RUN[,RUN...]" % spec)
-        ms = sorted((load(r) for r in paths), key=lambda m: -m["dx"])
-        series.append((label, ms))
+    png, series = lahar_py.convergence_args(__doc__, load, fail)
 
     first = series[0][1][0]
     window = first.get("window_ms", 10)
@@ -120,14 +95,6 @@ def main():
 
     fig, axes = plt.subplots(3, 3, figsize=(13, 10), sharex=True)
     dxs = [1e3 * m["dx"] for _, ms in series for m in ms]
-    lo, hi = min(dxs) / 1.3, max(dxs) * 1.3
-    ticks = sorted(set(dxs))
-
-    def dx_axis(ax):
-        ax.set_xscale("log")
-        ax.set_xlim(hi, lo)  # finer to the right
-        ax.set_xticks(ticks, ["%g" % d for d in ticks])  # the runs' dx, not decades
-        ax.xaxis.set_minor_formatter(NullFormatter())
     for k, n in enumerate(SENSORS):
         for row, (q, name) in enumerate((("peak", "peak"), ("peak_mean", "%g ms mean" % window))):
             ax = axes[row, k]
@@ -137,7 +104,7 @@ def main():
                 ax.axhspan(sp["p2.5"][q], sp["p97.5"][q], color="0.8", label="Lobovsky 2014, 2.5-97.5 % of the runs")
             for label, ms in series:
                 ax.plot([1e3 * m["dx"] for m in ms], [m["sensors"][n][q] for m in ms], "o-", label="lahar, " + label)
-            dx_axis(ax)
+            lahar_py.dx_axis(ax, dxs)
             if q == "peak":
                 ax.set_yscale("log")
             ax.set_title("%s: %s" % (n, name), fontsize=10)
@@ -154,7 +121,7 @@ def main():
                    if math.isfinite(m["sensors"]["sensor2"].get("spread", {}).get(q, math.nan))]
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label="lahar, " + label)
             drawn += [p[1] for p in pts]
-        dx_axis(ax)
+        lahar_py.dx_axis(ax, dxs)
         if q == "rms_outside" and any(v > 0 for v in drawn):
             ax.set_yscale("log")
         else:
@@ -165,11 +132,7 @@ def main():
     axes[2, 2].axis("off")
     axes[0, 1].legend(fontsize=7)
     fig.tight_layout()
-    try:
-        fig.savefig(png, dpi=90)
-    except OSError as e:
-        fail("%s: cannot write it (%s)" % (png, e))
-    print("wrote", png)
+    lahar_py.save_png(fig, png, fail)
     return 0
 
 
