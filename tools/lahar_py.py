@@ -1,7 +1,10 @@
-"""Code lahar's python tools share. Start-up: make sure h5py/numpy (and matplotlib when asked)
-import. Debian installs them for /usr/bin/python3 (python3-h5py, python3-matplotlib); when the
-`python3` first on PATH is another interpreter (pyenv, venv) without them, re-run the script under
-/usr/bin/python3 once instead of failing."""
+"""Code lahar's python tools share.
+
+Start-up (require): make sure h5py/numpy (and matplotlib when asked) import. Debian installs them
+for /usr/bin/python3 (python3-h5py, python3-matplotlib); when the `python3` first on PATH is
+another interpreter (pyenv, venv) without them, re-run the script under /usr/bin/python3 once
+instead of failing. Then: a sensor's window mean, strict JSON out and in, a run's case, Richardson
+extrapolation, and the command line, input, dx axis and PNG of the convergence plots."""
 import importlib
 import os
 import sys
