@@ -51,8 +51,9 @@ lahar_test(sph_dam_break_obstacle_3d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST
 # tools/plot_spheric2_convergence.py (timing and sustained loads against dx with their Richardson
 # extrapolation, docs/bench/impact_pressure.md "SPHERIC Test 2: P3 against resolution in the plane")
 # on the two runs above: each row's numbers those of the run's spheric2.json; on a synthetic
-# series of known limits and orders the converged values and orders recovered, "not monotone"
-# where the runs do not converge; a PNG; exit 2 on bad arguments
+# series of known limits and orders the converged values and orders recovered, and the reason
+# where the runs give none ("not monotone", "no order in 0.25-4", "no value in a run"); a PNG;
+# exit 2 on bad arguments
 lahar_test(tools_spheric2_convergence COMMAND sh ${LAHAR_TEST_DIR}/tools_spheric2_convergence.sh ${CMAKE_SOURCE_DIR}
   ${CMAKE_CURRENT_BINARY_DIR}/impact ${CMAKE_CURRENT_BINARY_DIR}/tools_spheric2_convergence ${LAHAR_OUTPUT_PYTHON}
   LABELS output TIMEOUT 60 PROPERTIES FIXTURES_REQUIRED spheric2_runs)
