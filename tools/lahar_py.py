@@ -101,17 +101,26 @@ def richardson_extrapolate(dxs, qs):
     richardson_order (Roache 1998; Celik et al. 2008). Returns (q*, p), or None when the three do
     not converge monotonically: the differences change sign, one is zero, or no order in
     [0.25, 4] fits their ratio. Then no converged value can be read off the runs."""
+    return richardson_extrapolate_or_why(dxs, qs)[0]
+
+
+def richardson_extrapolate_or_why(dxs, qs):
+    """richardson_extrapolate's result and, when it is None, why as a short phrase: "no value in a
+    run", "dx not decreasing", "not monotone" (the differences change sign or one is zero), "no
+    order in 0.25-4 (difference ratio r)" (they shrink too slowly or too fast)."""
     import math
     (d1, d2, d3), (q1, q2, q3) = dxs, qs
-    if not all(math.isfinite(q) for q in qs) or not d1 > d2 > d3 > 0:
-        return None
+    if not all(math.isfinite(q) for q in qs):
+        return None, "no value in a run"
+    if not d1 > d2 > d3 > 0:
+        return None, "dx not decreasing"
     e12, e23 = q1 - q2, q2 - q3
-    if e12 == 0 or e23 == 0 or (e12 > 0) != (e23 > 0):
-        return None
+    if e12 * e23 <= 0:
+        return None, "not monotone"
     p = richardson_order((d1, d2, d3), e12 / e23)
     if p is None:
-        return None
-    return q3 + (q3 - q2) * d3 ** p / (d2 ** p - d3 ** p), p
+        return None, "no order in 0.25-4 (difference ratio %.3g)" % (e12 / e23)
+    return (q3 + (q3 - q2) * d3 ** p / (d2 ** p - d3 ** p), p), None
 
 
 def convergence_args(doc, load, fail):

@@ -74,13 +74,8 @@ def converged(ms):
     dxs = tuple(m["dx"] for m in three)
     out = {}
     for key, _, val, _, _, _ in QUANTITIES:
-        qs = tuple(val(m) for m in three)
-        q = lahar_py.richardson_extrapolate(dxs, qs)
-        if q is None:
-            d12, d23 = qs[0] - qs[1], qs[1] - qs[2]
-            q = "no value in a run" if not all(math.isfinite(v) for v in qs) else \
-                "not monotone" if d12 * d23 <= 0 else "no order in 0.25-4 (difference ratio %.3g)" % (d12 / d23)
-        out[key] = q
+        q, why = lahar_py.richardson_extrapolate_or_why(dxs, tuple(val(m) for m in three))
+        out[key] = q if q is not None else why
     return out
 
 
