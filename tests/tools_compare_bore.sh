@@ -5,8 +5,8 @@
 # cases/bore_reflection_2d.yaml, snapshots of a sharp bore of known speed 0.6 m/s and depth 0.17 m
 # on a 10 mm lattice, a wall force 140 N/m with a ripple): speed, depth, force and the arriving
 # stream recovered, the --check verdicts at bounds either side of them; exit 2 with a message on a
-# missing run, an unknown wall, a window with too few snapshots or backwards, and a case without a
-# constant-velocity inlet.
+# missing run, an unknown wall, a window with too few snapshots or backwards, a case without a
+# constant-velocity inlet and one whose stream runs towards -x.
 # usage: tools_compare_bore.sh SRC_DIR OUT_DIR PYTHON
 set -u
 src=$1 out=$2 py=$3
@@ -100,4 +100,9 @@ bad window_late "snapshots in the window" "$run" --window 7 9
 mkdir -p "$out/no_inlet"
 echo "{\"case\": \"$src/cases/dam_break_lobovsky_2d.yaml\", \"status\": \"finished\"}" > "$out/no_inlet/summary.json"
 bad no_inlet "constant .velocity." "$out/no_inlet"
+mkdir -p "$out/upstream_wall"
+"$py" "$src/tools/case_override.py" "$src/cases/bore_reflection_2d.yaml" "$out/upstream_wall/case.yaml" \
+  "inlets.upstream.normal=[-1,0]" || fail "case_override"
+echo "{\"case\": \"$out/upstream_wall/case.yaml\", \"status\": \"finished\"}" > "$out/upstream_wall/summary.json"
+bad inlet_backwards "runs towards +x" "$out/upstream_wall"
 echo "tools_compare_bore: ok"

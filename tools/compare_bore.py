@@ -5,8 +5,8 @@
                         [--check [--speed-tol F] [--force-tol F] [--depth-tol F]]
 
 A supercritical stream (depth h1, velocity u1 from the case's inlet: `level` and a constant
-`velocity`) runs into a wall (the body --wall, default `wall`, a box whose upstream face ends the
-channel). The reference is the shallow-water shock across the bore that travels back upstream,
+`velocity`, the inlet's normal along +x) runs into a wall (the body --wall, default `wall`, a box
+whose upstream face ends the channel). The reference is the shallow-water shock across the bore that travels back upstream,
 with the water at rest behind it (mass and momentum conserved; e.g. Stoker 1957, Water Waves,
 ch. 10): with r = h2/h1 and F^2 = u1^2/(g h1), 2 r F^2 = (r - 1)^2 (r + 1), the bore speed
 w = h1 u1 / (h2 - h1), and the force on the wall rho g h2^2 / 2 per metre (2D).
@@ -77,6 +77,10 @@ def read_case(out, wall):
     if not inlets:
         raise InputError(f"{path}: inlets: none with `level` and a constant `velocity`: the reference needs "
                          "the stream's depth and speed (cases/bore_reflection_2d.yaml)")
+    normal = inlets[0].get("normal", [0.0, 0.0])
+    if not float(normal[0]) > 0.0:
+        raise InputError(f"{path}: inlets: normal {normal}: this tool reads a stream that runs towards +x, "
+                         "into a wall downstream of the inlet")
     bodies = {b.get("name"): b for b in case.get("bodies") or []}
     if wall not in bodies or bodies[wall].get("shape") != "box":
         raise InputError(f"{path}: bodies: no box named '{wall}' (bodies: {', '.join(map(str, bodies))}); "
