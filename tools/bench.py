@@ -671,7 +671,7 @@ def final_body_positions(out):
     import h5py
     import numpy as np
     with h5py.File(os.path.join(out, "bodies.h5"), "r") as f:
-        names = [n.decode() if isinstance(n, bytes) else str(n) for n in f["header/body_name"][()]]
+        names = lahar_py.text_names(f["header/body_name"][()])
         free = np.asarray(f["header/motion"][()]) == 0  # LAHAR_MOTION_FREE (common/scene/scene.h)
         snaps = sorted(f["snapshots"])
         first, last = f["snapshots"][snaps[0]], f["snapshots"][snaps[-1]]

@@ -141,7 +141,7 @@ def wall_force(out, wall):
     path = os.path.join(out, "forces.h5")
     try:
         with h5py.File(path, "r") as f:
-            names = [n.decode() if isinstance(n, bytes) else str(n) for n in f.attrs.get("body_names", [])]
+            names = lahar_py.text_names(f.attrs.get("body_names", []))
             if wall not in names:
                 raise InputError(f"{path}: no body '{wall}' (bodies: {', '.join(names)}); give it with --wall NAME")
             t = f["t"][()]
@@ -199,11 +199,8 @@ def plot(m, s, png):
     ax[0].set_ylabel("front x [m]")
     ax[0].legend(loc="best", fontsize=8)
     tf, fx = s["tf"], s["fx"]
-    k = max(1, int(round(0.1 / np.median(np.diff(tf))))) if len(tf) > 1 else 1
     ax[1].plot(tf, fx, color="0.8", lw=0.5, label="force on the wall, each step")
-    ones = np.ones(k)
-    running = np.convolve(fx, ones, mode="same") / np.convolve(np.ones(len(fx)), ones, mode="same")
-    ax[1].plot(tf, running, "b", lw=1, label="its 0.1 s running mean")
+    ax[1].plot(tf, lahar_py.running_mean(tf, fx, 0.1), "b", lw=1, label="its 0.1 s running mean")
     ax[1].axhline(s["f_ref"], color="r", ls="--", label=f"rho g h2^2 / 2 = {s['f_ref']:.1f} N/m")
     ax[1].axvspan(t0, t1, color="y", alpha=0.15, label=f"window: mean {m['force']['run']:.1f} N/m")
     ax[1].set_ylim(0, 3 * s["f_ref"])

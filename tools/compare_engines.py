@@ -35,10 +35,6 @@ class InputError(Exception):
     pass
 
 
-def _names(raw):
-    return [n.decode() if isinstance(n, bytes) else str(n) for n in raw]
-
-
 def load_run(out):
     """Snapshot times, names, motion kinds and positions (nsnap x nbody x 3) from bodies.h5, and
     the force stream (t, names, force) from forces.h5."""
@@ -48,7 +44,7 @@ def load_run(out):
             raise InputError(f"{p}: no such file (is {out} the output directory of a finished lahar run?)")
     try:
         with h5py.File(bpath, "r") as f:
-            names = _names(f["header/body_name"][()])
+            names = lahar_py.text_names(f["header/body_name"][()])
             motion = np.asarray(f["header/motion"][()])
             dim = int(f["header"].attrs.get("dimensions", 3))
             snaps = f["snapshots"]
@@ -61,7 +57,7 @@ def load_run(out):
             t = f["t"][()]
             n = len(t)
             force = f["force"][:n]
-            fnames = _names(f.attrs.get("body_names", []))
+            fnames = lahar_py.text_names(f.attrs.get("body_names", []))
     except (OSError, KeyError) as e:
         raise InputError(f"{out}: cannot read the output: {e}") from e
     order = np.argsort(times, kind="stable")

@@ -66,12 +66,6 @@ def first_at_or_above(t, p, level):
     return float(t[i[0]]) if len(i) else float("nan")
 
 
-def running_mean(t, p, tau):
-    """p averaged over a centred window of tau (samples assumed about evenly spaced)."""
-    w = max(1, int(round(tau / np.median(np.diff(t)))))
-    return np.convolve(p, np.ones(w) / w, mode="same")
-
-
 def window_peak(t, p, t0, tau):
     return lahar_py.window_mean_peak(t, p, t0, tau, SPAN)
 
@@ -130,9 +124,9 @@ def main():
         m["peaks"][n]["plateau"] = float(p[w].mean()) if covered else float("nan")
         m["peaks"][n]["plateau_exp"] = float(pe[we].mean())
         # how smooth the load is: rms of p about its running mean over --window, in that window
-        m["peaks"][n]["noise_rms"] = float(np.sqrt(np.mean((p - running_mean(t, p, tau))[w] ** 2))) if covered \
+        m["peaks"][n]["noise_rms"] = float(np.sqrt(np.mean((p - lahar_py.running_mean(t, p, tau))[w] ** 2))) if covered \
             else float("nan")
-        m["peaks"][n]["noise_rms_exp"] = float(np.sqrt(np.mean((pe - running_mean(te, pe, tau))[we] ** 2)))
+        m["peaks"][n]["noise_rms_exp"] = float(np.sqrt(np.mean((pe - lahar_py.running_mean(te, pe, tau))[we] ** 2)))
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
         if missing:
@@ -238,7 +232,7 @@ def plot(a, te, e, head, run_p, tls, hs, dx, tau, column):
         ax.plot(te, e[:, head.index(n)] / 1e3, "k", lw=1.0, label="Kleefsman et al. 2005 (SPHERIC Test 2)")
         t, p = run_p[n]
         ax.plot(t, p / 1e3, lw=0.7, label="lahar, dx %g mm" % (1e3 * dx))
-        ax.plot(t, running_mean(t, p, tau) / 1e3, lw=1.0, label="lahar, %g ms running mean" % a.window)
+        ax.plot(t, lahar_py.running_mean(t, p, tau) / 1e3, lw=1.0, label="lahar, %g ms running mean" % a.window)
         ax.set_ylabel(n + ", kPa")
         ax.grid(alpha=0.3)
         if k == 0:

@@ -49,6 +49,23 @@ def window_mean_peak(t, p, t0, tau, span):
     return float(best)
 
 
+def text_names(raw):
+    """Names stored as an HDF5 string array (forces.h5 body_names, bodies.h5 header/body_name) as str."""
+    return [n.decode() if isinstance(n, bytes) else str(n) for n in raw]
+
+
+def running_mean(t, p, tau):
+    """p averaged over a centred window of tau (samples assumed about evenly spaced); within tau/2
+    of either end over the samples the window holds there."""
+    import numpy as np
+    w = max(1, int(round(tau / np.median(np.diff(t))))) if len(t) > 1 else 1
+    mean = np.convolve(p, np.ones(w) / w, mode="same")
+    held = np.convolve(np.ones(len(p)), np.ones(w), mode="same")  # samples in each window
+    edge = held < w
+    mean[edge] *= w / held[edge]
+    return mean
+
+
 def _finite_or_none(x):
     import math
     if isinstance(x, dict):

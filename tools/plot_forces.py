@@ -23,11 +23,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def names_of(f):
-    raw = f.attrs.get("body_names", [])
-    return [n.decode() if isinstance(n, bytes) else str(n) for n in raw]
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", help="run output directory (holds forces.h5)")
@@ -41,7 +36,7 @@ def main():
         print(f"plot_forces: {path}: {e}", file=sys.stderr)
         return 2
     with f:
-        names = names_of(f)
+        names = lahar_py.text_names(f.attrs.get("body_names", []))
         t = f["t"][()]
         n = len(t)  # /t grows last: the other datasets hold at least these rows
         force, torque, ncont = f["force"][:n], f["torque"][:n], f["ncontacts"][:n]

@@ -101,7 +101,7 @@ def plot_body_energy(out, f, tmax):
     t = f["t"][:]
     m = clip(t, tmax)
     e = f["energy"][:]
-    names = [n.decode() if isinstance(n, bytes) else n for n in f.attrs.get("body_names", [])]
+    names = lahar_py.text_names(f.attrs.get("body_names", []))
     moving = [b for b in range(e.shape[1]) if np.any(e[:, b, 1] != 0) or np.any(e[:, b, 0] != 0)]
     if not moving:
         return None
