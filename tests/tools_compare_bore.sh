@@ -45,7 +45,7 @@ import numpy as np
 run, case = sys.argv[1], sys.argv[2]
 os.makedirs(run)
 json.dump({"case": os.path.abspath(case), "status": "finished"}, open(os.path.join(run, "summary.json"), "w"))
-dx, face = 0.01, 3.998
+dx, face = 0.01, 4.0
 cols = (np.arange(400) + 0.5) * dx  # to 3.995 m, in front of the face
 with h5py.File(os.path.join(run, "particles.h5"), "w") as f:
     f.create_group("header").attrs["dx"] = dx

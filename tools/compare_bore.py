@@ -86,7 +86,7 @@ def read_case(out, wall):
         raise InputError(f"{path}: bodies: no box named '{wall}' (bodies: {', '.join(map(str, bodies))}); "
                          "give the wall with --wall NAME")
     b = bodies[wall]
-    face = float(b["position"][0]) - 0.5 * float(b["size"][0]) - float(b.get("radius", 0.0))
+    face = float(b["position"][0]) - 0.5 * float(b["size"][0])  # a box's size is its outer size
     sph = case["sph"]
     return {"h1": float(inlets[0]["level"]), "u1": float(inlets[0]["velocity"]),
             "g": abs(float(case["gravity"][1])), "rho": float(sph["density"]),
