@@ -39,6 +39,11 @@ lahar_test(cli_progress_log COMMAND sh ${LAHAR_TEST_DIR}/cli_progress.sh $<TARGE
 # 92.4 %) and the dx that fills each short side; a case whose blocks are filled gets no note
 lahar_test(cli_block_fill_note COMMAND sh -c "out=$(\"$1\" validate \"$2\") && echo \"$out\" && echo \"$out\" | grep -q '^  9750 particles' && echo \"$out\" | grep -q \"note: sph.blocks\\[0\\] 'column' is 1.228 x 1 x 0.55 m, but at dx = 0.04 its particles fill 1.2 x 1 x 0.52 m, 92.4 % of its volume\" && echo \"$out\" | grep -q 'x 1.228 = 31 x 0.039613, z 0.55 = 14 x 0.039286' && ! \"$1\" validate \"$3\" | grep note" sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_3d.yaml ${CMAKE_SOURCE_DIR}/cases/dam_break_lobovsky_2d.yaml
   LABELS fast)
+# Pressure probes on a body with the penalty wall alone (debris_flow_3d.yaml's three on the dam)
+# read far below the body's load: `lahar validate` notes it once, naming the first probe, and
+# says which settings to use; a case with ghost walls (jet_impingement_2d.yaml) gets no note
+lahar_test(cli_wall_probe_note COMMAND sh -c "out=$(\"$1\" validate \"$2\") && echo \"$out\" && echo \"$out\" | grep -q \"note: probes\\[0\\] 'dam_low' (and the other probes on bodies) reads the pressure on body 'dam'\" && echo \"$out\" | grep -q 'Set sph.wall_pressure: ghost and sph.penalty_stiffness: acoustic' && [ $(echo \"$out\" | grep -c 'note: probes') -eq 1 ] && ! \"$1\" validate \"$3\" | grep note" sh $<TARGET_FILE:lahar> ${CMAKE_SOURCE_DIR}/cases/debris_flow_3d.yaml ${CMAKE_SOURCE_DIR}/cases/jet_impingement_2d.yaml
+  LABELS fast)
 
 # The key table (common/io/case_keys.c) drives the loader: keys accepted, defaults, range messages
 lahar_test(case_keys PROGRAM test_case_keys SOURCES test_case_keys.c LABELS fast)

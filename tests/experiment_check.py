@@ -8,8 +8,9 @@ Writes CASE with the overrides (tools/case_override.py syntax, e.g. sph.dx=0.01 
 OUT, runs it on one thread in one process, then tools/TOOL --check with the bounds after "--".
 TOOL is compare_lobovsky.py (Lobovsky et al. 2014; bounds --rise-tol, --peak-band, --level-tol,
 --spread-tol), compare_spheric2.py (SPHERIC Test 2, Kleefsman et al. 2005; bounds --impact-tol,
---travel-tol, --level-tol, --p1-mean-band) or compare_bore.py (the bore a wall reflects, against
-the shallow-water shock; bounds --speed-tol, --force-tol, --depth-tol); each tool's header says
+--travel-tol, --level-tol, --p1-mean-band) compare_bore.py (the bore a wall reflects, against
+the shallow-water shock; bounds --speed-tol, --force-tol, --depth-tol) or compare_jet.py (a jet
+hitting a wall, against the free-streamline solution; bounds --pressure-tol, --force-tol); each tool's header says
 what it measures. The bounds used and the values they guard: tests/dam_break_impact.cmake,
 cases/README.md. Writes OUT/NAME.json and OUT/NAME.png (NAME: the tool's name without compare_ and
 .py)."""
