@@ -7,7 +7,9 @@
 # difference, the stagnation deficit, the force and the probes' integral recovered; the --check
 # verdicts at bounds either side of them; exit 2 with a message on a missing run, an unknown plate,
 # a window backwards or after the run, a case without an inlet of constant velocity and one whose
-# inlet is only partly wetted.
+# inlet is only partly wetted; in 3D (cases/jet_impingement_3d.yaml) the stagnation point and the
+# force rho U^2 A recovered from a synthetic run, the off-axis probes without a reference, exit 2
+# without a probe on the axis.
 # usage: tools_compare_jet.sh SRC_DIR OUT_DIR PYTHON
 set -u
 src=$1 out=$2 py=$3
@@ -100,6 +102,54 @@ PY
   fail "--check with pressure at 6.5 %: exit $?, $(cat "$out/check0.txt")"
 "$py" "$tool" "$run" --no-plot --json "$out/c.json" --check --pressure-tol 0.065 --force-tol 0.015 > "$out/check2.txt"
 [ $? -eq 1 ] && grep -q "FAIL force" "$out/check2.txt" || fail "--check with force at 1.5 %: $(cat "$out/check2.txt")"
+
+# 3D (cases/jet_impingement_3d.yaml): only the stagnation point and the force have a reference; a
+# synthetic run with the axis probe at 0.7 rho U^2 / 2, the others off the axis, the force 1.05 rho U^2 A
+run3="$out/synthetic3d"
+"$py" - "$run3" "$src/cases/jet_impingement_3d.yaml" <<'PY' || fail "cannot write the synthetic 3D run"
+import json, os, sys
+import h5py
+import numpy as np
+run, case = sys.argv[1], sys.argv[2]
+os.makedirs(run)
+json.dump({"case": os.path.abspath(case), "status": "finished"}, open(os.path.join(run, "summary.json"), "w"))
+t = np.arange(201) * 1e-4
+with h5py.File(os.path.join(run, "gauges.h5"), "w") as f:
+    for name, y, z, p in (("axis", 0, 0, 35000), ("side", 0.01, 0, 20000), ("corner", 0.007, 0.007, 15000)):
+        g = f.create_group("probes/" + name)
+        g.attrs["kind"], g.attrs["body"] = "pressure", "plate"
+        g.attrs["position"] = np.array([0.06, y, z])
+        g["t"], g["p"] = t, np.full(len(t), float(p))
+with h5py.File(os.path.join(run, "forces.h5"), "w") as f:
+    force = np.zeros((len(t), 1, 3))
+    force[:, 0, 0] = 42.0
+    f.attrs["body_names"] = np.array(["plate"], dtype=object)
+    f["t"], f["force"] = t, force
+PY
+"$py" "$tool" "$run3" --window 0.01 0.02 --json "$out/synthetic3d.json" -o "$out/synthetic3d.png" > "$out/synthetic3d.txt" ||
+  fail "exit $? on the synthetic 3D run: $(cat "$out/synthetic3d.txt")"
+cat "$out/synthetic3d.txt"
+"$py" - "$out/synthetic3d.json" <<'PY' || fail "the synthetic 3D run's metrics"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["case"]["dim"] == 3 and abs(m["case"]["area"] - 4e-4) < 1e-12 and abs(m["case"]["b"] - 0.02) < 1e-12, m["case"]
+assert abs(m["stagnation"]["rel"] + 0.3) < 1e-9 and m["stagnation"]["probe"] == "axis", m["stagnation"]
+assert abs(m["pressure"]["max_abs_diff"] - 0.3) < 1e-9, m["pressure"]  # only the axis has a reference
+assert [r["reference"] for r in m["pressure"]["probes"]][1:] == [None, None], m["pressure"]
+assert abs(m["force"]["reference"] - 40) < 1e-9 and abs(m["force"]["rel"] - 0.05) < 1e-9, m["force"]
+assert m["probe_integral"] is None and m["reference_deficit_at_nozzle"] is None
+PY
+"$py" "$tool" "$run3" --window 0.01 0.02 --no-plot --json "$out/c.json" --check --pressure-tol 0.35 --force-tol 0.06 \
+  > "$out/check3.txt" || fail "--check 3D at 35 / 6 %: exit $?, $(cat "$out/check3.txt")"
+"$py" "$tool" "$run3" --window 0.01 0.02 --no-plot --json "$out/c.json" --check --pressure-tol 0.25 --force-tol 0.06 \
+  > "$out/check4.txt"
+[ $? -eq 1 ] && grep -q "FAIL pressure" "$out/check4.txt" || fail "--check 3D with pressure at 25 %: $(cat "$out/check4.txt")"
+"$py" - "$run3" <<'PY' || fail "cannot move the axis probe"
+import h5py, sys
+with h5py.File(sys.argv[1] + "/gauges.h5", "r+") as f:
+    f["probes/axis"].attrs["position"] = [0.06, 0.004, 0.0]
+PY
+bad no_axis_probe "no probe on the jet's axis" "$run3" --window 0.01 0.02
 
 bad no_run "summary.json" "$out/nosuchrun"
 bad no_plate "no body named 'wall'" "$run" --plate wall

@@ -52,8 +52,7 @@ CLEAR = 0.3  # m the front must be upstream of that reach
 ARRIVE = (0.2, 0.5)  # m ahead of the front where the arriving stream is measured
 
 
-class InputError(Exception):
-    pass
+InputError = lahar_py.InputError
 
 
 def bore_reference(h1, u1, g):
@@ -138,16 +137,8 @@ def front_positions(centres, depths, level, dx):
 
 
 def wall_force(out, wall):
-    path = os.path.join(out, "forces.h5")
-    try:
-        with h5py.File(path, "r") as f:
-            names = lahar_py.text_names(f.attrs.get("body_names", []))
-            if wall not in names:
-                raise InputError(f"{path}: no body '{wall}' (bodies: {', '.join(names)}); give it with --wall NAME")
-            t = f["t"][()]
-            return t, f["force"][: len(t), names.index(wall), 0]
-    except OSError as e:
-        raise InputError(f"{path}: {e}")
+    t, force = lahar_py.body_force(out, wall, "--wall NAME")
+    return t, force[:, 0]
 
 
 def measure(out, wall, window):
@@ -223,14 +214,10 @@ def plot(m, s, png):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out", help="run output directory")
+    lahar_py.compare_cli(ap, "bore")
     ap.add_argument("--wall", default="wall", help="the wall body's name (default wall)")
     ap.add_argument("--window", type=float, nargs=2, default=[1.5, 5.5], metavar=("T0", "T1"),
                     help="time window of the comparison, s (default 1.5 5.5)")
-    ap.add_argument("-o", "--output", help="PNG (default OUT/bore.png)")
-    ap.add_argument("--json", help="metrics as JSON (default OUT/bore.json)")
-    ap.add_argument("--no-plot", action="store_true", help="write no PNG")
-    ap.add_argument("--check", action="store_true", help="exit 1 when a bound below is not met")
     ap.add_argument("--speed-tol", type=float, default=0.05, help="bound on |speed / w - 1|")
     ap.add_argument("--force-tol", type=float, default=0.05, help="bound on |force / (rho g h2^2/2) - 1|")
     ap.add_argument("--depth-tol", type=float, default=0.05, help="bound on |depth / h2 - 1|")
@@ -257,12 +244,10 @@ def main():
     if not a.no_plot:
         plot(m, s, a.output or os.path.join(a.out, "bore.png"))
     if a.check:
-        bad = [f"{k} {100 * m[k]['rel']:+.1f} % outside +-{100 * tol:g} %"
-               for k, tol in (("speed", a.speed_tol), ("force", a.force_tol), ("depth", a.depth_tol))
-               if not abs(m[k]["rel"]) <= tol]
-        for b in bad:
-            print(f"compare_bore: FAIL {b}")
-        return 1 if bad else 0
+        return lahar_py.check_verdict("compare_bore", [
+            f"{k} {100 * m[k]['rel']:+.1f} % outside +-{100 * tol:g} %"
+            for k, tol in (("speed", a.speed_tol), ("force", a.force_tol), ("depth", a.depth_tol))
+            if not abs(m[k]["rel"]) <= tol])
     return 0
 
 

@@ -3,8 +3,9 @@
 Start-up (require): make sure h5py/numpy (and matplotlib when asked) import. Debian installs them
 for /usr/bin/python3 (python3-h5py, python3-matplotlib); when the `python3` first on PATH is
 another interpreter (pyenv, venv) without them, re-run the script under /usr/bin/python3 once
-instead of failing. Then: a sensor's window mean, strict JSON out and in, a run's case, Richardson
-extrapolation, and the command line, input, dx axis and PNG of the convergence plots."""
+instead of failing. Then: a sensor's window mean, strict JSON out and in, a run's case, a body's
+force stream, the command line and verdict of the comparison tools, Richardson extrapolation, and
+the command line, input, dx axis and PNG of the convergence plots."""
 import importlib
 import os
 import sys
@@ -52,6 +53,43 @@ def window_mean_peak(t, p, t0, tau, span):
 def text_names(raw):
     """Names stored as an HDF5 string array (forces.h5 body_names, bodies.h5 header/body_name) as str."""
     return [n.decode() if isinstance(n, bytes) else str(n) for n in raw]
+
+
+class InputError(Exception):
+    """A run or case a tool cannot read; the message says what is missing and what to do."""
+
+
+def body_force(out, body, option):
+    """(t, force rows [n, 3]) of the body named `body` in OUT/forces.h5; InputError naming the
+    file, the bodies it holds and the `option` that chooses another."""
+    import h5py
+    path = os.path.join(out, "forces.h5")
+    try:
+        with h5py.File(path, "r") as f:
+            names = text_names(f.attrs.get("body_names", []))
+            if body not in names:
+                raise InputError(f"{path}: no body '{body}' (bodies: {', '.join(names)}); give it with {option}")
+            t = f["t"][()]
+            return t, f["force"][: len(t), names.index(body), :]
+    except OSError as e:
+        raise InputError(f"{path}: {e}")
+
+
+def compare_cli(ap, name):
+    """The arguments compare_bore.py and compare_jet.py share: the run, the PNG, the JSON (default
+    OUT/NAME.png, OUT/NAME.json), --no-plot and --check."""
+    ap.add_argument("out", help="run output directory")
+    ap.add_argument("-o", "--output", help=f"PNG (default OUT/{name}.png)")
+    ap.add_argument("--json", help=f"metrics as JSON (default OUT/{name}.json)")
+    ap.add_argument("--no-plot", action="store_true", help="write no PNG")
+    ap.add_argument("--check", action="store_true", help="exit 1 when a bound below is not met")
+
+
+def check_verdict(tool, failures):
+    """Print one `TOOL: FAIL ...` line per failed bound; the exit status of --check (1 if any)."""
+    for x in failures:
+        print(f"{tool}: FAIL {x}")
+    return 1 if failures else 0
 
 
 def running_mean(t, p, tau):
