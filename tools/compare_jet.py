@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Compare a run of cases/jet_impingement_2d.yaml with the free-streamline solution of a jet that
-hits a wall normally.
+"""Compare a run of cases/jet_impingement_2d.yaml (or _3d.yaml) with the free-streamline solution of
+a jet that hits a wall normally.
 
   tools/compare_jet.py OUT [--plate NAME] [--window T0 T1] [-o FILE.png] [--json FILE] [--no-plot]
                        [--check [--pressure-tol F] [--force-tol F]]
@@ -20,6 +20,11 @@ at a distance d from the plate at the speed s U with d = (2 b / pi) (artanh s + 
 reference holds for a nozzle far from the plate, and the tool reports the speed deficit the theory
 gives at the inlet's distance (0.16 % of the dynamic pressure at 3 b).
 
+In 3D (the inlet's section the rectangle of `edge` and `edge2`, area A, b = sqrt(A)) only two
+things are exact for any section: the stagnation pressure rho U^2 / 2 (Bernoulli along the axis)
+and the force rho U^2 A. A probe on the axis (within 0.05 b of it) is compared with the first; the
+others are reported with their distance s from the axis, without a reference.
+
 Reads OUT/gauges.h5 (the pressure probes on the plate), OUT/forces.h5 and the case
 (OUT/summary.json). Metrics over the window T0-T1 (default: the second half of the case's
 time.end, 0.015-0.03 s in 2D, 0.01-0.02 s in 3D; the flow is steady after about 10 b / U), printed
@@ -27,13 +32,13 @@ and written to --json (default OUT/jet.json):
   pressure    per probe the window mean against p(s), the difference as a fraction of rho U^2 / 2;
               the largest |difference| over the probes is checked
   stagnation  the probe nearest the axis: its mean / (rho U^2 / 2) - 1
-  force       the plate's mean force along the jet against rho U^2 b, relative difference, and
-              its rms about the mean
-  probe_integral  the probes' means integrated along the plate (trapezoids over their span)
+  force       the plate's mean force along the jet against rho U^2 b (3D: rho U^2 A), relative
+              difference, and its rms about the mean
+  probe_integral  2D: the probes' means integrated along the plate (trapezoids over their span)
               against the reference's integral over the same span (reported: whether the wall
               pressure the probes read and the force the plate carries agree)
 With --check: exit 1 unless max |difference| <= --pressure-tol (default 0.05) and |force /
-(rho U^2 b) - 1| <= --force-tol (default 0.03). The PNG shows the mean pressure along the plate
+(momentum flux) - 1| <= --force-tol (default 0.03). The PNG shows the mean pressure along the plate
 against p(s) and the force against time. Exit 2 on a run or case this tool cannot read (what is
 missing and what to do is printed)."""
 import argparse
