@@ -328,8 +328,10 @@ static int dem_node_loop(dem_node *d, int64_t k0, double t0, int at_output0, int
                 dem_node_final_snapshot(d, &msg, k, t_now, last_snapshot);
                 return 0;
             }
-            if (rc == LAHAR_LINK_LOST)
+            if (rc == LAHAR_LINK_LOST) {
+                lahar_node_report_lost("lahar-dem", "the SPH node's loads of step", k);
                 return 3;
+            }
             if (rc != LAHAR_LINK_OK || dem_node_read_loads(d, &msg, err, sizeof err) != 0)
                 st.error = 1;
             const lahar_loads_buf *lm = &d->loads_msg;

@@ -100,18 +100,23 @@ int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, 
     return 0;
 }
 
+void lahar_node_report_lost(const char *prog, const char *what, int64_t k)
+{
+    if (lahar_link_parent_gone())
+        fprintf(stderr, "%s: lahar, which started this node, has ended (waiting for %s %lld); closing the "
+                "output files and exiting\n", prog, what, (long long)k);
+    else
+        fprintf(stderr, "%s: the coordinator has been silent for %.0f s (waiting for %s %lld); exiting\n", prog,
+                LAHAR_NODE_COORDINATOR_SILENCE, what, (long long)k);
+}
+
 int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_msg *msg, lahar_step_t *step)
 {
     int rc = lahar_link_wait(l, LAHAR_ROLE_COORDINATOR, LAHAR_FRAME_T_MSG_STEP, k, -1, msg);
     if (rc == LAHAR_LINK_STOP)
         return 0;
     if (rc == LAHAR_LINK_LOST) {
-        if (lahar_link_parent_gone())
-            fprintf(stderr, "%s: lahar, which started this node, has ended (waiting for step %lld); closing the "
-                    "output files and exiting\n", prog, (long long)k);
-        else
-            fprintf(stderr, "%s: the coordinator has been silent for %.0f s (waiting for step %lld); exiting\n", prog,
-                    LAHAR_NODE_COORDINATOR_SILENCE, (long long)k);
+        lahar_node_report_lost(prog, "step", k);
         return 3;
     }
     if (rc != LAHAR_LINK_OK || LAHAR_MSG_DECODE(lahar_step_t, msg->data, msg->size, step) < 0)

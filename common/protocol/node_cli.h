@@ -35,6 +35,12 @@ int lahar_node_connect(const lahar_node_options *o, const char *prog, int role, 
  * (reported as "prog: ..."), 1 a broken message. `msg` is the caller's receive slot. */
 int lahar_node_wait_step(lahar_link *l, const char *prog, int64_t k, lahar_link_msg *msg, lahar_step_t *step);
 
+/* Why a wait of the node ended with LAHAR_LINK_LOST, as "prog: ..." on stderr: lahar, which
+ * started the node, has ended, or the coordinator went silent. `what` names what the node was
+ * waiting for ("step", "the SPH node's loads of step"), k the step. Every wait that can be lost
+ * says it, so a node never stops without a reason whichever wait the loss finds it in. */
+void lahar_node_report_lost(const char *prog, const char *what, int64_t k);
+
 /* After lahar_node_wait_step returned 0: the reason of the coordinator's STOP in msg (stop_t:
  * 0 finished, 1 error, 2 interrupted, 3 node lost; -1 if undecodable) and its message into
  * text (n bytes, may be NULL). A node writes its final snapshot for inspection when it is not 0. */

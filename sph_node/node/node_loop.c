@@ -317,8 +317,10 @@ static int sph_step_wait_bodies(sph_node *s, int64_t k, const lahar_step_t *step
             sph_node_stopped_half_step(s, &msg, k, step);
         return 0;
     }
-    if (rc == LAHAR_LINK_LOST)
+    if (rc == LAHAR_LINK_LOST) {
+        lahar_node_report_lost("lahar-sph", "the DEM node's body states of step", k);
         return 3;
+    }
     if (rc != LAHAR_LINK_OK || lahar_body_state_decode(msg.data, msg.size, &s->bodies) != 0) {
         if (!w->st.error)
             snprintf(w->err, sizeof w->err, "undecodable BODY_STATE(%lld)", (long long)k);
