@@ -126,16 +126,15 @@ def read_case(out, plate):
 
 
 def read_probes(out, plate):
-    """{name: (s, t, p)} of the pressure probes on the plate, and the plate's name (the probes'
-    body when --plate is not given)."""
+    """The plate's name (the probes' body when --plate is not given) and {name: (position, t, p)}
+    of the pressure probes on it."""
     path = os.path.join(out, "gauges.h5")
     probes = {}
     try:
         with h5py.File(path, "r") as f:
             for name, g in f["probes"].items():
                 if g.attrs.get("kind") in (b"pressure", "pressure") and "body" in g.attrs:
-                    body = g.attrs["body"]
-                    body = body.decode() if isinstance(body, bytes) else str(body)
+                    body = lahar_py.text_names([g.attrs["body"]])[0]
                     probes[name] = (body, np.array(g.attrs["position"], float), g["t"][()], g["p"][()])
     except (OSError, KeyError) as e:
         raise InputError(f"{path}: {e}; give the output directory of a run of cases/jet_impingement_2d.yaml")
