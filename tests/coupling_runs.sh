@@ -186,6 +186,8 @@ node_killed)
     grep -q "DEM node" stderr.txt || fail "message does not name the DEM node"
     grep -q "last completed step [0-9]" stderr.txt || fail "message does not give the last completed step"
     h5dump -H killed/bodies.h5 > /dev/null || fail "bodies.h5 written so far does not open"
+    # the twin the killed writer left (common/io/output_snapfile.c) is removed by the coordinator
+    [ ! -e killed/.bodies.h5.twin ] || fail "the killed node's killed/.bodies.h5.twin is left"
     # the force stream of the killed SWMR writer: every row it flushed reads (h5dump reads the data)
     h5dump killed/forces.h5 > /dev/null || fail "forces.h5 of the killed node does not read"
     [ "$(summary killed "s['status']")" = "node lost" ] || fail "summary.json status is not 'node lost'"
@@ -422,7 +424,7 @@ busy_machine)
     echo "busy_machine: $threads threads on $cores cores: note, passive set, same results as active; user's policy kept"
     ;;
 disk_full)
-    # OUT on a small file system (a 2 MB tmpfs in a private user + mount namespace) that the run
+    # OUT on a small file system (a 5 MB tmpfs in a private user + mount namespace) that the run
     # fills: the node that cannot write says which file, "no space left on device" and the step
     # and time; the run stops with exit 1 and status "error" (no hang, no crash); every HDF5 file
     # opens with h5py and every dataset reads; the particle snapshots written before the failure
@@ -434,7 +436,7 @@ disk_full)
     "$bin/lahar" run full.yaml -o ref -q --in-process || fail "reference run failed"
     mkdir -p mnt
     unshare --user --map-root-user --mount bash -c "
-        mount -t tmpfs -o size=2m tmpfs mnt || exit 9
+        mount -t tmpfs -o size=5m tmpfs mnt || exit 9
         '$bin/lahar' run full.yaml -o mnt/out -q 2> full.stderr & lahar=\$!
         nodes=''
         while kill -0 \$lahar 2>/dev/null; do

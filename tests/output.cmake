@@ -69,3 +69,17 @@ lahar_test(include_deps COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/include
 # (tests/doc_section_refs.py): a section renamed or moved leaves no reader pointed at nothing
 lahar_test(doc_section_refs COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/doc_section_refs.py ${CMAKE_SOURCE_DIR}
   LABELS fast output)
+
+# A writer killed with SIGKILL at random moments (inside HDF5's writes and closes too) leaves
+# bodies.h5 and particles.h5 that open, with every snapshot it had finished: 80 writers killed
+# (tests/test_output_killed.c), 8 s
+lahar_output_test(test_output_killed)
+lahar_test(output_killed COMMAND test_output_killed ${LAHAR_OUTPUT_TEST_DIR}/killed 80 LABELS fast output TIMEOUT 120)
+
+# The cost of a particle snapshot at 2,400 to 1,000,000 particles (tests/bench/bench_output.c),
+# run by the `bench` target; prints a table, never a pass/fail (docs/bench/output.md).
+add_executable(bench_output ${LAHAR_TEST_DIR}/bench/bench_output.c)
+target_link_libraries(bench_output PRIVATE lahar_common)
+add_custom_target(bench_output_table COMMAND bench_output ${CMAKE_BINARY_DIR}/bench_output_dir DEPENDS bench_output
+  USES_TERMINAL COMMENT "bench_output: the cost of a particle snapshot")
+add_dependencies(bench bench_output_table)

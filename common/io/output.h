@@ -3,8 +3,9 @@
  *   OUT/bodies.h5   /header (units, version, case, per-body names, materials, motion, mass,
  *                   inertia), /geometry (display meshes written once), /snapshots/NNNNNN
  *                   (time, step, per-body pose and velocities, world-frame display vertices of
- *                   the moving bodies). Reopened and closed for every snapshot, so the file on
- *                   disk is always complete and other programs can open it while a job runs.
+ *                   the moving bodies). Closed after every snapshot, and written so that the
+ *                   file on disk is always complete, even when its writer is killed (see
+ *                   lahar_output_remove_twins), and other programs can open it while a job runs.
  *   OUT/bodies.xmf  XDMF temporal collection, rewritten in place after each snapshot.
  *   OUT/forces.h5   per-body force stream (SWMR: readable while the run appends to it).
  *   OUT/particles.h5 + OUT/particles.xmf   SPH particles (SoA datasets, fields selectable).
@@ -116,6 +117,13 @@ int lahar_gauge_output_sync(lahar_gauge_output *o);
  * forces.h5 and gauges.h5 after `step`; marks of a stopped run are removed. The writers, opened
  * with lahar_case.resume set, then continue these files. 0, or -1 with a message. */
 int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_step, char *err, size_t n);
+
+/* The snapshot files bodies.h5, particles.h5 and contacts.h5 each have a twin while their writer
+ * runs, OUT/.<name>.twin: every snapshot goes into the twin first, which then takes the file's
+ * name, so that a writer killed at any moment leaves the file complete with every snapshot it
+ * finished. A writer removes its twin when it closes; once the writers of OUT are gone (a node
+ * killed), this removes what they left. */
+void lahar_output_remove_twins(const char *outdir);
 
 /* Write OUT/lahar.xmf: one temporal collection whose time steps hold the body grids and the
  * particle grid of the snapshots found in OUT/bodies.h5 and OUT/particles.h5 (either may be

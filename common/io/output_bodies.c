@@ -40,6 +40,7 @@ struct lahar_body_output {
     double *state;             /* nbody * 13: x, q, v, w laid out as four blocks */
     float *vert, *vvel;        /* moving display vertices and their velocities */
     int64_t nsnap;
+    out_snapfile file;         /* bodies.h5 and its twin */
     lahar_xdmf_file xmf;
     char *xml;
     forces_stream fs;
@@ -480,6 +481,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     o->nbody = c->nbody;
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/bodies.h5", outdir);
+    out_snapfile_init(&o->file, o->h5path);
     size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
     o->mesh = calloc(nb, sizeof *o->mesh);
     o->moving = calloc(nb, sizeof *o->moving);
@@ -526,6 +528,22 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     return o;
 }
 
+/* The datasets of a body snapshot from o's buffers (out_snapshot_fill). */
+static int body_snapshot_fill(hid_t g, void *ctx)
+{
+    const lahar_body_output *o = ctx;
+    int nb = o->nbody;
+    const double *X = o->state, *Q = X + 3 * nb, *V = Q + 4 * nb, *W = V + 3 * nb;
+    int rc = out_dataset(g, "position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, X);
+    rc |= out_dataset(g, "quaternion", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 4, Q);
+    rc |= out_dataset(g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, V);
+    rc |= out_dataset(g, "angular_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, W);
+    rc |= out_dataset(g, "vertices", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3, o->vert);
+    rc |= out_dataset(g, "vertex_velocity", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3,
+                      o->vvel);
+    return rc;
+}
+
 int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, const lahar_body_state *s)
 {
     /* the force rows so far reach the disk with every snapshot too, even if the run then stalls */
@@ -553,26 +571,8 @@ int lahar_body_output_snapshot(lahar_body_output *o, int64_t step, double t, con
     }
     /* the snapshot's data, its object headers, and the XDMF text */
     double need = 8.0 * 13.0 * nb + 24.0 * (double)o->nmoving_vert + 6.0 * 1024.0 + OUT_XML_CAP;
-    hid_t f, g = out_snapshot_open(o->h5path, need, "a body snapshot", o->nsnap, step, t, &f);
-    if (g == H5I_INVALID_HID && f < 0)
+    if (out_snapfile_append(&o->file, need, "a body snapshot", o->nsnap, step, t, body_snapshot_fill, o) != 0)
         return -1;
-    int rc = g < 0 ? -1 : 0;
-    if (g >= 0) {
-        rc |= out_dataset(g, "position", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, X);
-        rc |= out_dataset(g, "quaternion", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 4, Q);
-        rc |= out_dataset(g, "velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, V);
-        rc |= out_dataset(g, "angular_velocity", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, (hsize_t)nb, 3, W);
-        rc |= out_dataset(g, "vertices", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3, o->vert);
-        rc |= out_dataset(g, "vertex_velocity", H5T_NATIVE_FLOAT, H5T_IEEE_F32LE, 2, (hsize_t)o->nmoving_vert, 3,
-                          o->vvel);
-        H5Gclose(g);
-    }
-    if (out_close(f) < 0)
-        rc = -1;
-    if (rc) {
-        out_write_failed(o->h5path, "a body snapshot", step, t);
-        return -1;
-    }
     lahar_xdmf_bodies xb;
     out_xdmf_bodies_info(o, &xb);
     size_t len = lahar_xdmf_step_begin(o->xml, OUT_XML_CAP, step, t);
@@ -620,6 +620,7 @@ void lahar_body_output_close(lahar_body_output *o)
     if (!o)
         return;
     forces_close(&o->fs);
+    out_snapfile_close(&o->file);
     lahar_xdmf_close(&o->xmf);
     if (o->mesh)
         for (int b = 0; b < o->nbody; b++)

@@ -15,12 +15,17 @@ struct lahar_contact_output {
     int *slot;         /* per body of the case: index into the listed bodies of the current write, -1 */
     int64_t *offset;   /* per body of the case: first point in x/f of the current write */
     int64_t nsnap;
+    out_snapfile file;  /* contacts.h5 and its twin */
+    /* the write in progress (contact_snapshot_fill) */
+    const int32_t *npoints;
+    const double (*x)[3], (*f)[3], (*force)[3], (*torque)[3];
 };
 
 void lahar_contact_output_close(lahar_contact_output *o)
 {
     if (!o)
         return;
+    out_snapfile_close(&o->file);
     free(o->marked);
     free(o->group);
     free(o->slot);
@@ -61,6 +66,7 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
                 snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
         }
     snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
+    out_snapfile_init(&o->file, o->h5path);
     if (c->resume) { /* continue contacts.h5 as the checkpoint left it */
         out_snap_entry *list = NULL;
         int64_t cnt = out_read_snapshot_list(o->h5path, &list);
@@ -109,6 +115,30 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
     return o;
 }
 
+/* A group per marked body with its points, forces and resultants (out_snapshot_fill); bodies not
+ * listed in this write get an empty group. */
+static int contact_snapshot_fill(hid_t g, void *ctx)
+{
+    const lahar_contact_output *o = ctx;
+    int rc = 0;
+    for (int m = 0; m < o->nmarked && !rc; m++) {
+        int b = o->marked[m], i = o->slot[b];
+        hid_t bg = out_group(g, o->group[m]);
+        if (bg < 0)
+            return -1;
+        static const double zero[3] = {0.0, 0.0, 0.0};
+        hsize_t np = i >= 0 ? (hsize_t)o->npoints[i] : 0;
+        const double *pts = np ? o->x[o->offset[b]] : zero, *fs = np ? o->f[o->offset[b]] : zero;
+        rc |= out_attr_int64(bg, "n", (int64_t)np);
+        rc |= out_attr(bg, "force", H5T_NATIVE_DOUBLE, 3, i >= 0 ? o->force[i] : zero);
+        rc |= out_attr(bg, "torque", H5T_NATIVE_DOUBLE, 3, i >= 0 ? o->torque[i] : zero);
+        rc |= out_dataset(bg, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, pts);
+        rc |= out_dataset(bg, "forces", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, fs);
+        H5Gclose(bg);
+    }
+    return rc;
+}
+
 int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, int nlisted, const int32_t *body_id,
                                const int32_t *npoints, const double (*x)[3], const double (*f)[3],
                                const double (*force)[3], const double (*torque)[3])
@@ -127,36 +157,9 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         off += npoints[i];
     }
     double need = 48.0 * (double)off + 4096.0 * (o->nmarked + 1);
-    hid_t file, g = out_snapshot_open(o->h5path, need, "the contact points", o->nsnap, step, t, &file);
-    if (g == H5I_INVALID_HID && file < 0)
+    o->npoints = npoints, o->x = x, o->f = f, o->force = force, o->torque = torque;
+    if (out_snapfile_append(&o->file, need, "the contact points", o->nsnap, step, t, contact_snapshot_fill, o) != 0)
         return -1;
-    int rc = g < 0 ? -1 : 0;
-    if (g >= 0) {
-        for (int m = 0; m < o->nmarked && !rc; m++) {
-            int b = o->marked[m], i = o->slot[b];
-            hid_t bg = out_group(g, o->group[m]);
-            if (bg < 0) {
-                rc = -1;
-                break;
-            }
-            static const double zero[3] = {0.0, 0.0, 0.0};
-            hsize_t np = i >= 0 ? (hsize_t)npoints[i] : 0;
-            const double *pts = np ? x[o->offset[b]] : zero, *fs = np ? f[o->offset[b]] : zero;
-            rc |= out_attr_int64(bg, "n", (int64_t)np);
-            rc |= out_attr(bg, "force", H5T_NATIVE_DOUBLE, 3, i >= 0 ? force[i] : zero);
-            rc |= out_attr(bg, "torque", H5T_NATIVE_DOUBLE, 3, i >= 0 ? torque[i] : zero);
-            rc |= out_dataset(bg, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, pts);
-            rc |= out_dataset(bg, "forces", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, fs);
-            H5Gclose(bg);
-        }
-        H5Gclose(g);
-    }
-    if (out_close(file) < 0)
-        rc = -1;
-    if (rc) {
-        out_write_failed(o->h5path, "the contact points", step, t);
-        return -1;
-    }
     o->nsnap++;
     return 0;
 }

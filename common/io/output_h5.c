@@ -1,7 +1,7 @@
 /* What every writer of output.h shares (declared in output_h5.h): room on the disk and the last
  * error of a writer, HDF5 files without locks, attributes, datasets, the /header group, SWMR row
- * appends, the start of a snapshot, and the list of a run's files. Separate from the writers so
- * that a change to how lahar writes HDF5 is made in one place for all of them. */
+ * appends, and the list of a run's files. Separate from the writers so that a change to how
+ * lahar writes HDF5 is made in one place for all of them. */
 #include "output_h5.h"
 #include <errno.h>
 #include <inttypes.h>
@@ -262,32 +262,6 @@ int out_append_rows(hid_t id, hid_t mtype, int rank, hsize_t start, hsize_t rows
     return rc;
 }
 
-/* A snapshot's start, the same for particles, bodies and contacts: room for `need` bytes (what:
- * for the message), the file reopened (*file), the group /snapshots/NNNNNN (nsnap) made with its
- * time and step. Returns the group; H5I_INVALID_HID with *file < 0 when nothing was opened (the
- * reason printed), H5I_INVALID_HID with *file open when the group or its attributes failed (the
- * group is closed then; the caller closes the file). */
-hid_t out_snapshot_open(const char *path, double need, const char *what, int64_t nsnap, int64_t step, double t,
-                        hid_t *file)
-{
-    *file = H5I_INVALID_HID;
-    if (out_room(path, need, what, step, t) != 0)
-        return H5I_INVALID_HID;
-    *file = out_file_open(path, H5F_ACC_RDWR, 0);
-    if (*file < 0) {
-        fprintf(stderr, "lahar: %s: cannot reopen for %s at step %" PRId64 "\n", path, what, step);
-        return H5I_INVALID_HID;
-    }
-    char name[48];
-    snprintf(name, sizeof name, "/snapshots/%06" PRId64, nsnap);
-    hid_t g = out_group(*file, name);
-    if (g >= 0 && (out_attr_double(g, "time", t) | out_attr_int64(g, "step", step)) != 0) {
-        H5Gclose(g);
-        g = H5I_INVALID_HID;
-    }
-    return g;
-}
-
 double out_wall_seconds(void)
 {
     struct timespec ts;
@@ -309,5 +283,7 @@ void out_stream_cache(hid_t fapl, double chunk_bytes)
 
 const char *const lahar_output_run_files[] = {
     "summary.json", "check.json", "check.png",   "lahar.xmf", "bodies.h5", "bodies.xmf",
-    "particles.h5", "particles.xmf", "forces.h5", "contacts.h5", "gauges.h5", NULL,
+    "particles.h5", "particles.xmf", "forces.h5", "contacts.h5", "gauges.h5",
+    /* the twins of the snapshot files (output_snapfile.c), left behind by a writer that was killed */
+    ".bodies.h5.twin", ".particles.h5.twin", ".contacts.h5.twin", NULL,
 };

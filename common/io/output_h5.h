@@ -2,7 +2,8 @@
  * output.h). What one writer shares with the others, each defined once:
  *
  *   output_h5.c       room on the disk, the last error, HDF5 files, groups, attributes, datasets,
- *                     the /header group, SWMR row appends, a snapshot's start
+ *                     the /header group, SWMR row appends
+ *   output_snapfile.c a snapshot file and its twin: appends that a killed writer cannot corrupt
  *   output_resume.c   the snapshot list of a file, a resumed writer's XDMF sidecar */
 #ifndef LAHAR_OUTPUT_H5_H
 #define LAHAR_OUTPUT_H5_H
@@ -36,10 +37,28 @@ int out_dataset(hid_t loc, const char *name, hid_t memtype, hid_t filetype, int 
                 const void *data);
 int out_strings(hid_t loc, const char *name, int n, const char *const *s);
 int out_append_rows(hid_t id, hid_t mtype, int rank, hsize_t start, hsize_t rows, hsize_t nb, const void *buf);
-hid_t out_snapshot_open(const char *path, double need, const char *what, int64_t nsnap, int64_t step, double t,
-                        hid_t *file);
 double out_wall_seconds(void);
 void out_stream_cache(hid_t fapl, double chunk_bytes);
+
+/* output_snapfile.c: a snapshot file (bodies.h5, particles.h5, contacts.h5) and its twin
+ * OUT/.<name>.twin, which holds the same snapshots. append writes /snapshots/NNNNNN (time,
+ * step, then what fill(group, ctx) writes) into the twin, swaps the two names, and writes the
+ * snapshot again into the former file: the file's name always refers to a completely written
+ * file. fill is called twice with the same ctx and must write the same both times. append
+ * checks room on the disk first; 0, or -1 with the message in lahar_output_error(). close
+ * removes the twin. */
+typedef int (*out_snapshot_fill)(hid_t group, void *ctx);
+typedef struct {
+    char path[OUT_PATH_MAX + 16];
+    char twin[OUT_PATH_MAX + 32];
+    int twin_ok;  /* the twin holds what the file holds (else it is copied before the next append) */
+    int in_place; /* the file system cannot swap two names: snapshots go into the file itself */
+} out_snapfile;
+void out_snapfile_init(out_snapfile *sf, const char *path);
+int out_snapfile_append(out_snapfile *sf, double need, const char *what, int64_t nsnap, int64_t step, double t,
+                        out_snapshot_fill fill, void *ctx);
+void out_snapfile_close(out_snapfile *sf);
+int out_snapfile_twin_path(const char *path, char *twin, size_t n);
 
 /* output_resume.c: one snapshot group of a file as found on disk */
 typedef struct {

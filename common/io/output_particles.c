@@ -16,6 +16,7 @@ struct lahar_particle_output {
     char h5path[OUT_PATH_MAX];
     unsigned fields;
     int64_t nsnap;
+    out_snapfile file;  /* particles.h5 and its twin */
     lahar_xdmf_file xmf;
     char *xml;
 };
@@ -35,6 +36,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     o->fields = fields & (LAHAR_PFIELD_ALL | LAHAR_PFIELD_STRESS);
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
+    out_snapfile_init(&o->file, o->h5path);
     if (c->resume) { /* continue particles.h5 as the checkpoint left it (lahar_output_resume_trim) */
         char path[OUT_PATH_MAX + 16];
         snprintf(path, sizeof path, "%s/particles.xmf", outdir);
@@ -98,72 +100,77 @@ static int out_particle_stress(hid_t g, const lahar_particles_view *p)
     return rc;
 }
 
+/* What a particle snapshot's fill writes: the view and the output's field selection. */
+typedef struct {
+    const lahar_particle_output *o;
+    const lahar_particles_view *p;
+} particle_snapshot;
+
+/* The datasets and counters of a particle snapshot (out_snapshot_fill). */
+static int particle_snapshot_fill(hid_t g, void *ctx)
+{
+    const lahar_particle_output *o = ((const particle_snapshot *)ctx)->o;
+    const lahar_particles_view *p = ((const particle_snapshot *)ctx)->p;
+    hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
+    int rc = out_attr_int64(g, "n", (int64_t)n);
+    const struct {
+        unsigned field;
+        const char *name;
+        hid_t mt, ft;
+        const void *data;
+    } col[] = {
+        {0, "x", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->x},
+        {0, "y", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->y},
+        {0, "z", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->z},
+        {LAHAR_PFIELD_VELOCITY, "vx", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vx},
+        {LAHAR_PFIELD_VELOCITY, "vy", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vy},
+        {LAHAR_PFIELD_VELOCITY, "vz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vz},
+        {LAHAR_PFIELD_DENSITY, "density", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->density},
+        {LAHAR_PFIELD_PRESSURE, "pressure", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->pressure},
+        {LAHAR_PFIELD_PHASE, "phase", H5T_NATIVE_INT32, H5T_STD_I32LE, p->phase},
+        {LAHAR_PFIELD_ID, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, p->id},
+    };
+    for (size_t k = 0; k < sizeof col / sizeof col[0] && !rc; k++) {
+        if (col[k].field && !(o->fields & col[k].field))
+            continue;
+        if (!col[k].data && n > 0) {
+            if (col[k].field == 0 && col[k].name[0] == 'z') {
+                /* 2D: z is never written, the dataset's fill value (0) stands for it */
+                hid_t sp = H5Screate_simple(1, &n, NULL);
+                hid_t dcpl = out_dcpl();
+                hid_t ds = H5Dcreate2(g, "z", H5T_IEEE_F64LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+                H5Pclose(dcpl);
+                if (ds < 0)
+                    rc = -1;
+                else
+                    H5Dclose(ds);
+                H5Sclose(sp);
+                continue;
+            }
+            fprintf(stderr, "lahar: particle snapshot: field %s selected but not given\n", col[k].name);
+            rc = -1;
+            break;
+        }
+        rc |= out_dataset(g, col[k].name, col[k].mt, col[k].ft, 1, n, 0, col[k].data);
+    }
+    if (!rc && (o->fields & LAHAR_PFIELD_STRESS))
+        rc |= out_particle_stress(g, p);
+    if (!rc && p->inlet)
+        rc |= out_dataset(g, "inlet", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, n, 0, p->inlet);
+    for (int k = 0; p->flow && k < LAHAR_FLOW_NVAL && !rc; k++)
+        rc |= out_attr_double(g, lahar_flow_names[k], p->flow[k]);
+    return rc;
+}
+
 int lahar_particle_output_snapshot(lahar_particle_output *o, int64_t step, double t, const lahar_particles_view *p)
 {
     /* at most 17 values of 8 bytes per particle (position, velocity, density, pressure, phase,
      * id, stress), the datasets' headers and the XDMF text */
     double need = 17.0 * 8.0 * (double)(p->n > 0 ? p->n : 0) + 16.0 * 1024.0 + OUT_XML_CAP;
-    hid_t f, g = out_snapshot_open(o->h5path, need, "a particle snapshot", o->nsnap, step, t, &f);
-    if (g == H5I_INVALID_HID && f < 0)
+    particle_snapshot snap = {o, p};
+    if (out_snapfile_append(&o->file, need, "a particle snapshot", o->nsnap, step, t, particle_snapshot_fill, &snap))
         return -1;
-    int rc = g < 0 ? -1 : 0;
     hsize_t n = (hsize_t)(p->n > 0 ? p->n : 0);
-    if (g >= 0) {
-        rc |= out_attr_int64(g, "n", (int64_t)n);
-        const struct {
-            unsigned field;
-            const char *name;
-            hid_t mt, ft;
-            const void *data;
-        } col[] = {
-            {0, "x", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->x},
-            {0, "y", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->y},
-            {0, "z", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->z},
-            {LAHAR_PFIELD_VELOCITY, "vx", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vx},
-            {LAHAR_PFIELD_VELOCITY, "vy", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vy},
-            {LAHAR_PFIELD_VELOCITY, "vz", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->vz},
-            {LAHAR_PFIELD_DENSITY, "density", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->density},
-            {LAHAR_PFIELD_PRESSURE, "pressure", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, p->pressure},
-            {LAHAR_PFIELD_PHASE, "phase", H5T_NATIVE_INT32, H5T_STD_I32LE, p->phase},
-            {LAHAR_PFIELD_ID, "id", H5T_NATIVE_INT64, H5T_STD_I64LE, p->id},
-        };
-        for (size_t k = 0; k < sizeof col / sizeof col[0] && !rc; k++) {
-            if (col[k].field && !(o->fields & col[k].field))
-                continue;
-            if (!col[k].data && n > 0) {
-                if (col[k].field == 0 && col[k].name[0] == 'z') {
-                    /* 2D: z is never written, the dataset's fill value (0) stands for it */
-                    hid_t sp = H5Screate_simple(1, &n, NULL);
-                    hid_t dcpl = out_dcpl();
-                    hid_t ds = H5Dcreate2(g, "z", H5T_IEEE_F64LE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-                    H5Pclose(dcpl);
-                    if (ds < 0)
-                        rc = -1;
-                    else
-                        H5Dclose(ds);
-                    H5Sclose(sp);
-                    continue;
-                }
-                fprintf(stderr, "lahar: particle snapshot: field %s selected but not given\n", col[k].name);
-                rc = -1;
-                break;
-            }
-            rc |= out_dataset(g, col[k].name, col[k].mt, col[k].ft, 1, n, 0, col[k].data);
-        }
-        if (!rc && (o->fields & LAHAR_PFIELD_STRESS))
-            rc |= out_particle_stress(g, p);
-        if (!rc && p->inlet)
-            rc |= out_dataset(g, "inlet", H5T_NATIVE_INT32, H5T_STD_I32LE, 1, n, 0, p->inlet);
-        for (int k = 0; p->flow && k < LAHAR_FLOW_NVAL && !rc; k++)
-            rc |= out_attr_double(g, lahar_flow_names[k], p->flow[k]);
-        H5Gclose(g);
-    }
-    if (out_close(f) < 0)
-        rc = -1;
-    if (rc) {
-        out_write_failed(o->h5path, "a particle snapshot", step, t);
-        return -1;
-    }
     lahar_xdmf_particles xp = {"particles.h5", o->fields};
     size_t len = lahar_xdmf_step_begin(o->xml, OUT_XML_CAP, step, t);
     if (len < OUT_XML_CAP)
@@ -182,6 +189,7 @@ void lahar_particle_output_close(lahar_particle_output *o)
 {
     if (!o)
         return;
+    out_snapfile_close(&o->file);
     lahar_xdmf_close(&o->xmf);
     int had_snapshots = o->nsnap > 0;
     char dir[OUT_PATH_MAX];

@@ -261,18 +261,9 @@ int lahar_output_resume_trim(const char *outdir, int64_t step, int snapshot_at_s
 
 /* ---------------------------------------------------------------- final snapshot of a failed run -- */
 
-int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const char *name, const char *text)
+/* The string attribute `name` on the last snapshot of the file at path, in place. 0 or -1. */
+static int out_mark_last(const char *path, const char *name, const char *text)
 {
-    char path[OUT_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/%s", outdir, file);
-    if (access(path, F_OK) != 0)
-        return -1;
-    double avail = lahar_output_free_bytes(outdir);
-    if (avail >= 0.0 && avail < LAHAR_OUTPUT_RESERVE) {
-        fprintf(stderr, "lahar: %s: the last snapshot is not marked (no space left on device: %.0f bytes free)\n",
-                path, avail);
-        return -1;
-    }
     hid_t f = out_file_open(path, H5F_ACC_RDWR, 0);
     if (f < 0)
         return -1;
@@ -294,8 +285,27 @@ int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const 
         H5Gclose(g);
     if (out_close(f) < 0)
         rc = -1;
+    return rc;
+}
+
+int lahar_output_mark_last_snapshot(const char *outdir, const char *file, const char *name, const char *text)
+{
+    char path[OUT_PATH_MAX + 64], twin[OUT_PATH_MAX + 96];
+    snprintf(path, sizeof path, "%s/%s", outdir, file);
+    if (access(path, F_OK) != 0)
+        return -1;
+    double avail = lahar_output_free_bytes(outdir);
+    if (avail >= 0.0 && avail < LAHAR_OUTPUT_RESERVE) {
+        fprintf(stderr, "lahar: %s: the last snapshot is not marked (no space left on device: %.0f bytes free)\n",
+                path, avail);
+        return -1;
+    }
+    int rc = out_mark_last(path, name, text);
     if (rc)
         fprintf(stderr, "lahar: %s: cannot mark the last snapshot\n", path);
+    /* the writer's twin (output_snapfile.c), which a later snapshot would publish, gets the mark too */
+    if (out_snapfile_twin_path(path, twin, sizeof twin) == 0 && access(twin, F_OK) == 0)
+        out_mark_last(twin, name, text);
     return rc;
 }
 

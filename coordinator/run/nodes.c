@@ -315,7 +315,8 @@ static void coord_finish_nodes(coord *co)
 
 /* A node process that died (killed, crashed) leaves the SWMR force stream flagged as open for
  * writing, and h5dump / h5py refuse it: once every node process is gone, clear the flags so the
- * rows it flushed can be read (nodes on other hosts, --no-spawn, are not ours to judge). */
+ * rows it flushed can be read, and remove the twins of its snapshot files (nodes on other hosts,
+ * --no-spawn, are not ours to judge). */
 void coord_release_files(coord *co)
 {
     int died = 0;
@@ -327,6 +328,7 @@ void coord_release_files(coord *co)
     }
     if (!died)
         return;
+    lahar_output_remove_twins(co->outdir);
     for (int i = 0; lahar_output_run_files[i]; i++) { /* every HDF5 file (forces.h5 and gauges.h5 are SWMR) */
         const char *name = lahar_output_run_files[i];
         size_t len = strlen(name);
