@@ -137,7 +137,7 @@ int out_snapfile_append(out_snapfile *sf, double need, const char *what, int64_t
             out_write_failed(sf->path, what, step, t);
             return -1;
         }
-        sf->in_place = 0;
+        sf->in_place = 1;
         fprintf(stderr,
                 "lahar: %s: this file system cannot swap two files in one step (renameat2: %s): later snapshots "
                 "are written in place, and a writer killed while writing one can leave the file unreadable\n",
