@@ -252,6 +252,7 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
         has_soil |= c->blocks[b].phase == 1;
     c->output_fields = has_soil ? 0x3f : 0x1f; /* LAHAR_PFIELD_*: all, and stress when there is soil */
     c->output_forces = 1;
+    c->output_in_place = 0;
     if (!n)
         return;
     rmap m;
@@ -259,6 +260,7 @@ static void read_output(reader *r, yaml_node_t *n, lahar_case *c)
         return;
     rmap_section(&m, "output");
     c->output_forces = rd_key_choice(&m, "forces");
+    c->output_in_place = !rd_key_bool(&m, "twins");
     yaml_node_t *f = rmap_get(&m, "fields");
     if (!f || r->failed)
         return;

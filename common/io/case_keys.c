@@ -85,6 +85,7 @@ static const char *const output_forces[] = {"none", "all", NULL};
 static const lahar_key output_keys[] = {
     {"fields", LAHAR_KEY_LIST, 0, "all", 0, 0, 0, NULL, "", "particle fields of every snapshot: any of velocity, density, pressure, phase, id, stress (positions always)", NULL},
     {"forces", LAHAR_KEY_CHOICE, 0, "all", 0, 0, 0, output_forces, "", "all = write the per-body force stream forces.h5, none = do not", NULL},
+    {"twins", LAHAR_KEY_BOOL, 0, "true", 0, 0, 0, bools, "", "write every snapshot through a hidden twin of particles.h5, bodies.h5 and contacts.h5, so that a node killed at any moment leaves them complete; the twins take as much room as the files while the run writes (false: in place, half the room, a killed node may leave a file unreadable)", NULL},
     END};
 
 static const lahar_key check_keys[] = {

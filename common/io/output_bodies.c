@@ -481,7 +481,7 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     o->nbody = c->nbody;
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/bodies.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path);
+    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
     size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
     o->mesh = calloc(nb, sizeof *o->mesh);
     o->moving = calloc(nb, sizeof *o->moving);

@@ -66,7 +66,7 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
                 snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
         }
     snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path);
+    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
     if (c->resume) { /* continue contacts.h5 as the checkpoint left it */
         out_snap_entry *list = NULL;
         int64_t cnt = out_read_snapshot_list(o->h5path, &list);

@@ -46,15 +46,17 @@ void out_stream_cache(hid_t fapl, double chunk_bytes);
  * snapshot again into the former file: the file's name always refers to a completely written
  * file. fill is called twice with the same ctx and must write the same both times. append
  * checks room on the disk first; 0, or -1 with the message in lahar_output_error(). close
- * removes the twin. */
+ * removes the twin. init with in_place set (the case's output.twins: false) writes into the
+ * file itself, with no twin. */
 typedef int (*out_snapshot_fill)(hid_t group, void *ctx);
 typedef struct {
     char path[OUT_PATH_MAX + 16];
     char twin[OUT_PATH_MAX + 32];
     int twin_ok;  /* the twin holds what the file holds (else it is copied before the next append) */
-    int in_place; /* the file system cannot swap two names: snapshots go into the file itself */
+    int in_place; /* snapshots go into the file itself (output.twins: false, or a file system that
+                   * cannot swap two names) */
 } out_snapfile;
-void out_snapfile_init(out_snapfile *sf, const char *path);
+void out_snapfile_init(out_snapfile *sf, const char *path, int in_place);
 int out_snapfile_append(out_snapfile *sf, double need, const char *what, int64_t nsnap, int64_t step, double t,
                         out_snapshot_fill fill, void *ctx);
 void out_snapfile_close(out_snapfile *sf);

@@ -36,7 +36,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     o->fields = fields & (LAHAR_PFIELD_ALL | LAHAR_PFIELD_STRESS);
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
     snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path);
+    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
     if (c->resume) { /* continue particles.h5 as the checkpoint left it (lahar_output_resume_trim) */
         char path[OUT_PATH_MAX + 16];
         snprintf(path, sizeof path, "%s/particles.xmf", outdir);

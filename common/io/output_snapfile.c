@@ -29,12 +29,12 @@ int out_snapfile_twin_path(const char *path, char *twin, size_t n)
     return snprintf(twin, n, "%.*s.%s.twin", dirlen, path, path + dirlen) < (int)n ? 0 : -1;
 }
 
-void out_snapfile_init(out_snapfile *sf, const char *path)
+void out_snapfile_init(out_snapfile *sf, const char *path, int in_place)
 {
     snprintf(sf->path, sizeof sf->path, "%s", path);
     out_snapfile_twin_path(path, sf->twin, sizeof sf->twin);
     sf->twin_ok = 0;
-    sf->in_place = 0;
+    sf->in_place = in_place;
 }
 
 /* Copy file `from` to `to` (created or truncated, with from's permissions). 0 or -1 (errno set). */

@@ -70,6 +70,7 @@ static void scene_settings_to_msg(const lahar_case *c, lahar_scene_t *m)
     m->resume_step = c->resume ? c->resume_step : -1;
     m->output_fields = (int32_t)c->output_fields;
     m->output_forces = (int8_t)(c->output_forces != 0);
+    m->output_in_place = (int8_t)(c->output_in_place != 0);
     m->dem_engine = (char *)c->dem_engine;
     m->dem_dt_safety = c->dem_dt_safety;
     memcpy(m->stability_density_band, c->stability.density_band, sizeof m->stability_density_band);
@@ -263,6 +264,7 @@ static void scene_settings_from_msg(const lahar_scene_t *m, lahar_case *c)
     c->dim = m->dim;
     c->output_fields = (unsigned)m->output_fields;
     c->output_forces = m->output_forces;
+    c->output_in_place = m->output_in_place;
     memcpy(c->gravity, m->gravity, sizeof c->gravity);
     c->t_end = m->t_end;
     c->dt_max = m->dt_max;

@@ -260,9 +260,12 @@ typedef struct {
 
     /* output: section. output_fields: particle fields to write, bits in the order of the names
      * velocity, density, pressure, phase, id (= LAHAR_PFIELD_* in output.h); default all.
-     * output_forces: 1 = write the per-body force stream (default), 0 = not. */
+     * output_forces: 1 = write the per-body force stream (default), 0 = not.
+     * output_in_place: 1 = snapshots written into particles.h5, bodies.h5, contacts.h5 in place
+     * (output.twins: false); 0 (default) = through their twins (common/io/output_h5.h). */
     unsigned output_fields;
     int output_forces;
+    int output_in_place;
 
     /* checkpoint: section (coordinator/README.md "Checkpoints"): every checkpoint_interval s of
      * simulated time (0: none) the nodes write their whole state to OUT/checkpoints/NNNNNN/;
