@@ -2,7 +2,8 @@
  * representative messages of a run encoded with the lcm-gen encoders and lahar's own code (the
  * scene of real cases, LOADS with contact points, BODY_STATE, STATUS with and without an
  * instability report, HELLO, STEP, STOP, NACK, heartbeats), and the frames a link publishes for
- * them, plain and authenticated, in the input format of fuzz_link.c.
+ * them, plain and authenticated, in the input format of fuzz_link.c; and the scene reproducers of
+ * OUT_DIR/../regressions/msg for the current scene_t.
  *   make_seeds CASES_DIR OUT_DIR      (writes the files of OUT_DIR/msg and OUT_DIR/link) */
 #include <stdio.h>
 #include <stdlib.h>
@@ -128,7 +129,8 @@ typedef struct {
         free(b_);                                                                                  \
     } while (0)
 
-static void encode_scene(const char *cases, const char *name, bytes *out)
+/* The scene of cases/<name>, changed by mutate (NULL: as it is) before it is encoded. */
+static void encode_scene(const char *cases, const char *name, void (*mutate)(lahar_scene_t *), bytes *out)
 {
     char path[4096], err[2048];
     snprintf(path, sizeof path, "%s/%s", cases, name);
@@ -143,6 +145,8 @@ static void encode_scene(const char *cases, const char *name, bytes *out)
         exit(1);
     }
     m.case_path = (char *)name; /* no absolute path of the machine in the seeds */
+    if (mutate)
+        mutate(&m);
     ENCODE(lahar_scene_t, &m, out);
     lahar_scene_msg_release(&m);
     lahar_case_free(&c);
@@ -213,7 +217,7 @@ static void all_encodings(const char *cases, encodings *e)
     lahar_hello_t h = {.run_id = RUN_ID, .step = -1, .role = 0, .engine = "lahar", .version = "0.1.0",
                        .protocol_version = 1, .ncapabilities = 4, .capabilities = (char **)caps, .host = "host", .pid = 42};
     ENCODE(lahar_hello_t, &h, &e->m[LAHAR_FRAME_T_MSG_HELLO]);
-    encode_scene(cases, "debris_2d.yaml", &e->m[LAHAR_FRAME_T_MSG_SCENE]);
+    encode_scene(cases, "debris_2d.yaml", NULL, &e->m[LAHAR_FRAME_T_MSG_SCENE]);
     lahar_step_t st = {.run_id = RUN_ID, .step = 3, .t = 0.01, .dt = 0.005, .t_next = 0.015, .write_output = 1};
     ENCODE(lahar_step_t, &st, &e->m[LAHAR_FRAME_T_MSG_STEP]);
     lahar_instability u = {.what = "density out of band", .kind = "particle", .id = 17, .name = "",
@@ -277,6 +281,75 @@ static void write_link(const char *name, const encodings *e, int role, int auth,
     free(rec.data);
 }
 
+/* Mutations of a scene that lahar_scene_msg_to_case must refuse (each crashed a node before
+ * the index checks): an edge to vertex nv of the first body with edges, a face vertex -1. */
+static void edge_beyond_nv(lahar_scene_t *m)
+{
+    for (int i = 0; i < m->nbody; i++)
+        if (m->bodies[i].ne > 0) {
+            m->bodies[i].e[0][1] = m->bodies[i].nv;
+            return;
+        }
+}
+
+static void face_vertex_negative(lahar_scene_t *m)
+{
+    for (int i = 0; i < m->nbody; i++)
+        if (m->bodies[i].nfv > 0) {
+            m->bodies[i].face_v[0] = -1;
+            return;
+        }
+}
+
+/* 1 when the encoding decodes as a scene_t (its type hash is the current one) and the scene is
+ * refused, 0 when it does not decode, -1 when it is accepted. */
+static int scene_refused(const bytes *b)
+{
+    lahar_scene_t sm;
+    if (lahar_scene_t_decode(b->data, 0, (int)b->n, &sm) < 0)
+        return 0;
+    lahar_case c;
+    char err[512];
+    int rc = lahar_scene_msg_to_case(&sm, &c, err, sizeof err) == 0 ? -1 : 1;
+    if (rc < 0)
+        lahar_case_free(&c);
+    lahar_scene_t_decode_cleanup(&sm);
+    return rc;
+}
+
+/* The scene reproducers of regressions/msg (the directory beside OUT_DIR), encoded for the
+ * current scene_t: an encoding of an older scene_t fails at the type hash and no longer reaches
+ * the checks it once crashed, so they are rewritten whenever the seeds are. `valid` holds the
+ * encoding of dem_drop_3d.yaml's scene (a box, edges and faces); the truncated one is cut in its
+ * bodies. */
+static void write_scene_regressions(const char *cases, const char *corpus, const bytes *valid)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s/../regressions", corpus);
+    const char *saved = out_dir;
+    out_dir = dir;
+    static const struct {
+        const char *name;
+        void (*mutate)(lahar_scene_t *);
+    } bad[] = {{"scene_edge_index_beyond_nv", edge_beyond_nv}, {"scene_face_vertex_negative", face_vertex_negative}};
+    if (scene_refused(valid) != -1) {
+        fprintf(stderr, "make_seeds: the scene of dem_drop_3d.yaml is not accepted as it is\n");
+        exit(1);
+    }
+    bytes b = {0};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        encode_scene(cases, "dem_drop_3d.yaml", bad[k].mutate, &b);
+        if (scene_refused(&b) != 1) {
+            fprintf(stderr, "make_seeds: %s does not decode, or decodes into a scene that is accepted\n", bad[k].name);
+            exit(1);
+        }
+        write_msg(bad[k].name, LAHAR_FRAME_T_MSG_SCENE, b.data, (int)b.n);
+    }
+    free(b.data);
+    write_msg("scene_truncated", LAHAR_FRAME_T_MSG_SCENE, valid->data, (int)(valid->n * 2 / 3));
+    out_dir = saved;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 3) {
@@ -291,9 +364,10 @@ int main(int argc, char **argv)
     for (int ty = 1; ty < LAHAR_NMSG; ty++)
         write_msg(names[ty], ty, e.m[ty].data, (int)e.m[ty].n);
     bytes b = {0};
-    encode_scene(argv[1], "dem_drop_3d.yaml", &b);
+    encode_scene(argv[1], "dem_drop_3d.yaml", NULL, &b);
     write_msg("scene_dem_drop_3d", LAHAR_FRAME_T_MSG_SCENE, b.data, (int)b.n);
-    encode_scene(argv[1], "soil_geostatic_3d.yaml", &b);
+    write_scene_regressions(argv[1], argv[2], &b);
+    encode_scene(argv[1], "soil_geostatic_3d.yaml", NULL, &b);
     write_msg("scene_soil_geostatic_3d", LAHAR_FRAME_T_MSG_SCENE, b.data, (int)b.n);
     encode_status("", 0, &b);
     write_msg("status_ok", LAHAR_FRAME_T_MSG_STATUS, b.data, (int)b.n);
