@@ -116,9 +116,12 @@ int out_snapfile_append(out_snapfile *sf, double need, const char *what, int64_t
         }
         return 0;
     }
-    /* room for the snapshot twice, and for a new twin when the last one fell behind */
+    /* room for the snapshot twice, and for a new twin when the last one fell behind; the message
+     * names the way out that needs half the room */
     double copy = sf->twin_ok ? 0.0 : out_file_bytes(sf->path);
-    if (out_room(sf->path, 2.0 * need + copy, what, step, t) != 0)
+    char both[256];
+    snprintf(both, sizeof both, "%s and its twin (output: {twins: false} writes it once)", what);
+    if (out_room(sf->path, 2.0 * need + copy, both, step, t) != 0)
         return -1;
     if (!sf->twin_ok && out_copy_file(sf->path, sf->twin) != 0) {
         out_write_failed(sf->twin, "a copy of the file", step, t);
