@@ -6,8 +6,8 @@
  * reported and at most one more, each complete. The snapshots are small, so that most of a
  * snapshot's time goes to HDF5's metadata and many kills land inside a close. Writing snapshots
  * in place, as lahar did before the twins of output_snapfile.c, failed in 5, 7 and 6 of 100
- * rounds (a snapshot group whose datasets do not read, or one snapshot too many): such a
- * regression fails the 80 rounds ctest runs with a probability above 99 %.
+ * rounds (the last snapshot's group on disk with datasets that do not read): such a regression
+ * fails the 80 rounds ctest runs with a probability above 99 %.
  *   test_output_killed OUTDIR [ROUNDS] */
 #include <errno.h>
 #include <hdf5.h>
