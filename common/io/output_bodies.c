@@ -32,7 +32,6 @@ typedef struct {
 
 struct lahar_body_output {
     char dir[OUT_PATH_MAX];
-    char h5path[OUT_PATH_MAX];
     int dim, nbody;
     lahar_display_mesh *mesh;  /* per body, body frame (fixed: world frame as given) */
     int *moving;               /* per body: 1 if not fixed */
@@ -442,16 +441,16 @@ static int bodies_file_continue(lahar_body_output *o, const char *outdir, char *
     snprintf(path, sizeof path, "%s/bodies.xmf", outdir);
     lahar_xdmf_bodies xb;
     out_xdmf_bodies_info(o, &xb);
-    return out_resume_sidecar(o->h5path, path, &o->xmf, &xb, NULL, &o->nsnap, err, n) != 0 ? -1 : 0;
+    return out_resume_sidecar(o->file.path, path, &o->xmf, &xb, NULL, &o->nsnap, err, n) != 0 ? -1 : 0;
 }
 
 /* bodies.h5 of a new run (header, geometry, an empty snapshots group) and its bodies.xmf. 0, or -1
  * with the message in err. */
 static int bodies_file_create(lahar_body_output *o, const lahar_case *c, const char *outdir, char *err, size_t n)
 {
-    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
+    hid_t f = out_file_open(o->file.path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
-        snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->h5path);
+        snprintf(err, n, "%s: cannot create HDF5 file (does the directory exist?)", o->file.path);
         return -1;
     }
     int rc = out_write_header(f, c);
@@ -460,7 +459,7 @@ static int bodies_file_create(lahar_body_output *o, const lahar_case *c, const c
     if (H5Fclose(f) < 0)
         rc = -1;
     if (rc) {
-        snprintf(err, n, "%s: writing header/geometry failed", o->h5path);
+        snprintf(err, n, "%s: writing header/geometry failed", o->file.path);
         return -1;
     }
     char path[OUT_PATH_MAX + 16];
@@ -480,8 +479,9 @@ lahar_body_output *lahar_body_output_open(const char *outdir, const lahar_case *
     o->dim = c->dim;
     o->nbody = c->nbody;
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
-    snprintf(o->h5path, sizeof o->h5path, "%s/bodies.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
+    char h5path[OUT_PATH_MAX + 16];
+    snprintf(h5path, sizeof h5path, "%s/bodies.h5", outdir);
+    out_snapfile_init(&o->file, h5path, c->output_in_place);
     size_t nb = (size_t)(c->nbody > 0 ? c->nbody : 1);
     o->mesh = calloc(nb, sizeof *o->mesh);
     o->moving = calloc(nb, sizeof *o->moving);

@@ -7,7 +7,6 @@
 #include "output_h5.h"
 
 struct lahar_contact_output {
-    char h5path[OUT_PATH_MAX];
     int nbody;         /* bodies of the case */
     int nmarked;
     int *marked;       /* body indices marked record_contacts */
@@ -16,10 +15,14 @@ struct lahar_contact_output {
     int64_t *offset;   /* per body of the case: first point in x/f of the current write */
     int64_t nsnap;
     out_snapfile file;  /* contacts.h5 and its twin */
-    /* the write in progress (contact_snapshot_fill) */
+};
+
+/* What a contact snapshot's fill writes: the output and the loads of this write. */
+typedef struct {
+    const lahar_contact_output *o;
     const int32_t *npoints;
     const double (*x)[3], (*f)[3], (*force)[3], (*torque)[3];
-};
+} contact_snapshot;
 
 void lahar_contact_output_close(lahar_contact_output *o)
 {
@@ -65,23 +68,24 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
             else
                 snprintf(o->group[m], sizeof o->group[m], "body_%d", b);
         }
-    snprintf(o->h5path, sizeof o->h5path, "%s/contacts.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
+    char h5path[OUT_PATH_MAX + 16];
+    snprintf(h5path, sizeof h5path, "%s/contacts.h5", outdir);
+    out_snapfile_init(&o->file, h5path, c->output_in_place);
     if (c->resume) { /* continue contacts.h5 as the checkpoint left it */
         out_snap_entry *list = NULL;
-        int64_t cnt = out_read_snapshot_list(o->h5path, &list);
+        int64_t cnt = out_read_snapshot_list(o->file.path, &list);
         free(list);
         if (cnt < 0) {
-            snprintf(err, n, "%s: cannot read it to continue it", o->h5path);
+            snprintf(err, n, "%s: cannot read it to continue it", o->file.path);
             lahar_contact_output_close(o);
             return NULL;
         }
         o->nsnap = cnt;
         return o;
     }
-    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
+    hid_t f = out_file_open(o->file.path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
-        snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
+        snprintf(err, n, "%s: cannot create HDF5 file", o->file.path);
         lahar_contact_output_close(o);
         return NULL;
     }
@@ -108,7 +112,7 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
     }
     rc |= out_snapshots_group(f);
     if (H5Fclose(f) < 0 || rc) {
-        snprintf(err, n, "%s: writing the header failed", o->h5path);
+        snprintf(err, n, "%s: writing the header failed", o->file.path);
         lahar_contact_output_close(o);
         return NULL;
     }
@@ -119,7 +123,8 @@ lahar_contact_output *lahar_contact_output_open(const char *outdir, const lahar_
  * listed in this write get an empty group. */
 static int contact_snapshot_fill(hid_t g, void *ctx)
 {
-    const lahar_contact_output *o = ctx;
+    const contact_snapshot *w = ctx;
+    const lahar_contact_output *o = w->o;
     int rc = 0;
     for (int m = 0; m < o->nmarked && !rc; m++) {
         int b = o->marked[m], i = o->slot[b];
@@ -127,11 +132,11 @@ static int contact_snapshot_fill(hid_t g, void *ctx)
         if (bg < 0)
             return -1;
         static const double zero[3] = {0.0, 0.0, 0.0};
-        hsize_t np = i >= 0 ? (hsize_t)o->npoints[i] : 0;
-        const double *pts = np ? o->x[o->offset[b]] : zero, *fs = np ? o->f[o->offset[b]] : zero;
+        hsize_t np = i >= 0 ? (hsize_t)w->npoints[i] : 0;
+        const double *pts = np ? w->x[o->offset[b]] : zero, *fs = np ? w->f[o->offset[b]] : zero;
         rc |= out_attr_int64(bg, "n", (int64_t)np);
-        rc |= out_attr(bg, "force", H5T_NATIVE_DOUBLE, 3, i >= 0 ? o->force[i] : zero);
-        rc |= out_attr(bg, "torque", H5T_NATIVE_DOUBLE, 3, i >= 0 ? o->torque[i] : zero);
+        rc |= out_attr(bg, "force", H5T_NATIVE_DOUBLE, 3, i >= 0 ? w->force[i] : zero);
+        rc |= out_attr(bg, "torque", H5T_NATIVE_DOUBLE, 3, i >= 0 ? w->torque[i] : zero);
         rc |= out_dataset(bg, "points", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, pts);
         rc |= out_dataset(bg, "forces", H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE, 2, np, 3, fs);
         H5Gclose(bg);
@@ -157,8 +162,8 @@ int lahar_contact_output_write(lahar_contact_output *o, int64_t step, double t, 
         off += npoints[i];
     }
     double need = 48.0 * (double)off + 4096.0 * (o->nmarked + 1);
-    o->npoints = npoints, o->x = x, o->f = f, o->force = force, o->torque = torque;
-    if (out_snapfile_append(&o->file, need, "the contact points", o->nsnap, step, t, contact_snapshot_fill, o) != 0)
+    contact_snapshot w = {o, npoints, x, f, force, torque};
+    if (out_snapfile_append(&o->file, need, "the contact points", o->nsnap, step, t, contact_snapshot_fill, &w) != 0)
         return -1;
     o->nsnap++;
     return 0;

@@ -13,7 +13,6 @@ const char *const lahar_flow_names[LAHAR_FLOW_NVAL] = {
 
 struct lahar_particle_output {
     char dir[OUT_PATH_MAX];
-    char h5path[OUT_PATH_MAX];
     unsigned fields;
     int64_t nsnap;
     out_snapfile file;  /* particles.h5 and its twin */
@@ -35,20 +34,21 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     o->xmf.fd = -1;
     o->fields = fields & (LAHAR_PFIELD_ALL | LAHAR_PFIELD_STRESS);
     snprintf(o->dir, sizeof o->dir, "%s", outdir);
-    snprintf(o->h5path, sizeof o->h5path, "%s/particles.h5", outdir);
-    out_snapfile_init(&o->file, o->h5path, c->output_in_place);
+    char h5path[OUT_PATH_MAX + 16];
+    snprintf(h5path, sizeof h5path, "%s/particles.h5", outdir);
+    out_snapfile_init(&o->file, h5path, c->output_in_place);
     if (c->resume) { /* continue particles.h5 as the checkpoint left it (lahar_output_resume_trim) */
         char path[OUT_PATH_MAX + 16];
         snprintf(path, sizeof path, "%s/particles.xmf", outdir);
-        if (out_resume_sidecar(o->h5path, path, &o->xmf, NULL, &o->fields, &o->nsnap, err, n) != 0) {
+        if (out_resume_sidecar(o->file.path, path, &o->xmf, NULL, &o->fields, &o->nsnap, err, n) != 0) {
             lahar_particle_output_close(o);
             return NULL;
         }
         return o;
     }
-    hid_t f = out_file_open(o->h5path, H5F_ACC_TRUNC, 1);
+    hid_t f = out_file_open(o->file.path, H5F_ACC_TRUNC, 1);
     if (f < 0) {
-        snprintf(err, n, "%s: cannot create HDF5 file", o->h5path);
+        snprintf(err, n, "%s: cannot create HDF5 file", o->file.path);
         lahar_particle_output_close(o);
         return NULL;
     }
@@ -66,7 +66,7 @@ lahar_particle_output *lahar_particle_output_open(const char *outdir, const laha
     }
     rc |= out_snapshots_group(f);
     if (H5Fclose(f) < 0 || rc) {
-        snprintf(err, n, "%s: writing the header failed", o->h5path);
+        snprintf(err, n, "%s: writing the header failed", o->file.path);
         lahar_particle_output_close(o);
         return NULL;
     }
