@@ -4,7 +4,13 @@
  * instability report, HELLO, STEP, STOP, NACK, heartbeats), and the frames a link publishes for
  * them, plain and authenticated, in the input format of fuzz_link.c; and the scene reproducers of
  * OUT_DIR/../regressions/msg for the current scene_t.
- *   make_seeds CASES_DIR OUT_DIR      (writes the files of OUT_DIR/msg and OUT_DIR/link) */
+ *   make_seeds CASES_DIR OUT_DIR      (writes the files of OUT_DIR/msg and OUT_DIR/link)
+ *   make_seeds --compare FRESH_DIR COMMITTED_DIR          (the same files, equal as below)
+ *   make_seeds --compare-written FRESH_DIR COMMITTED_DIR  (FRESH_DIR's files only)
+ * The comparisons exit 1 naming the first file and byte that differ. */
+#include <dirent.h>
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -350,10 +356,129 @@ static void write_scene_regressions(const char *cases, const char *corpus, const
     out_dir = saved;
 }
 
+/* ---- comparing written seeds with committed ones ----
+ * The scenes carry quaternions from the cases' axis-angle orientations, computed with the C
+ * library's sin and cos; glibc picks an FMA variant of them on CPUs that have FMA, and the last
+ * bits differ between machines. Two files are equal when they have the same length and every
+ * byte that differs lies in an 8-byte window holding, in both, finite doubles of the same sign
+ * within SEED_MAX_ULP units in the last place (LCM encodes doubles big-endian). What the check
+ * is for, a message type changed without rewriting the seeds, changes the 8-byte type hash at
+ * the start of every encoding and the lengths, which no such window explains. */
+#define SEED_MAX_ULP 16
+
+static int be_doubles_close(const uint8_t *a, const uint8_t *b)
+{
+    uint64_t ua = 0, ub = 0;
+    for (int k = 0; k < 8; k++) {
+        ua = ua << 8 | a[k];
+        ub = ub << 8 | b[k];
+    }
+    double da, db;
+    memcpy(&da, &ua, 8);
+    memcpy(&db, &ub, 8);
+    if (!isfinite(da) || !isfinite(db) || signbit(da) != signbit(db))
+        return 0;
+    uint64_t ma = ua & ~(1ull << 63), mb = ub & ~(1ull << 63); /* magnitudes order as integers */
+    return (ma > mb ? ma - mb : mb - ma) <= SEED_MAX_ULP;
+}
+
+/* -1 when equal as above, else the offset of the first byte no window explains */
+static long first_unexplained_byte(const uint8_t *a, const uint8_t *b, size_t n)
+{
+    size_t i = 0;
+    while (i < n) {
+        if (a[i] == b[i]) {
+            i++;
+            continue;
+        }
+        size_t q = i >= 7 ? i - 7 : 0, found = SIZE_MAX;
+        for (; q <= i && q + 8 <= n; q++)
+            if (be_doubles_close(a + q, b + q)) {
+                found = q;
+                break;
+            }
+        if (found == SIZE_MAX)
+            return (long)i;
+        i = found + 8;
+    }
+    return -1;
+}
+
+static uint8_t *read_all(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    bytes b = {0};
+    uint8_t buf[65536];
+    size_t k;
+    while ((k = fread(buf, 1, sizeof buf, f)) > 0)
+        put(&b, buf, k);
+    fclose(f);
+    *n = b.n;
+    return b.data ? b.data : calloc(1, 1);
+}
+
+/* every regular file of `from` against the file of that name in `to` (-1: missing there) */
+static int compare_files_of(const char *from, const char *to, int compare_bytes)
+{
+    DIR *d = opendir(from);
+    if (!d) {
+        fprintf(stderr, "make_seeds: cannot read the directory %s\n", from);
+        return 1;
+    }
+    int bad = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.')
+            continue;
+        char pa[4096], pb[4096];
+        snprintf(pa, sizeof pa, "%s/%s", from, e->d_name);
+        snprintf(pb, sizeof pb, "%s/%s", to, e->d_name);
+        size_t na = 0, nb = 0;
+        uint8_t *a = read_all(pa, &na), *b = read_all(pb, &nb);
+        if (!b) {
+            fprintf(stderr, "make_seeds: %s has no counterpart %s\n", pa, pb);
+            bad = 1;
+        } else if (compare_bytes && na != nb) {
+            fprintf(stderr, "make_seeds: %s (%zu bytes) and %s (%zu bytes) differ in length\n", pa, na, pb, nb);
+            bad = 1;
+        } else if (compare_bytes && a) {
+            long at = first_unexplained_byte(a, b, na);
+            if (at >= 0) {
+                fprintf(stderr, "make_seeds: %s and %s differ at byte %ld (0x%02x, 0x%02x), not by round-off in a double\n",
+                        pa, pb, at, a[at], b[at]);
+                bad = 1;
+            }
+        }
+        free(a);
+        free(b);
+    }
+    closedir(d);
+    return bad;
+}
+
+static int compare_main(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: make_seeds %s FRESH_DIR COMMITTED_DIR\n", argv[1]);
+        return 2;
+    }
+    int bad = compare_files_of(argv[2], argv[3], 1);
+    if (strcmp(argv[1], "--compare") == 0)
+        bad |= compare_files_of(argv[3], argv[2], 0); /* nothing committed that is no longer written */
+    if (bad)
+        fprintf(stderr, "make_seeds: the committed seeds are not what make_seeds writes now: rerun "
+                        "build/bin/fuzz_make_seeds cases tests/fuzz/corpus and commit them\n");
+    return bad;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && (strcmp(argv[1], "--compare") == 0 || strcmp(argv[1], "--compare-written") == 0))
+        return compare_main(argc, argv);
     if (argc != 3) {
-        fprintf(stderr, "usage: make_seeds CASES_DIR OUT_DIR\n");
+        fprintf(stderr, "usage: make_seeds CASES_DIR OUT_DIR | --compare FRESH_DIR COMMITTED_DIR | --compare-written FRESH_DIR COMMITTED_DIR\n");
         return 2;
     }
     out_dir = argv[2];
