@@ -55,6 +55,12 @@ void lahar_clock_advance(lahar_clock *c);
  * on stderr (no checkpoints, unreadable case). */
 int lahar_coord_resume_case(const char *outdir, lahar_case *c);
 
+/* For --in-process runs on a busy machine (more threads than free cores) with no OMP_WAIT_POLICY
+ * set: run this program again (argv, /proc/self/exe) with OMP_WAIT_POLICY=passive, which libgomp
+ * reads before main; results are the same. Returns only when nothing was done or the exec failed.
+ * Call before anything is created (files, threads). */
+void lahar_coord_in_process_wait_policy(char **argv, const lahar_coord_options *o);
+
 /* Run a loaded case (case.h). Returns a LAHAR_EXIT_* status. Call before creating threads (the
  * private network namespace requires a single-threaded process). */
 int lahar_coord_run(const lahar_case *c, const lahar_coord_options *o);

@@ -49,7 +49,8 @@ static void usage(FILE *f)
             "                     they would share cores with other work (the load average of the last\n"
             "                     minute + N > cores + 0.5, and the cores busy over 0.2 s + N too), lahar\n"
             "                     says so and starts the nodes with OMP_WAIT_POLICY=passive unless that\n"
-            "                     is set (summary.json \"machine\")\n"
+            "                     is set (summary.json \"machine\"); with --in-process it runs itself\n"
+            "                     again with that policy\n"
             "  --in-process       run the nodes as threads of this process over memq:// (no network;\n"
             "                     gives bitwise the same results as separate processes)\n"
             "  --no-spawn         do not start the nodes: start lahar-dem / lahar-sph yourself with the\n"
@@ -545,5 +546,7 @@ int main(int argc, char **argv)
     status = parse_options(argc, argv, &a, &o);
     if (status != GO_ON)
         return status;
+    if (!a.is_validate && !a.evaluate_only)
+        lahar_coord_in_process_wait_policy(argv, &o);
     return a.is_resume ? resume_command(argc, argv, &o) : case_command(&a, argc, argv, &o);
 }

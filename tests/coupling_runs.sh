@@ -388,7 +388,9 @@ busy_machine)
     # More OpenMP threads per node than cores: lahar notes it, and the nodes it starts run with
     # OMP_WAIT_POLICY=passive (a spinning wait takes the CPU from the threads it waits for),
     # which changes no result: bitwise the same as the user's OMP_WAIT_POLICY=active. A policy
-    # the user set is kept; one thread per node is never busy.
+    # the user set is kept; one thread per node is never busy. --in-process nodes share lahar's
+    # OpenMP, which reads the policy before main: lahar runs itself again with it, same results.
+    unset OMP_WAIT_POLICY # the suite's own (tests/CMakeLists.txt): this test is about lahar's
     cores=$(nproc)
     threads=$((2 * cores + 1))
     write_case_both both.yaml
@@ -400,8 +402,13 @@ busy_machine)
     OMP_WAIT_POLICY=active "$bin/lahar" run both.yaml -o active --threads $threads -q || fail "run with the user's policy failed"
     [ "$(summary active "s['machine']['omp_wait_policy'], s['machine']['omp_wait_policy_set_by_lahar']")" = "active False" ] ||
         fail "the user's OMP_WAIT_POLICY was not kept: $(summary active "s['machine']")"
+    "$bin/lahar" run both.yaml -o inproc --threads $threads --in-process 2> inproc.txt || fail "in-process run failed"
+    grep -q "The nodes run with OMP_WAIT_POLICY=passive (set by lahar" inproc.txt || fail "in-process note: $(cat inproc.txt)"
+    [ "$(summary inproc "s['machine']['omp_wait_policy'], s['machine']['omp_wait_policy_set_by_lahar']")" = "passive True" ] ||
+        fail "in-process: lahar did not run itself with the passive policy: $(summary inproc "s['machine']")"
     for f in bodies.h5 forces.h5 particles.h5; do
         "$python" "$tools/h5_compare.py" --quiet busy/$f active/$f || fail "$f differs between wait policies"
+        "$python" "$tools/h5_compare.py" --quiet inproc/$f active/$f || fail "$f differs in-process"
     done
     # the node lahar started has the policy in its environment
     write_case long.yaml 30
@@ -421,7 +428,7 @@ busy_machine)
     ! grep -q "note:" one.txt || fail "a note for one thread per node: $(cat one.txt)"
     [ "$(summary one "s['machine']['busy'], s['machine']['threads_per_node']")" = "False 1" ] ||
         fail "summary.json machine: $(summary one "s['machine']")"
-    echo "busy_machine: $threads threads on $cores cores: note, passive set, same results as active; user's policy kept"
+    echo "busy_machine: $threads threads on $cores cores: note, passive set (processes and in-process), same results as active; user's policy kept"
     ;;
 disk_full)
     # OUT on a small file system (a 5 MB tmpfs in a private user + mount namespace) that the run

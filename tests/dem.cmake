@@ -47,4 +47,4 @@ add_custom_target(bench COMMAND bench_dem DEPENDS bench_dem WORKING_DIRECTORY ${
 # The sphere fast path against LAMMPS on a small settled pile (contact count, KE decay); skipped
 # without lmp / liblammps (tests/dem_lammps_check.sh).
 lahar_test(dem_lammps_pile COMMAND sh ${LAHAR_TEST_DIR}/dem_lammps_check.sh $<TARGET_FILE:bench_dem> ${CMAKE_CURRENT_BINARY_DIR}/dem_lammps_pile
-  LABELS slow dem TIMEOUT 300 ENVIRONMENT "OMP_WAIT_POLICY=passive" PROPERTIES SKIP_RETURN_CODE 77)
+  LABELS slow dem TIMEOUT 300 PROPERTIES SKIP_RETURN_CODE 77)

@@ -19,13 +19,13 @@ if(LAHAR_SANITIZE)
   # that needs full stacks and the MCA components still loaded at exit to name them. The same for
   # the conformance suite's run of `lahar-dem --engine lammps` (tests/dem_conformance.cmake), whose
   # engine process inherits the environment.
-  set_tests_properties(test_dem_lammps dem_lammps_engine_option PROPERTIES ENVIRONMENT
+  set_property(TEST test_dem_lammps dem_lammps_engine_option APPEND PROPERTY ENVIRONMENT
     "OMPI_MCA_mca_base_component_disable_dlclose=1;PMIX_MCA_mca_base_component_disable_dlclose=1;ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0;LSAN_OPTIONS=suppressions=${LAHAR_TEST_DIR}/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
   if(TEST dem_conformance_lammps)
     get_test_property(test_dem_lammps ENVIRONMENT lahar_lammps_env)
     # the leak check at exit with full unwinding adds seconds to the node's exit after it gave up on
     # the silent coordinator (measured 8.2 s against 5 s): the silence check allows 5 s more here
-    set_tests_properties(dem_conformance_lammps PROPERTIES ENVIRONMENT "${lahar_lammps_env};LAHAR_CONFORMANCE_EXIT_SLACK=5")
+    set_property(TEST dem_conformance_lammps APPEND PROPERTY ENVIRONMENT "${lahar_lammps_env};LAHAR_CONFORMANCE_EXIT_SLACK=5")
   endif()
 endif()
 

@@ -32,18 +32,41 @@ static double coord_silence(const coord *co)
  * On cores that other work holds, or with more threads than cores, the spinning takes the CPU from
  * the threads it waits for (docs/bench/busy_machine.md). So, when the machine is
  * busy (lahar_machine_busy) and the user set no OMP_WAIT_POLICY, the nodes lahar starts as
- * processes get OMP_WAIT_POLICY=passive, which changes no result; --in-process nodes share this
- * process's OpenMP, configured before main: they only get the note. */
+ * processes get OMP_WAIT_POLICY=passive, which changes no result. --in-process nodes share this
+ * process's OpenMP, which libgomp configures before main: lahar_coord_in_process_wait_policy runs
+ * lahar again with the policy set, marked by LAHAR_WAIT_POLICY_SET_ENV. */
+#define LAHAR_WAIT_POLICY_SET_ENV "LAHAR_OMP_WAIT_POLICY_SET_BY_LAHAR"
+
+/* Busy for `threads` threads per node (`load` read): the load average says so, and still does over
+ * 0.2 s (the average lags by a minute; the sample is paid only when it says busy). */
+static int machine_busy_now(lahar_machine_load *load, int threads)
+{
+    if (!lahar_machine_busy(load, threads))
+        return 0;
+    return lahar_machine_sample(load, 0.2) == 0 ? lahar_machine_busy(load, threads) : 1;
+}
+
+void lahar_coord_in_process_wait_policy(char **argv, const lahar_coord_options *o)
+{
+    lahar_machine_load load;
+    if (!o->in_process || getenv("OMP_WAIT_POLICY") || lahar_machine_load_read(&load) != 0 ||
+        !machine_busy_now(&load, o->threads))
+        return;
+    if (setenv("OMP_WAIT_POLICY", "passive", 1) == 0 && setenv(LAHAR_WAIT_POLICY_SET_ENV, "1", 1) == 0)
+        execv("/proc/self/exe", argv);
+    /* not run again: on with the spinning policy; coord_machine_load's note says what to set */
+    unsetenv("OMP_WAIT_POLICY");
+    unsetenv(LAHAR_WAIT_POLICY_SET_ENV);
+}
+
 static void coord_machine_load(coord *co)
 {
     const lahar_coord_options *o = co->o;
     co->wait_policy = getenv("OMP_WAIT_POLICY");
+    const char *set_here = getenv(LAHAR_WAIT_POLICY_SET_ENV);
+    co->wait_policy_set = o->in_process && set_here && co->wait_policy && strcmp(co->wait_policy, "passive") == 0;
     co->load_read = lahar_machine_load_read(&co->load) == 0;
-    co->busy = co->load_read && lahar_machine_busy(&co->load, o->threads);
-    /* the load average lags by a minute: see whether the load is still there (0.2 s, paid only when
-     * the average says busy) */
-    if (co->busy && lahar_machine_sample(&co->load, 0.2) == 0)
-        co->busy = lahar_machine_busy(&co->load, o->threads);
+    co->busy = co->load_read && machine_busy_now(&co->load, o->threads);
     if (!co->busy || o->no_spawn)
         return;
     if (!co->wait_policy && !o->in_process && setenv("OMP_WAIT_POLICY", "passive", 1) == 0) {
@@ -66,9 +89,9 @@ static void coord_machine_load(coord *co)
     fprintf(stderr, ": threads that share a core wait for each other at every step, which can make the run several "
                     "times slower. %s%s\n",
             co->wait_policy_set ? "The nodes run with OMP_WAIT_POLICY=passive (set by lahar; results are the same). "
-            : o->in_process     ? "Set OMP_WAIT_POLICY=passive in the environment (lahar sets it only for nodes it starts "
-                                  "as processes). "
-                                : "",
+            : o->in_process && !co->wait_policy ? "Set OMP_WAIT_POLICY=passive in the environment (lahar could not "
+                                                  "run itself again with it). "
+                                                : "",
             o->threads == 1 ? "" : "--threads 1 may be faster still.");
 }
 
