@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "case.h"
 #include "fuzz.h"
 #include "instability.h"
@@ -419,7 +420,8 @@ static uint8_t *read_all(const char *path, size_t *n)
     return b.data ? b.data : calloc(1, 1);
 }
 
-/* every regular file of `from` against the file of that name in `to` (-1: missing there) */
+/* Every file of `from` against the file of that name in `to`: equal as above (compare_bytes), or
+ * only there. 0, or 1 after naming each one that fails. */
 static int compare_files_of(const char *from, const char *to, int compare_bytes)
 {
     DIR *d = opendir(from);
@@ -435,21 +437,26 @@ static int compare_files_of(const char *from, const char *to, int compare_bytes)
         char pa[4096], pb[4096];
         snprintf(pa, sizeof pa, "%s/%s", from, e->d_name);
         snprintf(pb, sizeof pb, "%s/%s", to, e->d_name);
-        size_t na = 0, nb = 0;
-        uint8_t *a = read_all(pa, &na), *b = read_all(pb, &nb);
-        if (!b) {
-            fprintf(stderr, "make_seeds: %s has no counterpart %s\n", pa, pb);
-            bad = 1;
-        } else if (compare_bytes && na != nb) {
-            fprintf(stderr, "make_seeds: %s (%zu bytes) and %s (%zu bytes) differ in length\n", pa, na, pb, nb);
-            bad = 1;
-        } else if (compare_bytes && a) {
-            long at = first_unexplained_byte(a, b, na);
-            if (at >= 0) {
-                fprintf(stderr, "make_seeds: %s and %s differ at byte %ld (0x%02x, 0x%02x), not by round-off in a double\n",
-                        pa, pb, at, a[at], b[at]);
+        if (!compare_bytes) {
+            if (access(pb, R_OK) != 0) {
+                fprintf(stderr, "make_seeds: %s has no counterpart %s\n", pa, pb);
                 bad = 1;
             }
+            continue;
+        }
+        size_t na = 0, nb = 0;
+        uint8_t *a = read_all(pa, &na), *b = read_all(pb, &nb);
+        long at = -1;
+        if (!a || !b) {
+            fprintf(stderr, "make_seeds: cannot read %s\n", !a ? pa : pb);
+            bad = 1;
+        } else if (na != nb) {
+            fprintf(stderr, "make_seeds: %s (%zu bytes) and %s (%zu bytes) differ in length\n", pa, na, pb, nb);
+            bad = 1;
+        } else if ((at = first_unexplained_byte(a, b, na)) >= 0) {
+            fprintf(stderr, "make_seeds: %s and %s differ at byte %ld (0x%02x, 0x%02x), not by round-off in a double\n",
+                    pa, pb, at, a[at], b[at]);
+            bad = 1;
         }
         free(a);
         free(b);
