@@ -1,17 +1,59 @@
 /* How busy the machine is when a run starts (machine_load.h). */
 #define _GNU_SOURCE
 #include "machine_load.h"
+#include <ctype.h>
+#include <dirent.h>
 #include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
+
+/* 1 when /proc/PID/cmdline is `lahar run|check|resume ...` (the program's name, without its
+ * directory, is lahar: not lahar-sph or lahar-dem, which a run starts) */
+static int is_lahar_run(const char *pid)
+{
+    char path[300], cmd[512];
+    snprintf(path, sizeof path, "/proc/%s/cmdline", pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    const size_t n = fread(cmd, 1, sizeof cmd - 1, f);
+    fclose(f);
+    cmd[n] = '\0';
+    const size_t len0 = strlen(cmd);
+    if (len0 + 1 >= n) /* no second argument (or a kernel thread: empty) */
+        return 0;
+    const char *slash = strrchr(cmd, '/');
+    const char *prog = slash ? slash + 1 : cmd, *verb = cmd + len0 + 1;
+    return strcmp(prog, "lahar") == 0 &&
+           (strcmp(verb, "run") == 0 || strcmp(verb, "check") == 0 || strcmp(verb, "resume") == 0);
+}
+
+/* The other lahar runs on the machine, or 0 when /proc cannot be read */
+static int other_lahar_runs(void)
+{
+    DIR *d = opendir("/proc");
+    if (!d)
+        return 0;
+    char self[32];
+    snprintf(self, sizeof self, "%ld", (long)getpid());
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (isdigit((unsigned char)e->d_name[0]) && strcmp(e->d_name, self) != 0)
+            n += is_lahar_run(e->d_name);
+    closedir(d);
+    return n;
+}
 
 int lahar_machine_load_read(lahar_machine_load *m)
 {
     cpu_set_t set;
     double load[1];
     m->busy_now = -1.0;
+    m->other_runs = other_lahar_runs();
     if (sched_getaffinity(0, sizeof set, &set) != 0 || getloadavg(load, 1) != 1)
         return -1;
     m->cores = CPU_COUNT(&set);
@@ -67,5 +109,7 @@ int lahar_machine_busy(const lahar_machine_load *m, int threads)
     /* half a core of slack for short-lived tasks; the load average decays over a minute, so a run
      * started just after a build or another run reads its load: the sample tells whether it is
      * still there */
+    if (t > 1 && m->other_runs > 0 && (double)(m->other_runs + 1) * t > m->cores + 0.5)
+        return 1;
     return t > 1 && m->load1 + t > m->cores + 0.5 && (m->busy_now < 0.0 || m->busy_now + t > m->cores + 0.5);
 }

@@ -424,11 +424,28 @@ busy_machine)
     done
     kill -INT $lahar_pid; wait $lahar_pid
     [ "$env_seen" = "OMP_WAIT_POLICY=passive" ] || fail "lahar-dem's environment: '$env_seen'"
+    # beside another lahar run that has only just started (no load to read yet): busy all the
+    # same, from the other run's process; one thread per core each
+    if [ "$cores" -ge 2 ]; then
+        "$bin/lahar" run long.yaml -o first --threads $cores -q &
+        first_pid=$!
+        for i in $(seq 1 100); do
+            tr '\0' ' ' < /proc/$first_pid/cmdline 2>/dev/null | grep -q "run long.yaml" && break
+            sleep 0.05
+        done
+        "$bin/lahar" run both.yaml -o beside --threads $cores --in-process 2> beside.txt
+        rc=$?
+        kill -INT $first_pid; wait $first_pid
+        [ $rc -eq 0 ] || fail "run beside another one failed: $(cat beside.txt)"
+        grep -q "other lahar run.* on this machine's $cores cores" beside.txt || fail "no note beside another run: $(cat beside.txt)"
+        [ "$(summary beside "s['machine']['other_lahar_runs'] >= 1, s['machine']['busy'], s['machine']['omp_wait_policy_set_by_lahar']")" = "True True True" ] ||
+            fail "beside another run: summary.json machine: $(summary beside "s['machine']")"
+    fi
     "$bin/lahar" run both.yaml -o one --threads 1 2> one.txt || fail "run with one thread failed"
     ! grep -q "note:" one.txt || fail "a note for one thread per node: $(cat one.txt)"
     [ "$(summary one "s['machine']['busy'], s['machine']['threads_per_node']")" = "False 1" ] ||
         fail "summary.json machine: $(summary one "s['machine']")"
-    echo "busy_machine: $threads threads on $cores cores: note, passive set (processes and in-process), same results as active; user's policy kept"
+    echo "busy_machine: $threads threads on $cores cores, and beside another run: note, passive set (processes and in-process), same results as active; user's policy kept"
     ;;
 disk_full)
     # OUT on a small file system (a 5 MB tmpfs in a private user + mount namespace) that the run

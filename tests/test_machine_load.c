@@ -1,6 +1,7 @@
 /* When the coordinator calls a machine busy for a run's threads (coordinator/machine_load.c): more
  * than one thread per node, and the load average plus the threads above the cores by more than half
- * a core; OpenMP's default (threads 0) is one thread per core. And the reading itself: the cores of
+ * a core, or other lahar runs whose threads with this one's overfill the cores; OpenMP's default
+ * (threads 0) is one thread per core. And the reading itself: the cores of
  * this process's affinity mask, a load average that is not negative. */
 #define _GNU_SOURCE
 #include <sched.h>
@@ -43,12 +44,31 @@ int main(void)
     /* a sample alone does not make a machine busy: the load average must say so too */
     lahar_machine_load burst = {.cores = 2, .load1 = 0.1, .busy_now = 1.6};
     CHECK(!lahar_machine_busy(&burst, 2), "a busy sample with an idle load average: called busy");
+    /* another lahar run that has only just started: no load yet, busy all the same when the two
+     * runs' threads (as many each) overfill the cores, even with an idle sample */
+    const struct {
+        int cores, other_runs, threads, busy;
+    } beside[] = {
+        {2, 1, 0, 1}, /* two runs of one thread per core on 2 cores */
+        {2, 1, 2, 1},
+        {2, 1, 1, 0}, /* one thread: nothing to wait for */
+        {8, 1, 4, 0}, /* room for both */
+        {8, 2, 4, 1}, /* not for three */
+        {2, 0, 2, 0}, /* alone */
+    };
+    for (size_t i = 0; i < sizeof beside / sizeof beside[0]; i++) {
+        lahar_machine_load b = {.cores = beside[i].cores, .load1 = 0.0, .busy_now = 0.0, .other_runs = beside[i].other_runs};
+        CHECK(lahar_machine_busy(&b, beside[i].threads) == beside[i].busy,
+              "%d cores, %d other runs, --threads %d: busy %d, expected %d", b.cores, b.other_runs, beside[i].threads,
+              lahar_machine_busy(&b, beside[i].threads), beside[i].busy);
+    }
     lahar_machine_load m = {0};
     cpu_set_t set;
     CHECK(lahar_machine_load_read(&m) == 0, "cannot read the machine's load");
     CHECK(sched_getaffinity(0, sizeof set, &set) == 0 && m.cores == CPU_COUNT(&set),
           "cores %d, the affinity mask has %d", m.cores, CPU_COUNT(&set));
     CHECK(m.load1 >= 0.0 && m.busy_now == -1.0, "load average %g, busy_now %g before a sample", m.load1, m.busy_now);
+    CHECK(m.other_runs >= 0, "other lahar runs %d", m.other_runs); /* counted for real in coupling_busy_machine */
     CHECK(lahar_machine_sample(&m, 0.05) == 0 && m.busy_now >= 0.0 && m.busy_now <= sysconf(_SC_NPROCESSORS_CONF) + 0.5,
           "sampled %g busy cores", m.busy_now);
     CHECK(lahar_machine_threads(&m, 0) == m.cores && lahar_machine_threads(&m, 3) == 3, "threads per node");

@@ -78,6 +78,10 @@ static void coord_machine_load(coord *co)
     const int t = lahar_machine_threads(&co->load, o->threads);
     if (t > co->load.cores)
         fprintf(stderr, "lahar: note: %d OpenMP threads per node on %d cores", t, co->load.cores);
+    else if (co->load.other_runs > 0)
+        fprintf(stderr, "lahar: note: %d other lahar run%s on this machine's %d cores, and each node runs %d OpenMP "
+                        "threads",
+                co->load.other_runs, co->load.other_runs > 1 ? "s" : "", co->load.cores, t);
     else if (co->load.busy_now >= 0.0)
         fprintf(stderr, "lahar: note: this machine is busy (other work holds %.1f of its %d cores) and each node runs "
                         "%d OpenMP threads",

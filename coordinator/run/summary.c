@@ -23,6 +23,7 @@ static void coord_summary_machine(const coord *co, cJSON *root)
     cJSON_AddNumberToObject(m, "load_average_1min", co->load.load1);
     if (co->load.busy_now >= 0.0)
         cJSON_AddNumberToObject(m, "busy_cores_sampled", co->load.busy_now);
+    cJSON_AddNumberToObject(m, "other_lahar_runs", co->load.other_runs);
     cJSON_AddNumberToObject(m, "threads_per_node", lahar_machine_threads(&co->load, co->o->threads));
     cJSON_AddBoolToObject(m, "busy", co->busy);
     if (co->wait_policy)
