@@ -3,28 +3,30 @@
 # coord_progress): whole lines "lahar: t = T / END s (P %) ... ETA ..." every --progress-every
 # seconds, with the simulated time rising and ending at or below END, a set-up line while the nodes
 # fill their particles, no carriage returns; none with -q, with --progress-every 0 or (default 60 s)
-# in a run shorter than a minute; a bad value is refused with exit 2. The cases: the 3D dam break to
-# t = 0.01 s (about 1.3 s), and for the lines into a file the same at dx = 5 mm (120000 particles)
-# for 7 steps, whose set-up (filling the particles, the first rates: about 0.35 s on one core)
-# spans several 0.05 s intervals.
+# in a run shorter than a minute; a bad value is refused with exit 2. The cases: the 3D dam break at
+# dx = 2 cm to t = 0.01 s (1875 particles, well under a second), and for the lines into a file the
+# case as it is (15000 particles) for 10 steps of about 50 ms each on one core: the set-up (filling
+# the particles, the first rates) and every step span a 5 ms interval, so it writes about one line
+# a step on a faster machine too. Small enough for the sanitizer build (about 20 s there; with
+# 120000 particles it reached the test's 120 s timeout).
 # usage: cli_progress.sh LAHAR CASE_OVERRIDE_PY CASES_DIR WORK_DIR
 lahar=$1 override=$2 cases=$3 work=$4
 fail=0 n=0
 rm -rf "$work" && mkdir -p "$work" || exit 2
-python3 "$override" "$cases/dam_break_3d.yaml" "$work/short.yaml" time.end=0.01 time.output_interval=0.01 >/dev/null || exit 2
-python3 "$override" "$cases/dam_break_3d.yaml" "$work/fine.yaml" sph.dx=0.005 time.end=0.0005 \
-    time.output_interval=0.0005 >/dev/null || exit 2
+python3 "$override" "$cases/dam_break_3d.yaml" "$work/short.yaml" sph.dx=0.02 time.end=0.01 time.output_interval=0.01 >/dev/null || exit 2
+python3 "$override" "$cases/dam_break_3d.yaml" "$work/fine.yaml" time.end=0.0015 \
+    time.output_interval=0.0015 >/dev/null || exit 2
 result() { # name ok-condition-status message
     n=$((n + 1))
     if [ "$2" -eq 0 ]; then echo "ok   $1"; else echo "FAIL $1: $3"; fail=$((fail + 1)); fi
 }
-"$lahar" run "$work/fine.yaml" -o "$work/log" --threads 1 --progress-every 0.05 >/dev/null 2>"$work/log.err"
+"$lahar" run "$work/fine.yaml" -o "$work/log" --threads 1 --progress-every 0.005 >/dev/null 2>"$work/log.err"
 rc=$?
-lines=$(grep -c '^lahar: t = [0-9.e+-]* / 0\.0005 s ([0-9]* %)   step [0-9]*   [0-9]* steps/s   .* elapsed   ETA ' "$work/log.err")
+lines=$(grep -c '^lahar: t = [0-9.e+-]* / 0\.0015 s ([0-9]* %)   step [0-9]*   [0-9]* steps/s   .* elapsed   ETA ' "$work/log.err")
 rising=$(sed -n 's/^lahar: t = \([0-9.e+-]*\) .*/\1/p' "$work/log.err" |
-         awk 'NR > 1 && $1 < prev { bad = 1 } $1 > 0.0005 { bad = 1 } { prev = $1 } END { print bad ? "no" : "yes" }')
+         awk 'NR > 1 && $1 < prev { bad = 1 } $1 > 0.0015 { bad = 1 } { prev = $1 } END { print bad ? "no" : "yes" }')
 [ "$rc" -eq 0 ] && [ "$lines" -ge 3 ] && [ "$rising" = yes ]
-result "--progress-every 0.05 into a file: $lines progress lines, times rising to <= 0.0005 s (exit $rc)" $? \
+result "--progress-every 0.005 into a file: $lines progress lines, times rising to <= 0.0015 s (exit $rc)" $? \
     "want exit 0, >= 3 lines, rising times; stderr: $(head -c 600 "$work/log.err")"
 grep -q '^lahar: setting up: waiting for the SPH node' "$work/log.err"
 result "a set-up line while the SPH node fills its particles" $? "none in: $(head -c 300 "$work/log.err")"
