@@ -14,7 +14,7 @@ endfunction()
 
 foreach(t ${LAHAR_FUZZ_TARGETS})
   lahar_fuzz_sources(src ${t})
-  add_executable(fuzz_${t}_replay ${src} ${LAHAR_FUZZ_DIR}/replay_main.c)
+  add_executable(fuzz_${t}_replay ${src} ${LAHAR_FUZZ_DIR}/replay_main.c ${LAHAR_FUZZ_DIR}/fuzz_file.c)
   target_include_directories(fuzz_${t}_replay PRIVATE ${LAHAR_FUZZ_DIR})
   target_compile_definitions(fuzz_${t}_replay PRIVATE LAHAR_FUZZ_CASE_PATH="${CMAKE_SOURCE_DIR}/cases/fuzz.yaml")
   target_link_libraries(fuzz_${t}_replay PRIVATE lahar_common)
@@ -23,7 +23,7 @@ foreach(t ${LAHAR_FUZZ_TARGETS})
 endforeach()
 
 # the message seeds: tests/fuzz/make_seeds.c (rerun and commit when a message type changes)
-add_executable(fuzz_make_seeds ${LAHAR_FUZZ_DIR}/make_seeds.c ${LAHAR_FUZZ_DIR}/fuzz_decode.c)
+add_executable(fuzz_make_seeds ${LAHAR_FUZZ_DIR}/make_seeds.c ${LAHAR_FUZZ_DIR}/fuzz_decode.c ${LAHAR_FUZZ_DIR}/fuzz_file.c)
 target_include_directories(fuzz_make_seeds PRIVATE ${LAHAR_FUZZ_DIR})
 target_link_libraries(fuzz_make_seeds PRIVATE lahar_common)
 # ... and the committed seeds and scene reproducers are what it writes now: a message type changed

@@ -24,4 +24,8 @@ extern const uint8_t fuzz_auth_key[32];
     } while (0)
 void fuzz_fail(const char *file, int line, const char *what);
 
+/* The bytes of the file at `path` in a buffer of exactly their size (free it), their count in
+ * *size; NULL when it cannot be read (fuzz_file.c). */
+uint8_t *fuzz_read_file(const char *path, size_t *size);
+
 #endif

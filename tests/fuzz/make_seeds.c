@@ -405,21 +405,6 @@ static long first_unexplained_byte(const uint8_t *a, const uint8_t *b, size_t n)
     return -1;
 }
 
-static uint8_t *read_all(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    bytes b = {0};
-    uint8_t buf[65536];
-    size_t k;
-    while ((k = fread(buf, 1, sizeof buf, f)) > 0)
-        put(&b, buf, k);
-    fclose(f);
-    *n = b.n;
-    return b.data ? b.data : calloc(1, 1);
-}
-
 /* Every file of `from` against the file of that name in `to`: equal as above (compare_bytes), or
  * only there. 0, or 1 after naming each one that fails. */
 static int compare_files_of(const char *from, const char *to, int compare_bytes)
@@ -445,7 +430,7 @@ static int compare_files_of(const char *from, const char *to, int compare_bytes)
             continue;
         }
         size_t na = 0, nb = 0;
-        uint8_t *a = read_all(pa, &na), *b = read_all(pb, &nb);
+        uint8_t *a = fuzz_read_file(pa, &na), *b = fuzz_read_file(pb, &nb);
         long at = -1;
         if (!a || !b) {
             fprintf(stderr, "make_seeds: cannot read %s\n", !a ? pa : pb);

@@ -10,34 +10,10 @@
 
 static int replay_file(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    size_t n = 0;
+    uint8_t *exact = fuzz_read_file(path, &n);
+    if (!exact)
         return -1;
-    size_t cap = 4096, n = 0;
-    uint8_t *buf = malloc(cap);
-    size_t k;
-    while (buf && (k = fread(buf + n, 1, cap - n, f)) > 0) {
-        n += k;
-        if (n == cap) {
-            uint8_t *p = realloc(buf, cap *= 2);
-            if (!p) {
-                free(buf);
-                buf = NULL;
-            }
-            buf = p;
-        }
-    }
-    fclose(f);
-    if (!buf)
-        return -1;
-    /* an exact-size copy, so that ASan sees a read past the input's end */
-    uint8_t *exact = malloc(n ? n : 1);
-    if (!exact) {
-        free(buf);
-        return -1;
-    }
-    memcpy(exact, buf, n);
-    free(buf);
     LLVMFuzzerTestOneInput(exact, n);
     free(exact);
     return 0;
