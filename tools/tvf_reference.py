@@ -30,7 +30,9 @@ largest speed, and it evaluates the rates with the predicted velocity instead of
 
 --check TOL: exit 1 if |E_lahar/E_reference - 1| > TOL at any snapshot (a verdict line per
 failure). --json FILE: the two histories and the largest deviation. --png FILE: both over the exact
-decay exp(-16 pi^2 nu t / L^2) against t. Exit 2 on a run that is not such a case (with what to do)."""
+decay exp(-16 pi^2 nu t / L^2) against t. Exit 2, with what to do, on a run that is not
+such a case: another kernel, no transport velocity, not a periodic square, or a first snapshot that
+is not the vortex u = -U cos(2 pi x/L) sin(2 pi y/L), v = U sin cos (to 1e-6 U)."""
 import argparse
 import math
 import os
@@ -158,13 +160,25 @@ def lahar_history(out):
                 g = snaps[key]
                 ts.append(float(g.attrs["time"]))
                 es.append(float(np.sum(g["vx"][:] ** 2 + g["vy"][:] ** 2)))
-            n0 = len(snaps[sorted(snaps)[0]]["vx"])
+            first = snaps[sorted(snaps)[0]]
+            x0, y0, u0, v0 = first["x"][:], first["y"][:], first["vx"][:], first["vy"][:]
     except (OSError, KeyError) as exc:
         fail(f"{path}: {exc}; give the output directory of a finished lahar run")
     if len(ts) < 2:
         fail(f"{path}: {len(ts)} snapshot(s); the comparison needs the run's history (time.output_interval)")
-    U = math.sqrt(2.0 * es[0] / n0)
-    return np.array(ts), np.array(es) / es[0], U
+    U = math.sqrt(2.0 * es[0] / len(u0))
+    return np.array(ts), np.array(es) / es[0], U, (x0, y0, u0, v0)
+
+
+def require_taylor_green(first, U, L, path):
+    """Exit 2 unless the run started from the vortex the reference runs, u = -U cos kx sin ky,
+    v = U sin kx cos ky (k = 2 pi / L, x from 0), at its own particle positions."""
+    x, y, u, v = first
+    k = 2 * math.pi / L
+    err = max(np.max(np.abs(u + U * np.cos(k * x) * np.sin(k * y))), np.max(np.abs(v - U * np.sin(k * x) * np.cos(k * y))))
+    if not err <= 1e-6 * U:
+        fail(f"{path}: the first snapshot is not the Taylor-Green vortex u = -U cos(2 pi x/L) sin(2 pi y/L), "
+             f"v = U sin cos (off by {err:.3g} m/s at U = {U:.4g} m/s); run a variant of cases/taylor_green_2d.yaml")
 
 
 def case_parameters(out):
@@ -196,7 +210,8 @@ def main():
     ap.add_argument("--png", metavar="FILE", help="plot both over the exact decay against t")
     a = ap.parse_args()
     prm = case_parameters(a.out)
-    t_run, e_run, U = lahar_history(a.out)
+    t_run, e_run, U, first = lahar_history(a.out)
+    require_taylor_green(first, U, prm["L"], os.path.join(a.out, "particles.h5"))
     t_ref, e_ref = taylor_green(U=U, **prm)
     keep = t_run <= t_ref[-1]
     t_run, e_run = t_run[keep], e_run[keep]
