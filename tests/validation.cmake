@@ -87,7 +87,7 @@ lahar_test(validation_taylor_green_2d COMMAND sh ${LAHAR_TEST_DIR}/validation_ta
 lahar_validation_test(taylor_green_2d_100 taylor_green_2d "velocity_l2_rel_error<=0.20"
   "density_mean_rel_change<=0.015")
 # The transport velocity against an independent implementation of Adami et al. 2013
-# (tools/tvf_reference.py) at 25 x 25 with their quintic kernel: E(t)/E(0) within 2 % at every
-# snapshot to t = 0.4 s (tests/validation_taylor_green_tvf.sh; ~15 s).
+# (tools/tvf_reference.py) at 25 x 25, with their quintic kernel and with the case's settings:
+# E(t)/E(0) within 2 % at every snapshot to t = 0.4 s (tests/validation_taylor_green_tvf.sh; ~20 s).
 lahar_test(validation_taylor_green_tvf COMMAND sh ${LAHAR_TEST_DIR}/validation_taylor_green_tvf.sh ${CMAKE_SOURCE_DIR}
   $<TARGET_FILE:lahar> ${LAHAR_VALIDATION_DIR}/taylor_green_tvf ${LAHAR_OUTPUT_PYTHON} LABELS validation TIMEOUT 300)

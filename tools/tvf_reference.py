@@ -5,9 +5,8 @@ J. Comput. Phys. 241:292-307) for the 2D periodic Taylor-Green vortex, to check 
 usage: tvf_reference.py OUT [--check TOL] [--json FILE] [--png FILE]
 
 OUT is a lahar run of a Taylor-Green case with the transport velocity (cases/taylor_green_2d.yaml
-or a tools/case_override.py variant of it) and the quintic kernel, the kernel of Adami et al.
-The tool reads the run's case (dx, L from sph.periodic, h_over_dx, c0, density, viscosity,
-background_pressure) and U from the run's first snapshot (U^2 = 2 <|v|^2>), runs the same vortex
+or a tools/case_override.py variant of it). The tool reads the run's case (dx, L from sph.periodic,
+kernel, h_over_dx, c0, density, viscosity, background_pressure) and U from the run's first snapshot (U^2 = 2 <|v|^2>), runs the same vortex
 with the formulation written out here in numpy, and compares the kinetic energy E(t)/E(0) of the
 two at the run's snapshot times (the reference's energy interpolated between its steps).
 
@@ -24,14 +23,15 @@ The reference, per Adami et al. 2013 (section 2, eqs. 7-8, 13-17), with V_i = 1/
   A = rho v (x) (v~ - v), F_ij = W'(r)/r (so x_ij.grad W / r^2),
   b_i = -p_b/m sum_j (V_i^2 + V_j^2) grad_i W_ij,
   kick-drift-kick: v += dt/2 a; v~ = v + dt/2 b; x += dt v~; evaluate a, b; v += dt/2 a,
-quintic spline (Morris et al. 1997, support 3h), dt = min(0.25 h/(c0 + U), 0.125 h^2/nu) fixed.
+the case's kernel (Adami et al. use the quintic spline with h = dx; `kernel` below),
+dt = min(0.25 h/(c0 + U), 0.125 h^2/nu) fixed.
 lahar differs in two details it documents (sph_node/fluid/sph_fluid.h): its steps adapt to the
 largest speed, and it evaluates the rates with the predicted velocity instead of v(t + dt/2).
 
 --check TOL: exit 1 if |E_lahar/E_reference - 1| > TOL at any snapshot (a verdict line per
 failure). --json FILE: the two histories and the largest deviation. --png FILE: both over the exact
 decay exp(-16 pi^2 nu t / L^2) against t. Exit 2, with what to do, on a run that is not
-such a case: another kernel, no transport velocity, not a periodic square, or a first snapshot that
+such a case: no transport velocity, not a periodic square, or a first snapshot that
 is not the vortex u = -U cos(2 pi x/L) sin(2 pi y/L), v = U sin cos (to 1e-6 U)."""
 import argparse
 import math
@@ -54,18 +54,26 @@ def fail(msg):
     sys.exit(2)
 
 
-def quintic(h):
-    """W(r) and W'(r) of the 2D quintic spline (Morris et al. 1997), support 3h."""
-    sig = 7.0 / (478.0 * math.pi * h * h)
-
-    def w(q):
-        return sig * (np.where(q < 3, (3 - q) ** 5, 0) - 6 * np.where(q < 2, (2 - q) ** 5, 0)
-                      + 15 * np.where(q < 1, (1 - q) ** 5, 0))
-
-    def dw(q):
-        return sig / h * (-5 * np.where(q < 3, (3 - q) ** 4, 0) + 30 * np.where(q < 2, (2 - q) ** 4, 0)
-                          - 75 * np.where(q < 1, (1 - q) ** 4, 0))
-    return w, dw
+def kernel(name, h):
+    """W(r), W'(r) and the support of a 2D kernel lahar offers (sph.kernel), from its published
+    form: cubic spline (Monaghan & Lattanzio 1985, 10/(7 pi h^2), support 2h), quintic spline
+    (Morris et al. 1997, 7/(478 pi h^2), 3h), Wendland C2 (Wendland 1995, 7/(4 pi h^2), 2h)."""
+    if name == "quintic":
+        sig = 7.0 / (478.0 * math.pi * h * h)
+        return (lambda q: sig * (np.where(q < 3, (3 - q) ** 5, 0) - 6 * np.where(q < 2, (2 - q) ** 5, 0)
+                                 + 15 * np.where(q < 1, (1 - q) ** 5, 0)),
+                lambda q: sig / h * (-5 * np.where(q < 3, (3 - q) ** 4, 0) + 30 * np.where(q < 2, (2 - q) ** 4, 0)
+                                     - 75 * np.where(q < 1, (1 - q) ** 4, 0)), 3.0 * h)
+    if name == "cubic":
+        sig = 10.0 / (7.0 * math.pi * h * h)
+        return (lambda q: sig * np.where(q < 1, 1 - 1.5 * q * q + 0.75 * q ** 3, np.where(q < 2, 0.25 * (2 - q) ** 3, 0)),
+                lambda q: sig / h * np.where(q < 1, -3 * q + 2.25 * q * q, np.where(q < 2, -0.75 * (2 - q) ** 2, 0)),
+                2.0 * h)
+    if name == "wendland2":
+        sig = 7.0 / (4.0 * math.pi * h * h)
+        return (lambda q: sig * np.where(q < 2, (1 - 0.5 * q) ** 4 * (2 * q + 1), 0),
+                lambda q: sig / h * np.where(q < 2, -5 * q * (1 - 0.5 * q) ** 3, 0), 2.0 * h)
+    fail(f"kernel {name!r}: the reference knows cubic, quintic and wendland2")
 
 
 def pairs(x, y, L, support):
@@ -96,11 +104,11 @@ def pairs(x, y, L, support):
     return I[keep], J[keep], rx[keep], ry[keep], r[keep]
 
 
-def taylor_green(n, L, U, rho0, mu, c0, pb, hdx, t_end):
+def taylor_green(n, L, U, rho0, mu, c0, pb, hdx, kern, t_end):
     """Times and E/E0 of the reference run: n x n particles, one entry per step."""
     dx = L / n
     h = hdx * dx
-    w, dw = quintic(h)
+    w, dw, support = kernel(kern, h)
     nu = mu / rho0
     p0 = rho0 * c0 * c0
     xs = (np.arange(n) + 0.5) * dx
@@ -112,7 +120,7 @@ def taylor_green(n, L, U, rho0, mu, c0, pb, hdx, t_end):
     m, N = rho0 * dx * dx, n * n
 
     def rates(uh, vh):
-        I, J, rx, ry, r = pairs(x, y, L, 3 * h)
+        I, J, rx, ry, r = pairs(x, y, L, support)
         vinv = np.bincount(I, w(r / h), N)
         rho, V = m * vinv, 1.0 / vinv
         p = p0 * (rho / rho0 - 1.0)
@@ -188,7 +196,7 @@ def exact_decay(t, prm):
 
 def case_parameters(out):
     """The reference's parameters from the run's case; a key the case leaves out takes lahar's
-    default (`lahar keys sph`: h_over_dx 1.3, background_pressure rho0 c0^2)."""
+    default (`lahar keys sph`: kernel cubic, h_over_dx 1.3, background_pressure rho0 c0^2)."""
     path = lahar_py.run_case(out)
     try:
         with open(path) as fh:
@@ -198,13 +206,13 @@ def case_parameters(out):
         L = per["x"][1] - per["x"][0]
         if abs((per["y"][1] - per["y"][0]) - L) > 1e-12 * L or case.get("dimensions") != 2:
             fail(f"{path}: the reference is the 2D vortex on a periodic square")
-        if not sph.get("transport_velocity") or sph.get("kernel") != "quintic":
-            fail(f"{path}: the reference is Adami et al.'s formulation: set sph.transport_velocity: true and "
-                 "sph.kernel: quintic (tools/case_override.py CASE V.yaml sph.kernel=quintic sph.h_over_dx=1.0)")
+        if not sph.get("transport_velocity"):
+            fail(f"{path}: the reference is Adami et al.'s transport-velocity formulation: set "
+                 "sph.transport_velocity: true (as cases/taylor_green_2d.yaml does)")
         n = int(round(L / sph["dx"]))
         return dict(n=n, L=L, rho0=float(sph["density"]), mu=float(sph["viscosity"]), c0=float(sph["c0"]),
                     pb=float(sph.get("background_pressure", float(sph["density"]) * float(sph["c0"]) ** 2)),
-                    hdx=float(sph.get("h_over_dx", 1.3)), t_end=float(case["time"]["end"]))
+                    hdx=float(sph.get("h_over_dx", 1.3)), kern=sph.get("kernel", "cubic"), t_end=float(case["time"]["end"]))
     except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError) as exc:
         fail(f"{path}: not a periodic Taylor-Green case ({exc!r})")
 
@@ -225,7 +233,7 @@ def main():
     e_at = np.interp(t_run, t_ref, e_ref)
     dev = e_run / e_at - 1.0
     decay = exact_decay(t_run, prm)
-    print(f"Taylor-Green, {prm['n']}^2, quintic h = {prm['hdx']} dx, c0 {prm['c0']}, p_b {prm['pb']}: "
+    print(f"Taylor-Green, {prm['n']}^2, {prm['kern']} h = {prm['hdx']} dx, c0 {prm['c0']}, p_b {prm['pb']}: "
           "E/E0 (and over the exact decay)")
     print("t [s]    lahar            reference        lahar/ref - 1")
     for t, er, ef, d, ex in zip(t_run, e_run, e_at, dev, decay):
@@ -251,7 +259,7 @@ def main():
         ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
         ax.set_xlabel("t (s)")
         ax.set_ylabel("E/E0 over the exact decay")
-        ax.set_title(f"Taylor-Green, Re 100, {prm['n']}$^2$, quintic h = {prm['hdx']:g} dx, p_b = {prm['pb']:g} Pa")
+        ax.set_title(f"Taylor-Green, Re 100, {prm['n']}$^2$, {prm['kern']} h = {prm['hdx']:g} dx, p_b = {prm['pb']:g} Pa")
         ax.legend()
         lahar_py.save_png(fig, a.png, fail)
     if a.check is not None:
