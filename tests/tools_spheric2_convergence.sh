@@ -2,7 +2,8 @@
 # tools/plot_spheric2_convergence.py: on the two SPHERIC Test 2 ctests' runs (3D at dx 40 mm, the
 # centre plane at dx 5 mm, each already compared by compare_spheric2.py) a row per run whose
 # impact, travel time, sustained loads and level distances are those of the run's spheric2.json
-# ("none" for a load the run ended before); on a synthetic series made from the plane's JSON
+# ("none" for a load the run ended before), and with --peaks its P1 and P3 peaks and largest window
+# means; on a synthetic series made from the plane's JSON
 # (dx 20 / 15 / 10 mm, each quantity q* + C dx^p with known q* and p, the travel time not
 # monotone) a "converged" row whose values are those q* and p, and "not monotone" for the travel
 # time; "no order in 0.25-4" and "no value in a run" where a series shrinks too slowly or lacks a
@@ -34,6 +35,28 @@ print("|".join(["%g" % (1e3 * m["dx"]), cell(m["impact"]["run"], m["impact"]["ex
     "$runs/$run/spheric2.json") || fail "cannot read $run's spheric2.json"
   got=$(row "$label" "$out/conv.md")
   [ "$got" = "$want" ] || fail "$label: the table's row '$got', spheric2.json's '$want'"
+done
+
+# --peaks: the same runs, a row per run whose P1 and P3 peaks and largest window means are those of
+# its spheric2.json
+"$py" "$tool" --peaks "$out/peaks.png" "3D=$runs/spheric2_3d" "plane=$runs/spheric2_plane_2d/spheric2.json" > "$out/peaks.md" ||
+  fail "--peaks: exit $? on the two runs"
+cat "$out/peaks.md"
+[ -s "$out/peaks.png" ] || fail "--peaks: no PNG"
+grep -q "P1 peak (one sample)" "$out/peaks.md" || fail "--peaks: no P1 peak column"
+for s in 3D:spheric2_3d plane:spheric2_plane_2d; do
+  label=${s%%:*} run=${s#*:}
+  want=$("$py" -c 'import json, sys
+m = json.load(open(sys.argv[1]))
+cells = ["%g" % (1e3 * m["dx"])]
+for n in ("P1", "P3"):
+    for k in ("peak", "peak_mean"):
+        v, e = m["peaks"][n][k], m["peaks"][n][k + "_exp"]
+        cells.append("%.2f (%+.1f %%)" % (1e-3 * v, 100 * (v / e - 1)))
+cells.append("%.0f / %.0f" % (1e3 * m["levels"]["H1"]["mean_abs_diff_m"], 1e3 * m["levels"]["H2"]["mean_abs_diff_m"]))
+print("|".join(cells))' "$runs/$run/spheric2.json") || fail "cannot read $run's spheric2.json"
+  got=$(row "$label" "$out/peaks.md")
+  [ "$got" = "$want" ] || fail "--peaks: $label: the table's row '$got', spheric2.json's '$want'"
 done
 
 # a synthetic series: impact 0.9 x the experiment's + 2 dx (order 1), P1 0.9 x + 30 dx^0.8 kPa,
