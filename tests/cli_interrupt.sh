@@ -2,8 +2,8 @@
 # Ctrl-C (SIGINT) and SIGTERM during a long set-up end the run at once (coordinator/run/nodes.c,
 # coord_setup_wait): lahar exits 1 within 2 s (it took 23 s, the whole set-up, before), summary.json
 # says "interrupted during set-up", and no node process is left. The case: the 3D dam break at
-# dx 2 mm (1.87 million particles, ~8 s of set-up on one thread of a quiet machine; at dx 3 mm it
-# took 2.4 s there, and the signal came after it), interrupted 2.5 s in.
+# dx 2 mm (1.87 million particles, 3.4 times dx 3 mm's, whose set-up took 2.4 s on one thread of a
+# quiet machine, so that the signal came after it), interrupted 2.5 s in.
 # usage: cli_interrupt.sh LAHAR CASE_OVERRIDE_PY CASES_DIR WORK_DIR
 lahar=$1 override=$2 cases=$3 work=$4
 fail=0 n=0
