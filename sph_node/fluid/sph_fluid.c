@@ -276,8 +276,12 @@ static inline __attribute__((always_inline)) int64_t fluid_pairs(const sph_fluid
                 const double pav = sph_monaghan_viscosity(av, vdotr, ieta, rhoi, rhoj);
                 gp = -mi * mj * (pri + pra[j] - pav) * fij;
             }
-            /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij */
-            const double gv = sph_morris_viscosity(visci, volj, fij, rsoft);
+            /* laminar viscosity, Morris 1997: 2 mu V_i V_j F_ij r^2/(r^2 + eta^2) v_ij. With the
+             * transport velocity, Adami et al. 2013's shear term mu (V_i^2 + V_j^2) F_ij v_ij (equal
+             * for equal volumes) has no eta: F_ij is finite at r = 0 for every kernel here, and the
+             * regularisation weakens a pair at r by 0.01 (h/r)^2 (4 % at r = dx for h = 2 dx), which
+             * alone slowed the Taylor-Green decay by 1 % (docs/bench/validation.md) */
+            const double gv = sph_morris_viscosity(visci, volj, fij, tvf ? 1.0 : rsoft);
             double Fx = gp * rx + gv * vx, Fy = gp * ry + gv * vy, Fz = dim == 3 ? gp * rz + gv * vz : 0.0;
             if (sps) { /* Canelas et al. 2015, eq. 10, third term: m_i m_j (tau_i/rho_i^2 + tau_j/rho_j^2) . grad_i W_ij */
                 const double tj[6] = {tau[0][j], tau[1][j], tau[2][j], tau[3][j], tau[4][j], tau[5][j]};
