@@ -26,7 +26,8 @@ static inline double sph_monaghan_viscosity(double av, double vdotr, double ieta
 }
 
 /* Laminar viscosity (Morris, Fox & Zhu 1997): the pair force's v_ij coefficient
- * m_i m_j (mu_i + mu_j)/(rho_i rho_j) F_ij rsoft = 2 mu V_i V_j F_ij rsoft; visci = 2 mu V_i. */
+ * m_i m_j (mu_i + mu_j)/(rho_i rho_j) F_ij rsoft = 2 mu V_i V_j F_ij rsoft; visci = 2 mu V_i.
+ * With rsoft = 1 it is Adami et al. 2013's shear term (the transport velocity's; sph_fluid.h). */
 static inline double sph_morris_viscosity(double visci, double volj, double fij, double rsoft)
 {
     return visci * volj * fij * rsoft;
