@@ -77,7 +77,7 @@ lahar_validation_test(lid_driven_cavity_2d lid_driven_cavity_2d dx=0.025 threads
 # Taylor-Green vortex, Re = 100, periodic, transport velocity (Adami et al. 2013) with p_b = 3 rho0
 # c0^2, Wendland C2 kernel with h = 2 dx. At 50 x 50 (validation_taylor_green_2d, ~4 s CPU per
 # run): the kinetic-energy decay rate within 2 % of 16 pi^2 nu / L^2 (measured 0.57 %; without the
-# transport velocity +285 %, so the test fails if the formulation stops working), velocity L2 at
+# transport velocity +134 %, so the test fails if the formulation stops working), velocity L2 at
 # t = 1 s <= 0.06 (0.042), mean density within 1.5 % (max over snapshots 0.87 %), and bitwise the
 # same particles.h5 on 1 and 2 threads (tests/validation_taylor_green.sh). At 100 x 100, the case
 # as it is (~30 s CPU): the case's 1 % (measured 0.57 %), L2 <= 0.06 (0.046), mean density within

@@ -38,7 +38,8 @@
  *       evaluation); density by summation rho_i = m_i sum_j W_ij (j includes i; continuity and
  *       delta-SPH unused, drho = 0); the laminar viscosity is Adami et al.'s shear term
  *       mu (V_i^2 + V_j^2) F_ij v_ij, Morris's without the eta^2 = 0.01 h^2 of its denominator.
- *       Adami et al. write the pair terms with (V_i^2 + V_j^2): equal to these for equal masses. Off: no arrays, the pair loop's branch is never taken.
+ *       Adami et al. write the pair terms with (V_i^2 + V_j^2): equal to these for equal masses.
+ *       Off: no arrays, the pair loop's branch is never taken.
  *   Shepard filter (Canelas et al. 2015, eq. 5, optional, every N steps): rho_i = sum_j m_j W_ij / sum_j V_j W_ij
  *     (j includes i), which removes the particle-scale pressure noise of WCSPH without the
  *     hydrostatic bias that delta-SPH has (Canelas et al. 2015, section 3.3; test_sph_hydrostatic.c).
