@@ -48,6 +48,11 @@ lahar_test(sph_dam_break_obstacle_3d COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST
   ${CMAKE_CURRENT_BINARY_DIR}/impact/spheric2_3d ${CMAKE_SOURCE_DIR}/cases/dam_break_obstacle_3d.yaml compare_spheric2.py time.end=0.5
   -- --impact-tol 0.14 --level-tol 0.03 --p1-mean-band 0.5 3
   LABELS sph validation slow TIMEOUT 600 PROPERTIES FIXTURES_SETUP spheric2_runs)
+# The face load compare_spheric2.py reports (the line load of P1-P4 up the box's face and the height
+# of its resultant) on profiles integrated by hand: uniform, hydrostatic, a load that stops between
+# two probes, none.
+lahar_test(tools_spheric2_face_load COMMAND ${LAHAR_OUTPUT_PYTHON} ${LAHAR_TEST_DIR}/test_spheric2_face_load.py
+  LABELS fast output TIMEOUT 60)
 # tools/plot_spheric2_convergence.py (timing and sustained loads against dx with their Richardson
 # extrapolation, docs/bench/impact_pressure.md "SPHERIC Test 2: P3 against resolution in the plane")
 # on the two runs above: each row's numbers those of the run's spheric2.json; on a synthetic

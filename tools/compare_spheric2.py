@@ -24,6 +24,12 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              the level first changes by 20 mm, and the mean |h_run - h_exp| over the run (m);
              h_run: the case's level gauges (kind: level, 1 kHz; the top of the water column on
              the floor, where the water's kernel fraction falls to 1/2, sph_node/probes/sph_probes.h)
+  profile    every probe the run has (P1-P4 up the face, P5-P8 along the top): the mean over the
+             sustained-load window above against the experiment's: how the load is spread up the
+             face, and whether water rests on the top (the experiment's P5-P8 read within 0.1 kPa
+             of zero there); with P1-P4, the face's line load (N/m: the profile piecewise linear
+             between the probes, constant below P1 and above P4 to the top, z = 0.161 m) and the
+             height of its resultant, the two numbers a barrier's sliding and overturning take
   depths     (--depths) H1 and H2 every 50 ms from 0.25 s: the run, the experiment and Ritter's
              (1892) shallow-water dam-break depth h = (4/9g) (sqrt(g H0) - x/2t)^2 for the
              instantaneous release of the case's column (H0 its height, x the distance from its
@@ -54,6 +60,10 @@ import yaml  # noqa: E402
 
 GAUGES = [("H1", 1.488, 0.5), ("H2", 0.992, 0.5), ("H3", 0.496, 0.5), ("H4", 2.638, 0.5)]
 BOX_FACE_X = 0.8245  # the obstacle's face towards the water: Ritter's depth is drawn for the gauges before it
+# SPHERIC's pressure probes: on the box's face (height z, m) and on its top (x, m)
+PROBES = {"P1": ("face", 0.021), "P2": ("face", 0.061), "P3": ("face", 0.101), "P4": ("face", 0.141),
+          "P5": ("top", 0.8035), "P6": ("top", 0.7635), "P7": ("top", 0.7235), "P8": ("top", 0.6835)}
+BOX_TOP_Z = 0.161
 IMPACT_PA = 1000.0
 SPAN = 0.2
 PLATEAU = (0.05, 0.15)  # s after the first impact on P1: the window of the sustained load
@@ -128,6 +138,9 @@ def main():
             else float("nan")
         m["peaks"][n]["noise_rms_exp"] = float(np.sqrt(np.mean((pe - lahar_py.running_mean(te, pe, tau))[we] ** 2)))
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
+        probes = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in PROBES if n in f["probes"]}
+    m["profile"] = profile(probes, te, e, head, ti_run, ti_exp)
+    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
         if missing:
             sys.stderr.write("compare_spheric2: %s/gauges.h5 has no level gauge %s (kind: level); run "
@@ -157,6 +170,18 @@ def main():
               "(exp %.0f), rms about the %g ms running mean there %.0f Pa (exp %.0f)" % (
                   n, s["peak"], s["peak_exp"], a.window, s["peak_mean"], s["peak_mean_exp"], s["plateau"],
                   s["plateau_exp"], a.window, s["noise_rms"], s["noise_rms_exp"]))
+    print("sustained load (mean %g-%g ms after P1's first impact), kPa%s:" % (
+        1e3 * PLATEAU[0], 1e3 * PLATEAU[1], "" if np.isfinite(m["peaks"]["P1"]["plateau"]) else
+        " (run: nan, it ends before the window does)"))
+    for n, d in m["profile"].items():
+        if n in PROBES:
+            print("  %s (%s = %3.0f mm): run %5.2f, experiment %5.2f" % (
+                n, "face, z" if d["where"] == "face" else "top, x", 1e3 * d["at"], 1e-3 * d["run"], 1e-3 * d["exp"]))
+    if "face_run" in m["profile"]:
+        r, x = m["profile"]["face_run"], m["profile"]["face_exp"]
+        print("  face from P1-P4: line load %.0f N/m (experiment %.0f, %+.1f %%), resultant at z = %.0f mm "
+              "(experiment %.0f mm)" % (r["line_load"], x["line_load"], 100 * (r["line_load"] / x["line_load"] - 1),
+                                        1e3 * r["resultant_z"], 1e3 * x["resultant_z"]))
     for g, d in m["levels"].items():
         print("%s: level changes by 20 mm at %.3f s (exp %.3f s); mean |h - h_exp| = %.3f m over 0-%.2f s" % (
             g, d["change_run"], d["change_exp"], d["mean_abs_diff_m"], tl[-1]))
@@ -171,6 +196,37 @@ def main():
         print("FAIL:", ", ".join(failed))
         return 1
     return 0
+
+
+def profile(probes, te, e, head, ti_run, ti_exp):
+    """Per probe the run has: the mean over the sustained-load window (PLATEAU after each series'
+    own first impact on P1), run and experiment (Pa); nan when the run ends before the window."""
+    lo, hi = PLATEAU
+    out = {}
+    for n, (t, p) in probes.items():
+        w, we = (t >= ti_run + lo) & (t <= ti_run + hi), (te >= ti_exp + lo) & (te <= ti_exp + hi)
+        covered = len(t) and t[-1] >= ti_run + hi
+        where, at = PROBES[n]
+        out[n] = {"where": where, "at": at, "run": float(p[w].mean()) if covered else float("nan"),
+                  "exp": float(e[we, head.index(n)].mean())}
+    face = ["P1", "P2", "P3", "P4"]
+    if all(n in out for n in face):
+        for k in ("run", "exp"):
+            load, z = face_load([PROBES[n][1] for n in face], [out[n][k] for n in face])
+            out["face_" + k] = {"line_load": load, "resultant_z": z}
+    return out
+
+
+def face_load(z, p, top=BOX_TOP_Z):
+    """Line load (N/m) and the height of its resultant (m) of the pressures p at the heights z up a
+    face from 0 to top: p piecewise linear between the probes and constant below the lowest and
+    above the highest; both integrals exact for that profile."""
+    z = np.concatenate([[0.0], z, [top]])
+    p = np.concatenate([p[:1], p, p[-1:]])
+    h = np.diff(z)
+    load = float(np.sum(0.5 * h * (p[:-1] + p[1:])))
+    moment = float(np.sum(h / 6.0 * (p[:-1] * (2 * z[:-1] + z[1:]) + p[1:] * (z[:-1] + 2 * z[1:]))))
+    return load, moment / load if load != 0.0 else float("nan")
 
 
 def ritter_depth(distance, t, h0, g=9.81):
