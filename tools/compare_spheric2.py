@@ -35,7 +35,8 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              instantaneous release of the case's column (H0 its height, x the distance from its
              downstream face): how much water arrives in front of the box
 The PNG shows P1, P3, P5, P7 and H1-H4 against the experiment (and Ritter's depth at the gauges
-before the box). Runs of the 2D centre plane
+before the box); when the run has P1-P4 and covers the sustained-load window, a second PNG
+(the first's name with _face) the load up the face with the line loads. Runs of the 2D centre plane
 (cases/dam_break_obstacle_plane_2d.yaml) are read the same way (its probes and gauges have the
 3D case's names).
 With --check: exit 1 unless |impact - 0.394 s| / 0.394 s <= --impact-tol (default 0.05), every
@@ -192,6 +193,8 @@ def main():
         lahar_py.dump_json(m, fh)
     if not a.no_plot:
         plot(a, te, e, head, run_p, tls, hs, dx, tau, column)
+        if "face_run" in m["profile"] and np.isfinite(m["profile"]["face_run"]["line_load"]):
+            plot_face(a, m["profile"], dx)
     if a.check and not ok:
         print("FAIL:", ", ".join(failed))
         return 1
@@ -314,6 +317,29 @@ def plot(a, te, e, head, run_p, tls, hs, dx, tau, column):
         ax.set_xlim(0, tl[-1])
     fig.tight_layout()
     png = a.output or os.path.join(a.out, "spheric2.png")
+    fig.savefig(png, dpi=90)
+    print("wrote", png)
+
+
+def plot_face(a, prof, dx):
+    """The sustained load up the face (P1-P4) against the experiment's, beside the PNG of plot()."""
+    fig, ax = plt.subplots(figsize=(5, 4.5))
+    face = [n for n in ("P1", "P2", "P3", "P4")]
+    z = [1e3 * PROBES[n][1] for n in face]
+    for k, style, label in (("exp", "ko-", "Kleefsman et al. 2005 (SPHERIC Test 2)"),
+                            ("run", "s-", "lahar, dx %g mm" % (1e3 * dx))):
+        f = prof["face_" + k]
+        ax.plot([1e-3 * prof[n][k] for n in face], z, style,
+                label="%s: %.0f N/m at z = %.0f mm" % (label, f["line_load"], 1e3 * f["resultant_z"]))
+    ax.axhline(1e3 * BOX_TOP_Z, color="0.5", lw=0.8, ls="--", label="the box's top")
+    ax.set_xlabel("mean pressure %g-%g ms after the first impact on P1, kPa" % (1e3 * PLATEAU[0], 1e3 * PLATEAU[1]))
+    ax.set_ylabel("height on the face, mm")
+    ax.set_xlim(left=0)
+    ax.set_ylim(0, 1.1e3 * BOX_TOP_Z)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    png = os.path.splitext(a.output or os.path.join(a.out, "spheric2.png"))[0] + "_face.png"
     fig.savefig(png, dpi=90)
     print("wrote", png)
 
