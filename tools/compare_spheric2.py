@@ -26,7 +26,7 @@ docs/references-data/kleefsman_2005_test2.csv (t in s, P1-P8 in Pa, H1-H4 in m).
              the floor, where the water's kernel fraction falls to 1/2, sph_node/probes/sph_probes.h)
   profile    every probe the run has (P1-P4 up the face, P5-P8 along the top): the mean over the
              sustained-load window above against the experiment's: how the load is spread up the
-             face, and whether water rests on the top (the experiment's P5-P8 read within 0.1 kPa
+             face, and whether water rests on the top (the experiment's P5-P8 read within 0.01 kPa
              of zero there); with P1-P4, the face's line load (N/m: the profile piecewise linear
              between the probes, constant below P1 and above P4 to the top, z = 0.161 m) and the
              height of its resultant, the two numbers a barrier's sliding and overturning take
@@ -110,7 +110,7 @@ def main():
     e = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
     te = e[:, 0]
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
-        run_p = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in ["P1", "P3", "P5", "P7"]}
+        run_p = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in PROBES if n in f["probes"]}
     m = {"dx": dx, "window_ms": a.window}
     ti_run = first_at_or_above(*run_p["P1"], IMPACT_PA)
     if np.isnan(ti_run):
@@ -120,6 +120,7 @@ def main():
         return 2
     ti_exp = first_at_or_above(te, e[:, head.index("P1")], IMPACT_PA)
     m["impact"] = {"run": ti_run, "experiment": ti_exp, "rel": (ti_run - ti_exp) / ti_exp}
+    m["profile"] = profile(run_p, te, e, head, ti_run, ti_exp)
     m["peaks"] = {}
     for n in ["P1", "P3"]:
         t, p = run_p[n]
@@ -127,20 +128,12 @@ def main():
         sel, sele = (t >= ti_run) & (t <= ti_run + SPAN), (te >= ti_exp) & (te <= ti_exp + SPAN)
         m["peaks"][n] = {"peak": float(p[sel].max()), "peak_exp": float(pe[sele].max()),
                          "peak_mean": window_peak(t, p, ti_run, tau), "peak_mean_exp": window_peak(te, pe, ti_exp, tau)}
-        # the sustained load after the impact, each series from its own first impact on P1 (so that
-        # the run's timing error does not enter); nan when the run ends before the window does
-        lo, hi = PLATEAU
-        w, we = (t >= ti_run + lo) & (t <= ti_run + hi), (te >= ti_exp + lo) & (te <= ti_exp + hi)
-        covered = len(t) and t[-1] >= ti_run + hi
-        m["peaks"][n]["plateau"] = float(p[w].mean()) if covered else float("nan")
-        m["peaks"][n]["plateau_exp"] = float(pe[we].mean())
+        m["peaks"][n]["plateau"], m["peaks"][n]["plateau_exp"] = m["profile"][n]["run"], m["profile"][n]["exp"]
+        w, we, covered = plateau_window(t, te, ti_run, ti_exp)
         # how smooth the load is: rms of p about its running mean over --window, in that window
         m["peaks"][n]["noise_rms"] = float(np.sqrt(np.mean((p - lahar_py.running_mean(t, p, tau))[w] ** 2))) if covered \
             else float("nan")
         m["peaks"][n]["noise_rms_exp"] = float(np.sqrt(np.mean((pe - lahar_py.running_mean(te, pe, tau))[we] ** 2)))
-    with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
-        probes = {n: (f["probes"][n]["t"][:], f["probes"][n]["p"][:]) for n in PROBES if n in f["probes"]}
-    m["profile"] = profile(probes, te, e, head, ti_run, ti_exp)
     with h5py.File(os.path.join(a.out, "gauges.h5"), "r") as f:
         missing = [g for g, _, _ in GAUGES if g not in f["probes"] or "h" not in f["probes"][g]]
         if missing:
@@ -201,14 +194,21 @@ def main():
     return 0
 
 
-def profile(probes, te, e, head, ti_run, ti_exp):
-    """Per probe the run has: the mean over the sustained-load window (PLATEAU after each series'
-    own first impact on P1), run and experiment (Pa); nan when the run ends before the window."""
+def plateau_window(t, te, ti_run, ti_exp):
+    """The sustained-load window, PLATEAU after each series' own first impact on P1 (so that the
+    run's timing error does not enter): the run's and the experiment's masks, and whether the run
+    lasts to the window's end."""
     lo, hi = PLATEAU
+    w, we = (t >= ti_run + lo) & (t <= ti_run + hi), (te >= ti_exp + lo) & (te <= ti_exp + hi)
+    return w, we, bool(len(t)) and t[-1] >= ti_run + hi
+
+
+def profile(probes, te, e, head, ti_run, ti_exp):
+    """Per probe the run has: the mean over the sustained-load window, run and experiment (Pa);
+    the run's nan when it ends before the window does."""
     out = {}
     for n, (t, p) in probes.items():
-        w, we = (t >= ti_run + lo) & (t <= ti_run + hi), (te >= ti_exp + lo) & (te <= ti_exp + hi)
-        covered = len(t) and t[-1] >= ti_run + hi
+        w, we, covered = plateau_window(t, te, ti_run, ti_exp)
         where, at = PROBES[n]
         out[n] = {"where": where, "at": at, "run": float(p[w].mean()) if covered else float("nan"),
                   "exp": float(e[we, head.index(n)].mean())}
@@ -324,7 +324,7 @@ def plot(a, te, e, head, run_p, tls, hs, dx, tau, column):
 def plot_face(a, prof, dx):
     """The sustained load up the face (P1-P4) against the experiment's, beside the PNG of plot()."""
     fig, ax = plt.subplots(figsize=(5, 4.5))
-    face = [n for n in ("P1", "P2", "P3", "P4")]
+    face = ["P1", "P2", "P3", "P4"]
     z = [1e3 * PROBES[n][1] for n in face]
     for k, style, label in (("exp", "ko-", "Kleefsman et al. 2005 (SPHERIC Test 2)"),
                             ("run", "s-", "lahar, dx %g mm" % (1e3 * dx))):
